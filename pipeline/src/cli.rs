@@ -1,0 +1,246 @@
+//! The `rh-pipeline` command line (SPEC §14). Exit status: 0 success, 2 bad input or
+//! usage (with a message naming what is wrong), 1 internal failure.
+
+use crate::build::{build, BuildError, BuildOptions};
+use crate::config::Config;
+use crate::plan::{LexiconPlanner, Planner};
+use crate::verify::verify;
+use clap::{Parser, Subcommand};
+use rh_catalog::Catalog;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "rh-pipeline",
+    version,
+    about = "Builds the ReactHuman dataset: bit-for-bit reproducible physics scenes with exact ground truth",
+    after_help = "Exit status: 0 success, 2 bad input or usage, 1 internal failure."
+)]
+pub struct Cli {
+    /// Build configuration (TOML); defaults to the embedded configs/default.toml.
+    #[arg(long, global = true, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Catalog directory holding objects.toml and rooms.toml; defaults to the embedded catalog.
+    #[arg(long, global = true, value_name = "DIR")]
+    pub catalog: Option<PathBuf>,
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Build N scenes into a Hugging Face-style dataset directory.
+    Build {
+        /// Number of scenes (four speed bands per scene group).
+        #[arg(long)]
+        n: u64,
+        /// Output directory (created if missing).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Build seed; defaults to the configuration's build.seed.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Comma-separated families; defaults to the configuration's build.families.
+        #[arg(long, value_delimiter = ',')]
+        families: Option<Vec<String>>,
+        /// Skip rendering (videos and frames); labels, specs and Parquet only.
+        #[arg(long)]
+        no_render: bool,
+        /// Build only shard i of N (scene groups g with g mod N = i), e.g. 0/4.
+        #[arg(long, value_name = "i/N")]
+        shard: Option<String>,
+        /// Worker threads (default: all cores). Never changes the output.
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Print the build summary as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+        /// No progress output.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Map a free-text description to a validated selection (family, object, room); prints JSON.
+    Plan {
+        /// e.g. "a cast-iron pan slides off the counter"
+        description: String,
+        /// Seed for choices the description leaves open.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+    },
+    /// Replay every spec of a dataset and compare per-step state hashes (exit 2 on any mismatch).
+    Verify {
+        /// Dataset directory built by `rh-pipeline build`.
+        dir: PathBuf,
+        /// Print the report as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// A failure with its exit code.
+pub struct Failure {
+    pub code: u8,
+    pub message: String,
+}
+
+fn input(message: impl Into<String>) -> Failure {
+    Failure {
+        code: 2,
+        message: message.into(),
+    }
+}
+
+fn parse_shard(text: &str) -> Result<(u64, u64), Failure> {
+    let bad = || {
+        input(format!(
+            "--shard '{text}': expected i/N with 0 <= i < N, e.g. 0/4"
+        ))
+    };
+    let (i, n) = text.split_once('/').ok_or_else(bad)?;
+    let (i, n): (u64, u64) = (
+        i.trim().parse().map_err(|_| bad())?,
+        n.trim().parse().map_err(|_| bad())?,
+    );
+    if n == 0 || i >= n {
+        return Err(bad());
+    }
+    Ok((i, n))
+}
+
+fn load(cli: &Cli) -> Result<(Catalog, Config), Failure> {
+    let catalog = match &cli.catalog {
+        Some(dir) => Catalog::load_dir(dir),
+        None => Catalog::embedded(),
+    }
+    .map_err(|e| input(format!("catalog: {e}")))?;
+    let config = match &cli.config {
+        Some(path) => Config::load(path),
+        None => Config::embedded(),
+    }
+    .map_err(|e| input(format!("config: {e}")))?;
+    Ok((catalog, config))
+}
+
+pub fn run(cli: Cli) -> Result<(), Failure> {
+    let (catalog, config) = load(&cli)?;
+    match cli.command {
+        Command::Build {
+            n,
+            out,
+            seed,
+            families,
+            no_render,
+            shard,
+            jobs,
+            json,
+            quiet,
+        } => {
+            let opts = BuildOptions {
+                n,
+                out,
+                seed: seed.unwrap_or(config.build.seed),
+                families: families.unwrap_or_else(|| config.build.families.clone()),
+                jobs: jobs
+                    .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+                shard: match shard {
+                    Some(s) => parse_shard(&s)?,
+                    None => (0, 1),
+                },
+                render: !no_render,
+                progress: !quiet,
+            };
+            let summary = build(&opts, &catalog, &config).map_err(|e| match e {
+                BuildError::Input(m) => input(m),
+                BuildError::Internal(m) => Failure {
+                    code: 1,
+                    message: m,
+                },
+            })?;
+            if json {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&summary).expect("summary serializes")
+                );
+            } else {
+                println!(
+                    "built {} scenes ({} valid) into {} — {}",
+                    summary.scenes, summary.valid, summary.out, summary.data_file
+                );
+                let actions: Vec<String> = summary
+                    .per_action
+                    .iter()
+                    .map(|(a, c)| format!("{a} {c}"))
+                    .collect();
+                println!("labels: {}", actions.join(", "));
+                if !summary.invalid_scene_ids.is_empty() {
+                    println!(
+                        "warning: {} scene(s) failed validation after every attempt: {}",
+                        summary.invalid_scene_ids.len(),
+                        summary.invalid_scene_ids.join(", ")
+                    );
+                }
+            }
+            Ok(())
+        }
+        Command::Plan { description, seed } => {
+            let planner = LexiconPlanner::new(&catalog);
+            let selection = planner
+                .plan(&description, seed)
+                .map_err(|e| input(e.to_string()))?;
+            let matches = planner.matches(&description);
+            let out = serde_json::json!({ "selection": selection, "matched": matches });
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&out).expect("selection serializes")
+            );
+            Ok(())
+        }
+        Command::Verify { dir, json } => {
+            let report = verify(&dir).map_err(input)?;
+            if json {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&report).expect("report serializes")
+                );
+            } else {
+                for m in &report.mismatches {
+                    println!("MISMATCH {}: {}", m.scene_id, m.problem);
+                }
+                println!(
+                    "verified {} scenes: {} match, {} mismatch",
+                    report.scenes,
+                    report.matched,
+                    report.mismatches.len()
+                );
+            }
+            if report.ok() {
+                Ok(())
+            } else {
+                Err(input(format!(
+                    "{} scene(s) did not replay to their stored state hash",
+                    report.mismatches.len()
+                )))
+            }
+        }
+    }
+}
+
+/// Entry point of the binary.
+pub fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("rh-pipeline: {}", f.message);
+            ExitCode::from(f.code)
+        }
+    }
+}

@@ -1,0 +1,309 @@
+//! Build configuration (`configs/*.toml`): every policy number of the pipeline.
+//!
+//! The default configuration is compiled in, so `rh-pipeline build` needs no files;
+//! `--config FILE` loads another one (its `labels` path is relative to that file).
+
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+const DEFAULT_TOML: &str = include_str!("../../configs/default.toml");
+const LABELS_TOML: &str = include_str!("../../configs/labels.toml");
+
+#[derive(Debug, thiserror::Error)]
+#[error("{location}: {message}")]
+pub struct ConfigError {
+    pub location: String,
+    pub message: String,
+}
+
+/// Label thresholds (SPEC §6); stored whole in every spec so a scene says which rule made it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LabelConfig {
+    pub rule_version: String,
+    pub reach_plane_z: f64,
+    pub closest_approach_max: f64,
+    pub reach_radius: f64,
+    pub heavy_mass_kg: f64,
+    pub heavy_momentum: f64,
+    pub catch_speed_max: f64,
+    pub catch_energy_max: f64,
+    pub strike_speed_min: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BuildSection {
+    pub seed: u64,
+    pub families: Vec<String>,
+    pub far_observer_share: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhysicsConfig {
+    pub dt: f64,
+    pub min_duration_s: f64,
+    pub horizon_s: f64,
+    pub settle_speed: f64,
+    pub settle_time_s: f64,
+    pub solver_iterations: usize,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObservationConfig {
+    pub window_s: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObserverConfig {
+    pub height: f64,
+    pub pelvis_z: f64,
+    pub shoulder_z: f64,
+    pub arm_reach: f64,
+    pub torso_radius: f64,
+    pub max_walk_speed: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ValidatorConfig {
+    pub max_attempts: u32,
+    pub penetration_tolerance: f64,
+    pub energy_gain_relative: f64,
+    pub energy_gain_absolute: f64,
+    pub tunnel_tolerance: f64,
+    pub frame_margin: f64,
+    pub frame_check_until_within: f64,
+}
+
+impl ValidatorConfig {
+    pub fn framing(&self) -> crate::cameras::FramingRules {
+        crate::cameras::FramingRules {
+            margin: self.frame_margin,
+            until_within: self.frame_check_until_within,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderConfig {
+    pub width: u32,
+    pub height: u32,
+    pub fps: u32,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawConfig {
+    labels: PathBuf,
+    build: BuildSection,
+    physics: PhysicsConfig,
+    observation: ObservationConfig,
+    observer: ObserverConfig,
+    validators: ValidatorConfig,
+    render: RenderConfig,
+    speed_bands: BTreeMap<String, [f64; 4]>,
+}
+
+/// The whole, validated build configuration.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Config {
+    pub build: BuildSection,
+    pub physics: PhysicsConfig,
+    pub observation: ObservationConfig,
+    pub observer: ObserverConfig,
+    pub validators: ValidatorConfig,
+    pub render: RenderConfig,
+    pub speed_bands: BTreeMap<String, [f64; 4]>,
+    pub labels: LabelConfig,
+}
+
+impl Config {
+    /// The configuration compiled into the binary (`configs/default.toml`).
+    pub fn embedded() -> Result<Config, ConfigError> {
+        let raw: RawConfig = parse("configs/default.toml", DEFAULT_TOML)?;
+        let labels: LabelConfig = parse("configs/labels.toml", LABELS_TOML)?;
+        Config::assemble("configs/default.toml", raw, labels)
+    }
+
+    /// Loads a configuration file and the labels file it names.
+    pub fn load(path: &Path) -> Result<Config, ConfigError> {
+        let name = path.display().to_string();
+        let text = read(path)?;
+        let raw: RawConfig = parse(&name, &text)?;
+        let labels_path = path.parent().unwrap_or(Path::new(".")).join(&raw.labels);
+        let labels_text = read(&labels_path)?;
+        let labels: LabelConfig = parse(&labels_path.display().to_string(), &labels_text)?;
+        Config::assemble(&name, raw, labels)
+    }
+
+    fn assemble(name: &str, raw: RawConfig, labels: LabelConfig) -> Result<Config, ConfigError> {
+        let config = Config {
+            build: raw.build,
+            physics: raw.physics,
+            observation: raw.observation,
+            observer: raw.observer,
+            validators: raw.validators,
+            render: raw.render,
+            speed_bands: raw.speed_bands,
+            labels,
+        };
+        config.validate(name)?;
+        Ok(config)
+    }
+
+    fn validate(&self, name: &str) -> Result<(), ConfigError> {
+        let fail = |field: &str, message: String| ConfigError {
+            location: format!("{name}: field '{field}'"),
+            message,
+        };
+        let positive = |field: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(fail(field, format!("must be a positive number (got {v})")))
+            }
+        };
+        positive("physics.dt", self.physics.dt)?;
+        positive("physics.horizon_s", self.physics.horizon_s)?;
+        positive("physics.min_duration_s", self.physics.min_duration_s)?;
+        positive("observation.window_s", self.observation.window_s)?;
+        positive("labels.reach_plane_z", self.labels.reach_plane_z)?;
+        positive("labels.reach_radius", self.labels.reach_radius)?;
+        positive(
+            "labels.closest_approach_max",
+            self.labels.closest_approach_max,
+        )?;
+        positive("labels.heavy_mass_kg", self.labels.heavy_mass_kg)?;
+        positive("labels.heavy_momentum", self.labels.heavy_momentum)?;
+        positive("labels.catch_speed_max", self.labels.catch_speed_max)?;
+        positive("labels.catch_energy_max", self.labels.catch_energy_max)?;
+        positive("observer.torso_radius", self.observer.torso_radius)?;
+        if self.physics.horizon_s < self.physics.min_duration_s {
+            return Err(fail(
+                "physics.horizon_s",
+                "must be at least physics.min_duration_s".into(),
+            ));
+        }
+        if self.physics.min_duration_s < self.observation.window_s {
+            return Err(fail(
+                "physics.min_duration_s",
+                "must cover the observation window".into(),
+            ));
+        }
+        if self.validators.max_attempts == 0 {
+            return Err(fail("validators.max_attempts", "must be at least 1".into()));
+        }
+        if self.labels.reach_radius > self.labels.closest_approach_max {
+            return Err(fail(
+                "labels.reach_radius",
+                "must not exceed labels.closest_approach_max (a reachable hazard needs an impact point)".into(),
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.build.far_observer_share) {
+            return Err(fail(
+                "build.far_observer_share",
+                "must be within [0, 1]".into(),
+            ));
+        }
+        if self.render.width == 0 || self.render.height == 0 || self.render.fps == 0 {
+            return Err(fail(
+                "render",
+                "width, height and fps must be positive".into(),
+            ));
+        }
+        for family in &self.build.families {
+            if !rh_catalog::FAMILIES.contains(&family.as_str()) {
+                return Err(fail("build.families", format!("unknown family '{family}'")));
+            }
+        }
+        for (family, bands) in &self.speed_bands {
+            if !rh_catalog::FAMILIES.contains(&family.as_str()) {
+                return Err(fail("speed_bands", format!("unknown family '{family}'")));
+            }
+            if bands.iter().any(|v| !v.is_finite() || *v < 0.0) {
+                return Err(fail(
+                    &format!("speed_bands.{family}"),
+                    "must be four finite, non-negative numbers".into(),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The family's speed parameter in the four bands (slow, normal, fast, very fast).
+    pub fn speed_bands(&self, family: &str) -> Option<&[f64; 4]> {
+        self.speed_bands.get(family)
+    }
+}
+
+fn read(path: &Path) -> Result<String, ConfigError> {
+    std::fs::read_to_string(path).map_err(|e| ConfigError {
+        location: path.display().to_string(),
+        message: format!("cannot read: {e}"),
+    })
+}
+
+fn parse<T: serde::de::DeserializeOwned>(name: &str, text: &str) -> Result<T, ConfigError> {
+    toml::from_str(text).map_err(|e| {
+        let location = match e.span() {
+            Some(span) => {
+                let line = text[..span.start.min(text.len())].lines().count().max(1);
+                format!("{name}:{line}")
+            }
+            None => name.to_string(),
+        };
+        ConfigError {
+            location,
+            message: e.message().to_string(),
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn embedded_config_is_valid() {
+        let c = Config::embedded().unwrap();
+        assert!((c.physics.dt - 1.0 / 240.0).abs() < 1e-15);
+        assert_eq!(c.labels.rule_version, "v1");
+        for f in &c.build.families {
+            assert!(
+                c.speed_bands(f).is_some(),
+                "default family {f} has no speed bands"
+            );
+        }
+    }
+
+    #[test]
+    fn malformed_config_names_file_and_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.toml");
+        std::fs::write(&path, DEFAULT_TOML.replace("seed = 0", "seed = \"zero\"")).unwrap();
+        std::fs::write(dir.path().join("labels.toml"), LABELS_TOML).unwrap();
+        let err = Config::load(&path).unwrap_err().to_string();
+        assert!(err.contains("bad.toml:"), "{err}");
+        assert!(err.contains("seed") || err.contains("integer"), "{err}");
+    }
+
+    #[test]
+    fn semantic_errors_name_the_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.toml");
+        std::fs::write(
+            &path,
+            DEFAULT_TOML.replace("horizon_s = 4.0", "horizon_s = -1.0"),
+        )
+        .unwrap();
+        std::fs::write(dir.path().join("labels.toml"), LABELS_TOML).unwrap();
+        let err = Config::load(&path).unwrap_err().to_string();
+        assert!(err.contains("physics.horizon_s"), "{err}");
+    }
+}

@@ -1,0 +1,374 @@
+//! Event families (SPEC §4): one file per family behind the `Family` trait.
+//!
+//! A family lays out its scene (`sample`) from a seeded stream and the band's speed
+//! value, and says whether its intended event really happened (`event_happened`).
+//! The contract that makes speed bands honest: a sampler draws the same random numbers
+//! in the same order whatever the speed, so the four bands of a group differ only in
+//! the speed parameter and what follows from it physically.
+
+use crate::simulate::Simulation;
+use crate::spec::{
+    quat, BodyKind, BodyRole, BodySpec, JointSpec, PartSpec, Quat, SceneSpec, ShapeSpec, Vec3,
+    IDENTITY,
+};
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
+use rh_catalog::{Object, Room, ShapeKind};
+use std::collections::BTreeMap;
+
+mod ceiling_drop;
+mod object_drop;
+mod rolling_ball;
+mod shelf_slide;
+mod sliding_object;
+mod thrown_object;
+
+pub const GRAVITY: f64 = 9.81;
+
+/// What a sampler gets: the true physics of the object, the room, the band's speed.
+pub struct FamilyInput<'a> {
+    pub object: &'a Object,
+    pub room: &'a Room,
+    pub speed: f64,
+    /// The family's speed in each band, slowest first: a sampler may size its layout so
+    /// that even the slowest band's event happens (without the draws depending on `speed`).
+    pub band_speeds: [f64; 4],
+    /// Whether this group's observer stands far from the event (drawn by the randomizer).
+    pub far_observer: bool,
+    pub observer_height: f64,
+}
+
+/// Where the observer stands: on the floor at (x, y), facing `yaw`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObserverPose {
+    pub x: f64,
+    pub y: f64,
+    pub yaw: f64,
+}
+
+/// A family's layout of one scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layout {
+    pub bodies: Vec<BodySpec>,
+    pub joints: Vec<JointSpec>,
+    pub hazard: usize,
+    /// The body the hazard starts on, if any (table, shelf, ramp).
+    pub source_support: Option<usize>,
+    pub observer: ObserverPose,
+    /// Family-specific numbers worth recording (drop height, ramp angle, …).
+    pub params: BTreeMap<String, f64>,
+}
+
+pub trait Family: Sync {
+    fn name(&self) -> &'static str;
+    /// What the speed value means (e.g. `push_speed_mps`).
+    fn speed_parameter(&self) -> &'static str;
+    /// False for families whose pace gravity sets; their bands exist but analyses skip them.
+    fn speed_sweep(&self) -> bool;
+    /// Lays out the scene. Must draw from `rng` identically for every `input.speed`.
+    fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout;
+    /// Whether the family's intended event happened in the simulation.
+    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool;
+}
+
+/// All implemented families, in canonical order.
+pub fn all() -> Vec<&'static dyn Family> {
+    vec![
+        &object_drop::ObjectDrop,
+        &shelf_slide::ShelfSlide,
+        &ceiling_drop::CeilingDrop,
+        &sliding_object::SlidingObject,
+        &rolling_ball::RollingBall,
+        &thrown_object::ThrownObject,
+    ]
+}
+
+pub fn get(name: &str) -> Option<&'static dyn Family> {
+    all().into_iter().find(|f| f.name() == name)
+}
+
+// ---------------------------------------------------------------------------
+// Shared building blocks for samplers.
+
+/// Converts catalog parts into spec parts.
+pub fn object_parts(object: &Object) -> Vec<PartSpec> {
+    object
+        .parts
+        .iter()
+        .map(|p| PartSpec {
+            shape: match p.shape {
+                ShapeKind::Box => ShapeSpec::Box {
+                    half_extents: [p.size[0] / 2.0, p.size[1] / 2.0, p.size[2] / 2.0],
+                },
+                ShapeKind::Sphere => ShapeSpec::Sphere {
+                    radius: p.size[0] / 2.0,
+                },
+                ShapeKind::Cylinder => ShapeSpec::Cylinder {
+                    half_height: p.size[1] / 2.0,
+                    radius: p.size[0] / 2.0,
+                },
+                ShapeKind::Capsule => ShapeSpec::Capsule {
+                    half_height: (p.size[1] - p.size[0]) / 2.0,
+                    radius: p.size[0] / 2.0,
+                },
+            },
+            offset: p.offset,
+            rotation: IDENTITY,
+        })
+        .collect()
+}
+
+/// The catalog object as the scene's hazard body.
+pub fn hazard_body(
+    object: &Object,
+    position: Vec3,
+    rotation: Quat,
+    linvel: Vec3,
+    angvel: Vec3,
+) -> BodySpec {
+    BodySpec {
+        name: object.id.clone(),
+        role: BodyRole::Hazard,
+        kind: BodyKind::Dynamic,
+        catalog_id: Some(object.id.clone()),
+        parts: object_parts(object),
+        position,
+        rotation,
+        mass: object.mass,
+        friction: object.friction,
+        restitution: object.restitution,
+        linvel,
+        angvel,
+        ccd: true,
+    }
+}
+
+/// A fixed furniture box (table, shelf board, ramp).
+pub fn fixed_box(
+    name: &str,
+    half_extents: Vec3,
+    position: Vec3,
+    rotation: Quat,
+    friction: f64,
+    restitution: f64,
+) -> BodySpec {
+    BodySpec {
+        name: name.to_string(),
+        role: BodyRole::Support,
+        kind: BodyKind::Fixed,
+        catalog_id: None,
+        parts: vec![PartSpec {
+            shape: ShapeSpec::Box { half_extents },
+            offset: [0.0; 3],
+            rotation: IDENTITY,
+        }],
+        position,
+        rotation,
+        mass: 0.0,
+        friction,
+        restitution,
+        linvel: [0.0; 3],
+        angvel: [0.0; 3],
+        ccd: false,
+    }
+}
+
+/// Distance from the object's origin down to its lowest point, unrotated.
+pub fn bottom_offset(object: &Object) -> f64 {
+    object
+        .parts
+        .iter()
+        .map(|p| p.half_extents()[2] - p.offset[2])
+        .fold(0.0, f64::max)
+}
+
+/// Half length of the object's footprint along a horizontal direction at angle `rel`
+/// to its own x axis.
+pub fn footprint_half_length(object: &Object, rel: f64) -> f64 {
+    let h = object.half_extents();
+    h[0] * rel.cos().abs() + h[1] * rel.sin().abs()
+}
+
+pub fn yaw_quat(yaw: f64) -> Quat {
+    quat::from_axis_angle([0.0, 0.0, 1.0], yaw)
+}
+
+pub fn uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
+    if hi <= lo {
+        // Still draw, so the stream's position does not depend on the range.
+        let _: f64 = rng.random();
+        lo
+    } else {
+        rng.random_range(lo..hi)
+    }
+}
+
+/// Unit vector in the floor plane at heading `angle`.
+pub fn heading(angle: f64) -> [f64; 2] {
+    [angle.cos(), angle.sin()]
+}
+
+/// Friction coefficient rapier uses for a pair (the `Average` combine rule).
+pub fn combined_friction(a: f64, b: f64) -> f64 {
+    (a + b) / 2.0
+}
+
+/// The standard observer placement: beyond `landing` along the hazard's floor heading
+/// `dir`, at `near` distance (or `far` distance for far-observer groups), with a
+/// lateral offset, facing back toward `face_point`. Always makes the same draws.
+pub fn observer_beyond(
+    rng: &mut ChaCha8Rng,
+    landing: [f64; 2],
+    dir: [f64; 2],
+    near: (f64, f64),
+    far: (f64, f64),
+    lateral: f64,
+    far_observer: bool,
+    face_point: [f64; 2],
+) -> ObserverPose {
+    let d_near = uniform(rng, near.0, near.1);
+    let d_far = uniform(rng, far.0, far.1);
+    let side = uniform(rng, -lateral, lateral);
+    let d = if far_observer { d_far } else { d_near };
+    let perp = [-dir[1], dir[0]];
+    let x = landing[0] + dir[0] * d + perp[0] * side;
+    let y = landing[1] + dir[1] * d + perp[1] * side;
+    let yaw = (face_point[1] - y).atan2(face_point[0] - x);
+    ObserverPose { x, y, yaw }
+}
+
+/// A sampler's event origin: near the room centre, shifted against the heading so the
+/// event and the observer both fit in the room.
+pub fn event_origin(rng: &mut ChaCha8Rng, room: &Room, dir: [f64; 2], back: f64) -> [f64; 2] {
+    let jitter_x = uniform(rng, -0.3, 0.3);
+    let jitter_y = uniform(rng, -0.3, 0.3);
+    let limit_x = (room.size[0] / 2.0 - 0.8).max(0.0);
+    let limit_y = (room.size[1] / 2.0 - 0.8).max(0.0);
+    [
+        (-dir[0] * back + jitter_x).clamp(-limit_x, limit_x),
+        (-dir[1] * back + jitter_y).clamp(-limit_y, limit_y),
+    ]
+}
+
+/// The hazard's speed at the end of the run is small and it touched the floor.
+pub fn reached_floor(sim: &Simulation) -> bool {
+    sim.time_to_floor_step().is_some()
+}
+
+/// Shared layout for "pushed off the edge of a horizontal surface" families
+/// (object_drop from a table, shelf_slide from a high shelf, rolling_ball).
+pub struct EdgeLaunch {
+    pub surface_name: &'static str,
+    pub surface_height: f64,
+    pub surface_half: [f64; 2],
+    pub surface_friction: f64,
+    pub heading_angle: f64,
+    /// Distance of the hazard's centre behind the surface edge (m); its front may overhang.
+    pub com_to_edge: f64,
+    /// Lateral position of the hazard along the edge (m, from the edge's centre).
+    pub lateral: f64,
+    /// Yaw of the object relative to the heading (rad).
+    pub relative_yaw: f64,
+    pub origin: [f64; 2],
+    /// A solid block from the floor (table, cabinet) or a thin board (shelf).
+    pub board_thickness: Option<f64>,
+    pub rolling: bool,
+}
+
+impl EdgeLaunch {
+    /// Builds the surface and the hazard on it, moving toward the edge at `speed`.
+    pub fn build(&self, object: &Object, speed: f64) -> (Vec<BodySpec>, [f64; 2], Vec3) {
+        let dir = heading(self.heading_angle);
+        let perp = [-dir[1], dir[0]];
+        let h = self.surface_height;
+        let (thickness, centre_z) = match self.board_thickness {
+            Some(t) => (t, h - t / 2.0),
+            None => (h, h / 2.0),
+        };
+        // The surface's local x axis points along the heading, so its front edge is at
+        // +surface_half[0] from its centre.
+        let surface_centre = [self.origin[0], self.origin[1]];
+        let surface = fixed_box(
+            self.surface_name,
+            [self.surface_half[0], self.surface_half[1], thickness / 2.0],
+            [surface_centre[0], surface_centre[1], centre_z],
+            yaw_quat(self.heading_angle),
+            self.surface_friction,
+            0.2,
+        );
+        let edge = [
+            surface_centre[0] + dir[0] * self.surface_half[0],
+            surface_centre[1] + dir[1] * self.surface_half[0],
+        ];
+        let back = self.com_to_edge;
+        let pos = [
+            edge[0] - dir[0] * back + perp[0] * self.lateral,
+            edge[1] - dir[1] * back + perp[1] * self.lateral,
+            h + bottom_offset(object),
+        ];
+        let linvel = [dir[0] * speed, dir[1] * speed, 0.0];
+        let angvel = if self.rolling {
+            // Rolling without slipping on a +z surface: v + ω × (−r ẑ) = 0 gives
+            // ω = (−v_y, v_x, 0) / r.
+            let r = bottom_offset(object).max(1e-3);
+            [-dir[1] * speed / r, dir[0] * speed / r, 0.0]
+        } else {
+            [0.0; 3]
+        };
+        let hazard = hazard_body(
+            object,
+            pos,
+            yaw_quat(self.heading_angle + self.relative_yaw),
+            linvel,
+            angvel,
+        );
+        (vec![surface, hazard], edge, pos)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::seeds;
+    use rh_catalog::Catalog;
+
+    /// The band contract: layouts of the four bands differ only in velocities.
+    #[test]
+    fn samplers_draw_the_same_layout_at_every_speed() {
+        let catalog = Catalog::embedded().unwrap();
+        for family in all() {
+            let object = catalog.objects_for_family(family.name()).next().unwrap();
+            let room = &catalog.rooms[0];
+            let layouts: Vec<Layout> = [0.3, 2.0]
+                .iter()
+                .map(|&speed| {
+                    let input = FamilyInput {
+                        object,
+                        room,
+                        speed,
+                        band_speeds: [0.3, 0.6, 1.0, 2.0],
+                        far_observer: false,
+                        observer_height: 1.32,
+                    };
+                    family.sample(&input, &mut seeds::stream(11, 0, "placement"))
+                })
+                .collect();
+            // Thrown objects aim with an elevation that follows from the speed.
+            let strip = |l: &Layout| {
+                let mut l = l.clone();
+                for b in &mut l.bodies {
+                    b.linvel = [0.0; 3];
+                    b.angvel = [0.0; 3];
+                }
+                l.params.retain(|k, _| !k.contains("elevation"));
+                l
+            };
+            assert_eq!(
+                strip(&layouts[0]),
+                strip(&layouts[1]),
+                "{} layout depends on speed",
+                family.name()
+            );
+        }
+    }
+}

@@ -1,0 +1,99 @@
+//! One scene group through the DAG: randomize → simulate → frame cameras → validate →
+//! label, with attempt-indexed resampling when any band fails a validator.
+
+use crate::cameras;
+use crate::config::Config;
+use crate::families;
+use crate::label::{label, Labels};
+use crate::randomize::{randomize, RandomizeError, SceneKey};
+use crate::simulate::{simulate, SimOptions, Simulation};
+use crate::spec::{SceneSpec, Selection};
+use crate::validate::{validate, Verdicts};
+use rh_catalog::Catalog;
+
+/// Everything the dataset needs about one finished scene.
+#[derive(Debug, Clone)]
+pub struct SceneResult {
+    pub spec: SceneSpec,
+    pub labels: Labels,
+    pub verdicts: Verdicts,
+    pub state_hash: String,
+    /// The hazard's centre at each video frame: `[t, x, y, z]` until the scene ends.
+    pub trajectory: Vec<[f32; 4]>,
+    pub steps: u32,
+}
+
+/// Simulates one spec (plain and counterfactual), frames its cameras, validates and labels.
+pub fn run_scene(mut spec: SceneSpec, config: &Config) -> SceneResult {
+    let family = families::get(&spec.family).expect("randomize only emits implemented families");
+    let sim = simulate(&spec, SimOptions::default());
+    let framed = cameras::frame(&spec, &sim, &config.validators.framing());
+    let in_frame = framed.is_some();
+    spec.cameras = framed.unwrap_or_default();
+    let verdicts = validate(&spec, &sim, family, &config.validators, in_frame);
+    let counterfactual = simulate(
+        &spec,
+        SimOptions {
+            observer_collider: true,
+        },
+    );
+    let labels = label(&spec, &sim, &counterfactual);
+    let trajectory = hazard_trajectory(&spec, &sim);
+    SceneResult {
+        state_hash: sim.state_hash.clone(),
+        steps: sim.steps(),
+        spec,
+        labels,
+        verdicts,
+        trajectory,
+    }
+}
+
+fn hazard_trajectory(spec: &SceneSpec, sim: &Simulation) -> Vec<[f32; 4]> {
+    (0..)
+        .map(|frame| (frame, spec.frame_step(frame)))
+        .take_while(|&(_, step)| step <= sim.steps())
+        .map(|(frame, step)| {
+            let p = sim.hazard_state(step).position;
+            [
+                (frame as f64 / spec.video.fps as f64) as f32,
+                p[0],
+                p[1],
+                p[2],
+            ]
+        })
+        .collect()
+}
+
+/// Produces scenes `first_index .. first_index + count` (one group, `count` ≤ 4 bands).
+/// Tries attempts 0, 1, … until every band passes every validator; if none does within
+/// `max_attempts`, the last attempt is kept with `valid = false` so the failure is visible.
+pub fn produce_group(
+    selection: &Selection,
+    build_seed: u64,
+    first_index: u64,
+    count: u64,
+    catalog: &Catalog,
+    config: &Config,
+) -> Result<Vec<SceneResult>, RandomizeError> {
+    let mut results = Vec::new();
+    for attempt in 0..config.validators.max_attempts {
+        results.clear();
+        for index in first_index..first_index + count {
+            let spec = randomize(
+                selection,
+                &SceneKey::new(build_seed, index, attempt),
+                catalog,
+                config,
+            )?;
+            // Simulate what the file will say: a JSON round trip is exact (serde_json
+            // float_roundtrip), and this makes "replay equals build" hold by construction.
+            let spec = SceneSpec::from_json(&spec.to_json()).expect("a spec parses back");
+            results.push(run_scene(spec, config));
+        }
+        if results.iter().all(|r| r.verdicts.all()) {
+            break;
+        }
+    }
+    Ok(results)
+}

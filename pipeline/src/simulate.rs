@@ -1,0 +1,381 @@
+//! Stage 3 — simulate: rapier3d (enhanced determinism) at the spec's fixed dt.
+//!
+//! `simulate(&spec, options)` builds the world from plain spec numbers, steps it until
+//! the scene settles or the horizon, and returns the per-step state of every dynamic
+//! body, the hazard's contacts and energy, and a SHA-256 hash of the whole per-step
+//! state. The same spec gives the same hash in any process, thread count or shard: a
+//! scene is simulated single-threaded, and nothing here reads a clock or a hash map.
+
+use crate::spec::{BodyKind, JointKind, PartSpec, SceneSpec, ShapeSpec};
+use rapier3d::prelude::*;
+use sha2::{Digest, Sha256};
+
+/// Contact flags of the hazard at one step.
+pub const TOUCH_FLOOR: u8 = 1;
+pub const TOUCH_SOURCE: u8 = 2;
+pub const TOUCH_OTHER: u8 = 4;
+pub const TOUCH_OBSERVER: u8 = 8;
+
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SimOptions {
+    /// Adds the observer's body as a static collider (the counterfactual of SPEC §6) and
+    /// stops at the hazard's first contact with it.
+    pub observer_collider: bool,
+}
+
+/// State of one dynamic body at one step (f32, exactly as the solver holds it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyState {
+    pub position: [f32; 3],
+    pub rotation: [f32; 4],
+    pub linvel: [f32; 3],
+    pub angvel: [f32; 3],
+}
+
+/// The hazard struck the standing observer.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Strike {
+    pub step: u32,
+    /// Hazard speed just before the contact (m/s).
+    pub speed: f64,
+}
+
+#[derive(Debug, Clone)]
+pub struct Simulation {
+    pub dt: f64,
+    /// Spec indices of the dynamic bodies, in spec order.
+    pub dynamic_bodies: Vec<usize>,
+    /// `states[step * dynamic_bodies.len() + j]`; step 0 is the initial state at t0.
+    pub states: Vec<BodyState>,
+    /// Index of the hazard among `dynamic_bodies`.
+    pub hazard_slot: usize,
+    /// The hazard's lowest point (m above the floor) per step.
+    pub hazard_lowest_z: Vec<f64>,
+    /// The hazard's contact flags per step.
+    pub hazard_contacts: Vec<u8>,
+    /// Total mechanical energy of the dynamic bodies per step (J).
+    pub energy: Vec<f64>,
+    /// Deepest penetration between any two colliders at t0 (m, ≥ 0).
+    pub initial_penetration: f64,
+    pub strike: Option<Strike>,
+    /// Hex SHA-256 (first 16 bytes) of every dynamic body's state at every step.
+    pub state_hash: String,
+}
+
+impl Simulation {
+    /// Number of steps simulated (states hold `steps() + 1` entries per body).
+    pub fn steps(&self) -> u32 {
+        (self.hazard_lowest_z.len() - 1) as u32
+    }
+
+    pub fn state(&self, step: u32, slot: usize) -> &BodyState {
+        &self.states[step as usize * self.dynamic_bodies.len() + slot]
+    }
+
+    pub fn hazard_state(&self, step: u32) -> &BodyState {
+        self.state(step, self.hazard_slot)
+    }
+
+    pub fn hazard_position(&self, step: u32) -> [f64; 3] {
+        self.hazard_state(step).position.map(f64::from)
+    }
+
+    pub fn hazard_velocity(&self, step: u32) -> [f64; 3] {
+        self.hazard_state(step).linvel.map(f64::from)
+    }
+
+    /// First step (≥ 1) whose hazard touches anything.
+    pub fn first_contact_step(&self) -> Option<u32> {
+        (1..=self.steps()).find(|&k| self.hazard_contacts[k as usize] != 0)
+    }
+
+    /// First step (≥ 1) at which the hazard's lowest point reaches the floor (within 1 mm)
+    /// having been above it before.
+    pub fn time_to_floor_step(&self) -> Option<u32> {
+        const FLOOR_EPS: f64 = 1e-3;
+        if self.hazard_lowest_z[0] <= FLOOR_EPS {
+            return None;
+        }
+        (1..=self.steps()).find(|&k| {
+            self.hazard_lowest_z[k as usize] <= FLOOR_EPS
+                && self.hazard_contacts[k as usize] & TOUCH_FLOOR != 0
+        })
+    }
+}
+
+fn v3(a: [f64; 3]) -> Vector {
+    Vector::new(a[0] as Real, a[1] as Real, a[2] as Real)
+}
+
+fn rot(q: [f64; 4]) -> Rotation {
+    Rotation::from_xyzw(q[0] as Real, q[1] as Real, q[2] as Real, q[3] as Real).normalize()
+}
+
+fn shared_shape(shape: &ShapeSpec) -> SharedShape {
+    match *shape {
+        ShapeSpec::Box { half_extents: h } => {
+            SharedShape::cuboid(h[0] as Real, h[1] as Real, h[2] as Real)
+        }
+        ShapeSpec::Sphere { radius } => SharedShape::ball(radius as Real),
+        // rapier's cylinders and capsules are along local y; the spec's are along z.
+        ShapeSpec::Cylinder {
+            half_height,
+            radius,
+        } => SharedShape::cylinder(half_height as Real, radius as Real),
+        ShapeSpec::Capsule {
+            half_height,
+            radius,
+        } => SharedShape::capsule_y(half_height as Real, radius as Real),
+    }
+}
+
+/// Extra rotation taking a y-axis primitive to the spec's z axis.
+fn axis_fix(shape: &ShapeSpec) -> Rotation {
+    match shape {
+        ShapeSpec::Cylinder { .. } | ShapeSpec::Capsule { .. } => {
+            Rotation::from_axis_angle(Vector::X, std::f32::consts::FRAC_PI_2 as Real)
+        }
+        _ => Rotation::IDENTITY,
+    }
+}
+
+fn collider_for(parts: &[PartSpec]) -> ColliderBuilder {
+    let posed: Vec<(Pose, SharedShape)> = parts
+        .iter()
+        .map(|p| {
+            let pose = Pose::from_parts(v3(p.offset), rot(p.rotation) * axis_fix(&p.shape));
+            (pose, shared_shape(&p.shape))
+        })
+        .collect();
+    if posed.len() == 1 {
+        let (pose, shape) = posed.into_iter().next().expect("one part");
+        ColliderBuilder::new(shape).position(pose)
+    } else {
+        ColliderBuilder::compound(posed)
+    }
+}
+
+const FLOOR_HALF_EXTENT: Real = 50.0;
+const FLOOR_HALF_THICKNESS: Real = 0.5;
+
+/// Runs the scene. Pure in `spec` and `options`.
+pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
+    let mut world = PhysicsWorld::new();
+    world.gravity = v3(spec.physics.gravity);
+    world.integration_parameters.dt = spec.physics.dt as Real;
+    world.integration_parameters.num_solver_iterations = spec.physics.solver_iterations.max(1);
+
+    let floor = world
+        .insert(
+            RigidBodyBuilder::fixed().translation(Vector::new(0.0, 0.0, -FLOOR_HALF_THICKNESS)),
+            ColliderBuilder::cuboid(FLOOR_HALF_EXTENT, FLOOR_HALF_EXTENT, FLOOR_HALF_THICKNESS)
+                .friction(spec.room.floor_friction as Real)
+                .restitution(spec.room.floor_restitution as Real)
+                .friction_combine_rule(CoefficientCombineRule::Average)
+                .restitution_combine_rule(CoefficientCombineRule::Average),
+        )
+        .1;
+
+    let mut body_handles = Vec::with_capacity(spec.bodies.len());
+    let mut collider_handles = Vec::with_capacity(spec.bodies.len());
+    for b in &spec.bodies {
+        let builder = match b.kind {
+            BodyKind::Fixed => RigidBodyBuilder::fixed(),
+            BodyKind::Dynamic => RigidBodyBuilder::dynamic()
+                .linvel(v3(b.linvel))
+                .angvel(v3(b.angvel))
+                .ccd_enabled(b.ccd)
+                // Never frozen by the sleep heuristic (an object balanced on an edge must
+                // tip); `simulate` stops by its own settle rule instead.
+                .can_sleep(false),
+        }
+        .pose(Pose::from_parts(v3(b.position), rot(b.rotation)));
+        let mut collider = collider_for(&b.parts)
+            .friction(b.friction as Real)
+            .restitution(b.restitution as Real)
+            .friction_combine_rule(CoefficientCombineRule::Average)
+            .restitution_combine_rule(CoefficientCombineRule::Average);
+        if b.kind == BodyKind::Dynamic {
+            collider = collider.mass(b.mass as Real);
+        }
+        let (bh, ch) = world.insert(builder, collider);
+        body_handles.push(bh);
+        collider_handles.push(ch);
+    }
+
+    // Joints; a world anchor is a fixed body at the origin.
+    let mut world_anchor = None;
+    for j in &spec.joints {
+        let a = match j.body_a {
+            Some(i) => body_handles[i],
+            None => {
+                *world_anchor.get_or_insert_with(|| world.bodies.insert(RigidBodyBuilder::fixed()))
+            }
+        };
+        let b = body_handles[j.body_b];
+        let joint: GenericJoint = match &j.kind {
+            JointKind::Revolute { axis } => RevoluteJointBuilder::new(v3(*axis).normalize())
+                .local_anchor1(v3(j.anchor_a))
+                .local_anchor2(v3(j.anchor_b))
+                .into(),
+            JointKind::Spherical => SphericalJointBuilder::new()
+                .local_anchor1(v3(j.anchor_a))
+                .local_anchor2(v3(j.anchor_b))
+                .into(),
+            JointKind::Rope { max_length } => RopeJointBuilder::new(*max_length as Real)
+                .local_anchor1(v3(j.anchor_a))
+                .local_anchor2(v3(j.anchor_b))
+                .into(),
+        };
+        world.impulse_joints.insert(a, b, joint, true);
+    }
+
+    let observer_collider = options.observer_collider.then(|| {
+        let o = &spec.observer;
+        let radius = o.torso_radius as Real;
+        let half = ((o.height as Real) / 2.0 - radius).max(0.0);
+        world
+            .insert(
+                RigidBodyBuilder::fixed().translation(Vector::new(
+                    o.x as Real,
+                    o.y as Real,
+                    (o.height / 2.0) as Real,
+                )),
+                ColliderBuilder::capsule_z(half, radius),
+            )
+            .1
+    });
+
+    let dynamic_bodies: Vec<usize> = (0..spec.bodies.len())
+        .filter(|&i| spec.bodies[i].kind == BodyKind::Dynamic)
+        .collect();
+    let hazard_slot = dynamic_bodies
+        .iter()
+        .position(|&i| i == spec.hazard)
+        .expect("the hazard is a dynamic body");
+    let hazard_collider = collider_handles[spec.hazard];
+    let source_collider = spec.source_support.map(|i| collider_handles[i]);
+
+    // Penetration at t0, by direct shape queries (a collision pass through the world
+    // before the first step would disturb rapier's state).
+    let mut initial_penetration: f64 = 0.0;
+    let colliders: Vec<&Collider> = world.colliders.iter().map(|(_, c)| c).collect();
+    for (i, a) in colliders.iter().enumerate() {
+        for b in &colliders[i + 1..] {
+            let both_fixed = [a, b].iter().all(|c| {
+                c.parent()
+                    .is_none_or(|p| world.bodies[p].body_type() == RigidBodyType::Fixed)
+            });
+            if both_fixed {
+                continue;
+            }
+            if let Ok(Some(contact)) = rapier3d::parry::query::contact(
+                a.position(),
+                a.shape(),
+                b.position(),
+                b.shape(),
+                0.0,
+            ) {
+                initial_penetration = initial_penetration.max(-(contact.dist as f64));
+            }
+        }
+    }
+
+    let gravity = v3(spec.physics.gravity);
+    let n_dyn = dynamic_bodies.len();
+    let max_steps = spec.physics.max_steps as usize;
+    let mut sim = Simulation {
+        dt: spec.physics.dt,
+        dynamic_bodies: dynamic_bodies.clone(),
+        states: Vec::with_capacity((max_steps + 1) * n_dyn),
+        hazard_slot,
+        hazard_lowest_z: Vec::with_capacity(max_steps + 1),
+        hazard_contacts: Vec::with_capacity(max_steps + 1),
+        energy: Vec::with_capacity(max_steps + 1),
+        initial_penetration,
+        strike: None,
+        state_hash: String::new(),
+    };
+    let mut hasher = Sha256::new();
+    let mut calm_steps = 0u32;
+
+    for step in 0..=spec.physics.max_steps {
+        if step > 0 {
+            world.step();
+        }
+        // Record every dynamic body's state and fold it into the hash.
+        let mut energy = 0.0f64;
+        for &i in &dynamic_bodies {
+            let rb = &world.bodies[body_handles[i]];
+            let t = rb.translation();
+            let q = rb.rotation();
+            let v = rb.linvel();
+            let w = rb.angvel();
+            let state = BodyState {
+                position: [t.x, t.y, t.z],
+                rotation: [q.x, q.y, q.z, q.w],
+                linvel: [v.x, v.y, v.z],
+                angvel: [w.x, w.y, w.z],
+            };
+            for value in state
+                .position
+                .iter()
+                .chain(&state.rotation)
+                .chain(&state.linvel)
+                .chain(&state.angvel)
+            {
+                hasher.update(value.to_le_bytes());
+            }
+            sim.states.push(state);
+            let com = rb.center_of_mass();
+            energy += rb.kinetic_energy() as f64 - rb.mass() as f64 * (gravity.dot(com) as f64);
+        }
+        sim.energy.push(energy);
+        sim.hazard_lowest_z
+            .push(world.colliders[hazard_collider].compute_aabb().mins.z as f64);
+
+        let mut flags = 0u8;
+        for pair in world.narrow_phase.contact_pairs_with(hazard_collider) {
+            if !pair.has_any_active_contact() {
+                continue;
+            }
+            let other = if pair.collider1 == hazard_collider {
+                pair.collider2
+            } else {
+                pair.collider1
+            };
+            flags |= if other == floor {
+                TOUCH_FLOOR
+            } else if Some(other) == source_collider {
+                TOUCH_SOURCE
+            } else if Some(other) == observer_collider {
+                TOUCH_OBSERVER
+            } else {
+                TOUCH_OTHER
+            };
+        }
+        sim.hazard_contacts.push(flags);
+
+        if step == 0 {
+            continue;
+        }
+        if flags & TOUCH_OBSERVER != 0 {
+            let before = sim.hazard_velocity(step - 1);
+            let speed = (before[0].powi(2) + before[1].powi(2) + before[2].powi(2)).sqrt();
+            sim.strike = Some(Strike { step, speed });
+            break;
+        }
+        let calm = dynamic_bodies.iter().all(|&i| {
+            let rb = &world.bodies[body_handles[i]];
+            (rb.linvel().length() as f64) < spec.physics.settle_speed
+                && (rb.angvel().length() as f64) < spec.physics.settle_speed * 10.0
+        });
+        calm_steps = if calm { calm_steps + 1 } else { 0 };
+        if step >= spec.physics.min_steps && calm_steps >= spec.physics.settle_steps {
+            break;
+        }
+    }
+    let digest = hasher.finalize();
+    sim.state_hash = digest[..16].iter().map(|b| format!("{b:02x}")).collect();
+    sim
+}

@@ -1,0 +1,371 @@
+//! `SceneSpec` v1 (SPEC §3): the JSON document that fully determines a scene.
+//!
+//! Everything the simulator needs is here in plain numbers, so `simulate(&spec)`
+//! replays a scene bit for bit in any process. Floats are f64 in the file (serde_json
+//! with exact round-tripping) and converted to rapier's f32 at one place.
+
+use crate::config::LabelConfig;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+pub const SCHEMA_VERSION: u32 = 1;
+
+pub type Vec3 = [f64; 3];
+/// Unit quaternion `[x, y, z, w]`.
+pub type Quat = [f64; 4];
+pub const IDENTITY: Quat = [0.0, 0.0, 0.0, 1.0];
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpeedBand {
+    Slow,
+    Normal,
+    Fast,
+    VeryFast,
+}
+
+impl SpeedBand {
+    pub const ALL: [SpeedBand; 4] = [
+        SpeedBand::Slow,
+        SpeedBand::Normal,
+        SpeedBand::Fast,
+        SpeedBand::VeryFast,
+    ];
+
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SpeedBand::Slow => "slow",
+            SpeedBand::Normal => "normal",
+            SpeedBand::Fast => "fast",
+            SpeedBand::VeryFast => "very_fast",
+        }
+    }
+}
+
+/// The planner's semantic choice (SPEC §3: the planner never sets a number).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Selection {
+    pub family: String,
+    pub object_id: String,
+    pub room_id: String,
+    /// The free-text description the selection came from, if any.
+    #[serde(default)]
+    pub description: Option<String>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ShapeSpec {
+    Box {
+        half_extents: Vec3,
+    },
+    Sphere {
+        radius: f64,
+    },
+    /// Axis along the part's local z.
+    Cylinder {
+        half_height: f64,
+        radius: f64,
+    },
+    /// Axis along the part's local z; `half_height` excludes the caps.
+    Capsule {
+        half_height: f64,
+        radius: f64,
+    },
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PartSpec {
+    pub shape: ShapeSpec,
+    /// Pose of the part in the body frame.
+    pub offset: Vec3,
+    pub rotation: Quat,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BodyKind {
+    Fixed,
+    Dynamic,
+}
+
+/// What a body is for; the labeler and renderer read it, physics ignores it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BodyRole {
+    /// The object the labels are about.
+    Hazard,
+    /// Furniture and fixtures the event happens on (tables, shelves, ramps, mounts).
+    Support,
+    /// Other moving objects (triggers, neighbours in a row).
+    Prop,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    pub name: String,
+    pub role: BodyRole,
+    pub kind: BodyKind,
+    /// Catalog id for catalog objects; furniture has none.
+    #[serde(default)]
+    pub catalog_id: Option<String>,
+    pub parts: Vec<PartSpec>,
+    pub position: Vec3,
+    pub rotation: Quat,
+    /// Total mass (kg), spread over the parts by volume. Ignored for fixed bodies.
+    pub mass: f64,
+    pub friction: f64,
+    pub restitution: f64,
+    pub linvel: Vec3,
+    pub angvel: Vec3,
+    /// Continuous collision detection for fast bodies.
+    pub ccd: bool,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum JointKind {
+    /// Hinge about `axis` (in both bodies' frames).
+    Revolute {
+        axis: Vec3,
+    },
+    Spherical,
+    /// Keeps the anchors at most `max_length` apart.
+    Rope {
+        max_length: f64,
+    },
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpec {
+    pub kind: JointKind,
+    /// Body indices; `None` for `body_a` means the world (a fixed anchor at `anchor_a`).
+    pub body_a: Option<usize>,
+    pub body_b: usize,
+    pub anchor_a: Vec3,
+    pub anchor_b: Vec3,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoomSpec {
+    pub id: String,
+    pub size: [f64; 2],
+    pub ceiling_height: f64,
+    pub floor_friction: f64,
+    pub floor_restitution: f64,
+    pub wall_color: String,
+    pub floor_color: String,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObserverSpec {
+    pub x: f64,
+    pub y: f64,
+    /// Heading about +z (rad); the observer faces the event.
+    pub yaw: f64,
+    pub height: f64,
+    pub pelvis_z: f64,
+    pub shoulder_z: f64,
+    pub torso_radius: f64,
+}
+
+impl ObserverSpec {
+    /// Distance from a point to the observer's torso axis: the vertical segment from the
+    /// floor to the top of the head.
+    pub fn torso_axis_distance(&self, p: Vec3) -> f64 {
+        let dz = if p[2] < 0.0 {
+            -p[2]
+        } else if p[2] > self.height {
+            p[2] - self.height
+        } else {
+            0.0
+        };
+        ((p[0] - self.x).powi(2) + (p[1] - self.y).powi(2) + dz * dz).sqrt()
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraSpec {
+    pub name: String,
+    pub position: Vec3,
+    pub look_at: Vec3,
+    /// Vertical field of view (rad).
+    pub fov_y: f64,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// Video settings; video frame `k` shows physics step `frame_step(k)`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VideoSpec {
+    pub width: u32,
+    pub height: u32,
+    pub fps: u32,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightingSpec {
+    /// Direction the sun light travels (unit vector, pointing down).
+    pub sun_direction: Vec3,
+    pub sun_intensity: f64,
+    pub ambient: f64,
+    pub color_temperature_k: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhysicsSpec {
+    pub dt: f64,
+    pub gravity: Vec3,
+    pub solver_iterations: usize,
+    pub min_steps: u32,
+    pub max_steps: u32,
+    pub settle_speed: f64,
+    pub settle_steps: u32,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSpec {
+    pub schema_version: u32,
+    pub scene_id: String,
+    pub group_id: String,
+    pub build_seed: u64,
+    pub scene_index: u64,
+    /// The group's randomization seed (shared by its four speed bands).
+    pub seed: u64,
+    /// Rejection-sampling attempt that produced this scene (0 = first try).
+    pub attempt: u32,
+    pub family: String,
+    pub speed_band: SpeedBand,
+    pub speed_sweep: bool,
+    pub speed_parameter: String,
+    pub speed_value: f64,
+    pub selection: Selection,
+    pub room: RoomSpec,
+    pub physics: PhysicsSpec,
+    pub bodies: Vec<BodySpec>,
+    pub joints: Vec<JointSpec>,
+    /// Index of the hazard body in `bodies`.
+    pub hazard: usize,
+    /// The body whose separation from the hazard marks the event's start (e.g. the table).
+    #[serde(default)]
+    pub source_support: Option<usize>,
+    /// The hazard's true hazard flags (catalog `hazards` of the object itself, not of
+    /// what it looks like).
+    pub hazard_flags: Vec<String>,
+    pub observer: ObserverSpec,
+    pub observation_window_s: f64,
+    pub video: VideoSpec,
+    pub cameras: Vec<CameraSpec>,
+    pub lighting: LightingSpec,
+    /// Family-specific numbers worth recording (drop height, ramp angle, …).
+    pub family_params: BTreeMap<String, f64>,
+    pub labels: LabelConfig,
+}
+
+impl SceneSpec {
+    pub fn hazard_body(&self) -> &BodySpec {
+        &self.bodies[self.hazard]
+    }
+
+    pub fn to_json(&self) -> String {
+        let mut text = serde_json::to_string_pretty(self).expect("a spec always serializes");
+        text.push('\n');
+        text
+    }
+
+    pub fn from_json(text: &str) -> Result<SceneSpec, serde_json::Error> {
+        serde_json::from_str(text)
+    }
+
+    /// The physics step shown by video frame `frame` (exact: frame time / dt, rounded).
+    pub fn frame_step(&self, frame: u32) -> u32 {
+        (frame as f64 / self.video.fps as f64 / self.physics.dt).round() as u32
+    }
+}
+
+/// Quaternion helpers (the spec keeps rotations as plain arrays).
+pub mod quat {
+    use super::{Quat, Vec3};
+
+    /// Rotation of `angle` radians about a unit `axis`.
+    pub fn from_axis_angle(axis: Vec3, angle: f64) -> Quat {
+        let (s, c) = (angle / 2.0).sin_cos();
+        [axis[0] * s, axis[1] * s, axis[2] * s, c]
+    }
+
+    pub fn mul(a: Quat, b: Quat) -> Quat {
+        let [ax, ay, az, aw] = a;
+        let [bx, by, bz, bw] = b;
+        [
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz,
+        ]
+    }
+
+    pub fn rotate(q: Quat, v: Vec3) -> Vec3 {
+        let [x, y, z, w] = q;
+        // v' = v + 2w (u × v) + 2 u × (u × v), u = (x, y, z)
+        let u = [x, y, z];
+        let uv = cross(u, v);
+        let uuv = cross(u, uv);
+        [
+            v[0] + 2.0 * (w * uv[0] + uuv[0]),
+            v[1] + 2.0 * (w * uv[1] + uuv[1]),
+            v[2] + 2.0 * (w * uv[2] + uuv[2]),
+        ]
+    }
+
+    fn cross(a: Vec3, b: Vec3) -> Vec3 {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quaternion_rotates_x_to_y_about_z() {
+        let q = quat::from_axis_angle([0.0, 0.0, 1.0], std::f64::consts::FRAC_PI_2);
+        let v = quat::rotate(q, [1.0, 0.0, 0.0]);
+        assert!((v[0]).abs() < 1e-12 && (v[1] - 1.0).abs() < 1e-12 && v[2].abs() < 1e-12);
+    }
+
+    #[test]
+    fn floats_round_trip_exactly_through_json() {
+        let values = [
+            0.1f64,
+            1.0 / 3.0,
+            2.0f64.sqrt(),
+            1e-300,
+            123456.789e10,
+            -0.0,
+        ];
+        for v in values {
+            let text = serde_json::to_string(&v).unwrap();
+            let back: f64 = serde_json::from_str(&text).unwrap();
+            assert_eq!(v.to_bits(), back.to_bits(), "{v} -> {text}");
+        }
+    }
+}

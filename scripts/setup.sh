@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Installs what ReactHuman needs on a fresh Debian/Ubuntu machine. Idempotent: packages
+# already present are skipped, so running it again is cheap.
+set -euo pipefail
+
+apt_packages=(
+  mesa-vulkan-drivers libvulkan1
+  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
+  libavfilter-dev libavdevice-dev libswresample-dev
+  clang libclang-dev pkg-config ffmpeg
+)
+python_packages=(pyarrow)
+
+missing=()
+for pkg in "${apt_packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || missing+=("$pkg")
+done
+
+if [ ${#missing[@]} -gt 0 ]; then
+  sudo_cmd=()
+  if [ "$(id -u)" -ne 0 ]; then
+    command -v sudo >/dev/null || { echo "setup: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+    sudo_cmd=(sudo)
+  fi
+  echo "setup: installing system packages: ${missing[*]}"
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+py_missing=()
+for mod in "${python_packages[@]}"; do
+  python3 -c "import $mod" 2>/dev/null || py_missing+=("$mod")
+done
+if [ ${#py_missing[@]} -gt 0 ]; then
+  echo "setup: installing Python packages: ${py_missing[*]}"
+  python3 -m pip install --quiet --disable-pip-version-check "${py_missing[@]}" \
+    || python3 -m pip install --quiet --disable-pip-version-check --break-system-packages "${py_missing[@]}"
+fi
+
+command -v cargo >/dev/null || { echo "setup: cargo not found; install Rust (rustup) first" >&2; exit 1; }
+echo "setup: ok"

@@ -1,0 +1,62 @@
+//! Helpers shared by the end-to-end tests: locate the real binaries and run them.
+//!
+//! The binaries are built by `scripts/test.sh` (`cargo build --release --bins`) before
+//! `cargo test --release` runs; a test binary lives in `target/<profile>/deps/`, so the
+//! programs sit one directory up.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+/// Path of a workspace binary built in the same profile as the running test.
+pub fn bin(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().expect("current test executable");
+    let profile_dir = exe
+        .parent()
+        .and_then(|deps| deps.parent())
+        .expect("test binary lives in target/<profile>/deps");
+    let path = profile_dir.join(name);
+    assert!(
+        path.exists(),
+        "{} is not built; run `cargo build --release --bins` first (scripts/test.sh does)",
+        path.display()
+    );
+    path
+}
+
+/// Runs a workspace binary with arguments and returns its output (never panics on exit code).
+pub fn run(name: &str, args: &[&str]) -> Output {
+    Command::new(bin(name))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap_or_else(|e| panic!("cannot start {name}: {e}"))
+}
+
+/// Like `run`, but asserts success and returns stdout as text.
+pub fn run_ok(name: &str, args: &[&str]) -> String {
+    let out = run(name, args);
+    assert!(
+        out.status.success(),
+        "{name} {args:?} failed with {:?}\nstdout:\n{}\nstderr:\n{}",
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("utf-8 stdout")
+}
+
+/// Runs a Python snippet (pyarrow and friends come from scripts/setup.sh).
+pub fn python(script: &str) -> String {
+    let out = Command::new("python3")
+        .arg("-c")
+        .arg(script)
+        .output()
+        .expect("python3 is installed by scripts/setup.sh");
+    assert!(
+        out.status.success(),
+        "python failed:\n{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("utf-8 stdout")
+}
