@@ -4,7 +4,7 @@
 //! simulation and the strike from the counterfactual one (the observer standing still as
 //! a static collider), and applies the thresholds stored in the spec.
 
-use crate::simulate::Simulation;
+use crate::simulate::{Simulation, Strike};
 use crate::spec::{SceneSpec, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -81,7 +81,7 @@ pub fn time_to_floor(sim: &Simulation, gravity: f64) -> Option<f64> {
     Some((k - 1) as f64 * sim.dt + tau.clamp(0.0, sim.dt))
 }
 
-pub fn label(spec: &SceneSpec, sim: &Simulation, counterfactual: &Simulation) -> Labels {
+pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labels {
     let cfg = &spec.labels;
     let g = -spec.physics.gravity[2];
     let steps = sim.steps();
@@ -145,7 +145,7 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, counterfactual: &Simulation) ->
     }
     let dangerous = !danger_reasons.is_empty();
 
-    let strike_speed = counterfactual.strike.map(|s| s.speed);
+    let strike_speed = strike.map(|s| s.speed);
     let danger_present = strike_speed.is_some_and(|s| s >= cfg.strike_speed_min);
     let reachable = closest_approach <= cfg.reach_radius || danger_present;
 

@@ -31,13 +31,12 @@ pub fn run_scene(mut spec: SceneSpec, config: &Config) -> SceneResult {
     let in_frame = framed.is_some();
     spec.cameras = framed.unwrap_or_default();
     let verdicts = validate(&spec, &sim, family, &config.validators, in_frame);
-    let counterfactual = simulate(
-        &spec,
-        SimOptions {
-            observer_collider: true,
-        },
-    );
-    let labels = label(&spec, &sim, &counterfactual);
+    let strike = if may_touch_observer(&spec, &sim) {
+        simulate(&spec, SimOptions { observer_collider: true }).strike
+    } else {
+        None
+    };
+    let labels = label(&spec, &sim, strike);
     let trajectory = hazard_trajectory(&spec, &sim);
     SceneResult {
         state_hash: sim.state_hash.clone(),
@@ -47,6 +46,22 @@ pub fn run_scene(mut spec: SceneSpec, config: &Config) -> SceneResult {
         verdicts,
         trajectory,
     }
+}
+
+/// Clearance kept beyond the bounding spheres before a body could touch the observer
+/// (covers the solver's speculative-contact distance with a wide margin).
+const OBSERVER_CLEARANCE: f64 = 0.1;
+
+/// Whether any dynamic body ever comes near enough to the observer's body to touch it.
+/// If none does, the counterfactual run (observer as a static collider) is step for step
+/// the plain run — a static collider changes nothing until something touches it — so
+/// it cannot strike and need not be simulated.
+pub fn may_touch_observer(spec: &SceneSpec, sim: &Simulation) -> bool {
+    let o = &spec.observer;
+    sim.dynamic_bodies.iter().enumerate().any(|(slot, &body)| {
+        let reach = spec.bodies[body].bounding_radius() + o.torso_radius + OBSERVER_CLEARANCE;
+        (0..=sim.steps()).any(|k| o.torso_axis_distance(sim.state(k, slot).position.map(f64::from)) <= reach)
+    })
 }
 
 fn hazard_trajectory(spec: &SceneSpec, sim: &Simulation) -> Vec<[f32; 4]> {

@@ -129,6 +129,31 @@ pub struct BodySpec {
     pub ccd: bool,
 }
 
+impl ShapeSpec {
+    /// Radius of the smallest sphere around the shape's centre holding it.
+    pub fn bounding_radius(&self) -> f64 {
+        match *self {
+            ShapeSpec::Box { half_extents: h } => (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt(),
+            ShapeSpec::Sphere { radius } => radius,
+            ShapeSpec::Cylinder { half_height, radius } => (half_height * half_height + radius * radius).sqrt(),
+            ShapeSpec::Capsule { half_height, radius } => half_height + radius,
+        }
+    }
+}
+
+impl BodySpec {
+    /// Radius of the smallest sphere around the body's origin holding all its parts.
+    pub fn bounding_radius(&self) -> f64 {
+        self.parts
+            .iter()
+            .map(|p| {
+                let o = p.offset;
+                (o[0] * o[0] + o[1] * o[1] + o[2] * o[2]).sqrt() + p.shape.bounding_radius()
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum JointKind {

@@ -1,0 +1,396 @@
+//! Reference baselines (`rh-score baseline KIND`): predictions written as `preds.jsonl`.
+//!
+//! * `oracle` — on every scene a plan the action rule classifies as the ground-truth
+//!   action; on CATCH scenes the final hands land exactly on the impact point. The base
+//!   walks (constant twist, ≤ 1.2 m/s) to a stance with the impact point 0.40 m straight
+//!   ahead of the pelvis at the end of the walk; when standing behind the impact point
+//!   would mean backing away from it (an impact point very close to the observer), the
+//!   base walks past it and turns to face it instead, so the rule never reads a retreat.
+//! * `always-catch` — arms forward (0.45 m), no walking. `always-dodge` — walk 0.8 m
+//!   straight away from the hazard, hands at rest. `freeze` — no walking, hands at rest.
+//! * `majority` — the dataset's most frequent ground-truth action (ties: DODGE, NO_ACTION,
+//!   CATCH) on every scene, as the template plan above.
+//! * `random` — per scene, a uniformly chosen action with random plan parameters, from
+//!   `ChaCha8Rng` seeded by (seed, scene id): reproducible and order-independent.
+
+use crate::config::Config;
+use crate::dataset::{Dataset, Scene};
+use crate::types::Action;
+use anyhow::Result;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde_json::{json, Value};
+use std::f64::consts::PI;
+use std::io::Write;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum BaselineKind {
+    Majority,
+    Oracle,
+    Random,
+    AlwaysCatch,
+    AlwaysDodge,
+    Freeze,
+}
+
+impl BaselineKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            BaselineKind::Majority => "majority",
+            BaselineKind::Oracle => "oracle",
+            BaselineKind::Random => "random",
+            BaselineKind::AlwaysCatch => "always-catch",
+            BaselineKind::AlwaysDodge => "always-dodge",
+            BaselineKind::Freeze => "freeze",
+        }
+    }
+}
+
+/// Oracle stance: hands this far ahead of the pelvis at the end of the walk (m).
+const ORACLE_STANDOFF: f64 = 0.40;
+/// Oracle walking speed cap (m/s), below the robot's 1.5 m/s.
+const ORACLE_MAX_SPEED: f64 = 1.2;
+
+fn kf(t: f64, left: [f64; 3], right: [f64; 3]) -> Value {
+    json!({"t": t, "left_hand": left, "right_hand": right, "knee_bend": 0.0})
+}
+
+fn rest_kf(t: f64, cfg: &Config) -> Value {
+    kf(t, cfg.body.rest_left, cfg.body.rest_right)
+}
+
+/// Hazard direction on the floor in the observer's body frame (default: straight ahead).
+fn hazard_dir_body(scene: &Scene) -> [f64; 2] {
+    let [x0, y0, th] = scene.observer_pose;
+    let p = scene.hazard_point();
+    let (dx, dy) = (p[0] - x0, p[1] - y0);
+    let n = dx.hypot(dy);
+    if n < 1e-9 {
+        return [1.0, 0.0];
+    }
+    let (s, c) = th.sin_cos();
+    [(c * dx + s * dy) / n, (-s * dx + c * dy) / n]
+}
+
+fn plan(intent: &str, cmd: [f64; 3], dur: f64, keyframes: Vec<Value>) -> Value {
+    json!({
+        "intent": intent,
+        "confidence": 1.0,
+        "walking_cmd": cmd,
+        "walking_duration": dur,
+        "keyframes": keyframes,
+    })
+}
+
+/// Arms forward, no walking.
+pub fn catch_template() -> Value {
+    plan(
+        "Reach out with both hands and catch the object.",
+        [0.0; 3],
+        0.0,
+        vec![kf(0.3, [0.45, 0.15, 0.10], [0.45, -0.15, 0.10])],
+    )
+}
+
+/// Walk `dist` metres straight away from the hazard in `dur` seconds, hands at rest.
+pub fn dodge_template(scene: &Scene, cfg: &Config, dist: f64, dur: f64) -> Value {
+    let u = hazard_dir_body(scene);
+    let v = dist / dur;
+    plan(
+        "Dodge: step back and move away from the hazard's path.",
+        [-u[0] * v, -u[1] * v, 0.0],
+        dur,
+        vec![rest_kf(dur, cfg)],
+    )
+}
+
+/// No walking, hands at rest.
+pub fn freeze_template(cfg: &Config) -> Value {
+    plan(
+        "Stay still; no action is needed.",
+        [0.0; 3],
+        0.0,
+        vec![rest_kf(0.25, cfg)],
+    )
+}
+
+fn wrap_angle(a: f64) -> f64 {
+    let mut a = (a + PI).rem_euclid(2.0 * PI) - PI;
+    if a <= -PI {
+        a += 2.0 * PI;
+    }
+    a
+}
+
+/// Body-frame walking command `[vx, vy, w]` that takes the base from `start` to the world
+/// position `goal` with final heading `yaw1` in `dur` seconds (constant twist).
+pub fn solve_walk(start: [f64; 3], goal: [f64; 2], yaw1: f64, dur: f64) -> [f64; 3] {
+    let [x0, y0, th0] = start;
+    let dth = wrap_angle(yaw1 - th0);
+    let (dx, dy) = (goal[0] - x0, goal[1] - y0);
+    if dth.abs() < 1e-12 {
+        let (s, c) = th0.sin_cos();
+        return [(c * dx + s * dy) / dur, (-s * dx + c * dy) / dur, 0.0];
+    }
+    let w = dth / dur;
+    let (s0, c0) = th0.sin_cos();
+    let (s1, c1) = (th0 + dth).sin_cos();
+    let a = (s1 - s0) / w;
+    let b = (c1 - c0) / w;
+    let det = a * a + b * b;
+    [(a * dx - b * dy) / det, (b * dx + a * dy) / det, w]
+}
+
+/// The oracle's plan for a CATCH scene: final mean hand exactly at the impact point.
+pub fn oracle_catch(scene: &Scene, cfg: &Config) -> Value {
+    let [x0, y0, th0] = scene.observer_pose;
+    let p = scene.hazard_point();
+    let (rx, ry) = (p[0] - x0, p[1] - y0);
+    let d = rx.hypot(ry);
+    let a = ORACLE_STANDOFF;
+    let margin = 0.05;
+    // Option A: keep the heading, stand `a` behind the point along the forward axis.
+    let (s0, c0) = th0.sin_cos();
+    let goal_a = [p[0] - a * c0, p[1] - a * s0];
+    let d_dot_u = if d > 1e-9 {
+        ((goal_a[0] - x0) * rx + (goal_a[1] - y0) * ry) / d
+    } else {
+        0.0
+    };
+    let (goal, yaw1) = if d_dot_u > -cfg.action_rule.retreat_threshold + margin {
+        (goal_a, th0)
+    } else {
+        // Option B: walk past the point (away from the observer) and turn to face it.
+        let u = [rx / d, ry / d];
+        ([p[0] + a * u[0], p[1] + a * u[1]], (-u[1]).atan2(-u[0]))
+    };
+    let dth = wrap_angle(yaw1 - th0);
+    // Speed for a 1 s walk, then stretch the duration to respect the speed cap.
+    let v1 = solve_walk(scene.observer_pose, goal, th0 + dth, 1.0);
+    let speed1 = v1[0].hypot(v1[1]);
+    let dur = (speed1 / ORACLE_MAX_SPEED).max(1.0);
+    let cmd = solve_walk(scene.observer_pose, goal, th0 + dth, dur);
+    let zb = p[2] - cfg.body.pelvis_height;
+    plan(
+        "Step toward the object, reach out and catch it with both hands.",
+        cmd,
+        dur,
+        vec![rest_kf(0.0, cfg), kf(dur, [a, 0.05, zb], [a, -0.05, zb])],
+    )
+}
+
+/// The plan a baseline writes for one scene.
+pub fn baseline_plan(
+    kind: BaselineKind,
+    scene: &Scene,
+    majority: Action,
+    seed: u64,
+    cfg: &Config,
+) -> Value {
+    let template = |a: Action| match a {
+        Action::Catch => catch_template(),
+        Action::Dodge => dodge_template(scene, cfg, 0.8, 1.0),
+        Action::NoAction => freeze_template(cfg),
+    };
+    match kind {
+        BaselineKind::AlwaysCatch => template(Action::Catch),
+        BaselineKind::AlwaysDodge => template(Action::Dodge),
+        BaselineKind::Freeze => template(Action::NoAction),
+        BaselineKind::Majority => template(majority),
+        BaselineKind::Oracle => match scene.gt_action {
+            Action::Catch => oracle_catch(scene, cfg),
+            a => template(a),
+        },
+        BaselineKind::Random => random_plan(scene, seed, cfg),
+    }
+}
+
+fn random_plan(scene: &Scene, seed: u64, cfg: &Config) -> Value {
+    let mut h = seed ^ 0x5248_5f52_414e_444d;
+    for b in scene.scene_id.bytes() {
+        h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(h);
+    let u = hazard_dir_body(scene);
+    match rng.random_range(0..3) {
+        0 => {
+            let x = rng.random_range(0.35..0.65);
+            let y = rng.random_range(-0.2..0.2);
+            let z = rng.random_range(-0.3..0.5);
+            let step = rng.random_range(0.0..0.6);
+            let dur = rng.random_range(0.5..1.5);
+            plan(
+                "Catch it.",
+                [u[0] * step / dur, u[1] * step / dur, 0.0],
+                dur,
+                vec![kf(dur, [x, y + 0.1, z], [x, y - 0.1, z])],
+            )
+        }
+        1 => {
+            let ang = rng.random_range(-1.0..1.0);
+            let (s, c) = f64::sin_cos(ang);
+            let away = [-(c * u[0] - s * u[1]), -(s * u[0] + c * u[1])];
+            let dist = rng.random_range(0.3..1.2);
+            let dur = rng.random_range(0.5..1.5);
+            plan(
+                "Dodge away.",
+                [away[0] * dist / dur, away[1] * dist / dur, 0.0],
+                dur,
+                vec![rest_kf(dur, cfg)],
+            )
+        }
+        _ => {
+            let jitter = rng.random_range(0.0..0.1);
+            plan(
+                "Stay put.",
+                [jitter, 0.0, 0.0],
+                1.0,
+                vec![rest_kf(1.0, cfg)],
+            )
+        }
+    }
+}
+
+/// The dataset's most frequent ground-truth action (ties: DODGE, NO_ACTION, CATCH).
+pub fn majority_action(ds: &Dataset) -> Action {
+    let mut counts = [0usize; 3];
+    for s in ds.scenes.iter().filter(|s| s.valid) {
+        counts[s.gt_action.index()] += 1;
+    }
+    let mut best = Action::Dodge;
+    for a in [Action::NoAction, Action::Catch] {
+        if counts[a.index()] > counts[best.index()] {
+            best = a;
+        }
+    }
+    best
+}
+
+/// Writes one prediction line per scene, in dataset order.
+pub fn write_baseline(
+    kind: BaselineKind,
+    ds: &Dataset,
+    seed: u64,
+    model: &str,
+    cfg: &Config,
+    out: &mut dyn Write,
+) -> Result<()> {
+    let majority = majority_action(ds);
+    #[derive(serde::Serialize)]
+    struct Line<'a> {
+        scene_id: &'a str,
+        model: &'a str,
+        plan: Value,
+    }
+    for scene in ds.scenes.iter().filter(|s| s.valid) {
+        let line = Line {
+            scene_id: &scene.scene_id,
+            model,
+            plan: baseline_plan(kind, scene, majority, seed, cfg),
+        };
+        serde_json::to_writer(&mut *out, &line)?;
+        out.write_all(b"\n")?;
+    }
+    out.flush()?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::aia::AiaMatcher;
+    use crate::fixture::{dataset_of, synth_rows};
+    use crate::metrics::score_decision;
+    use crate::plan::plan_from_value;
+
+    #[test]
+    fn oracle_is_perfect_on_synthetic_scenes() {
+        let cfg = Config::default();
+        let aia = AiaMatcher::new(&cfg.aia);
+        let ds = dataset_of(&synth_rows(2000, 3));
+        let maj = majority_action(&ds);
+        for s in &ds.scenes {
+            let v = baseline_plan(BaselineKind::Oracle, s, maj, 0, &cfg);
+            // Through JSON text, as the scorer will see it.
+            let v: Value = serde_json::from_str(&v.to_string()).unwrap();
+            let p = plan_from_value(&v, &cfg).unwrap();
+            let r = score_decision(Some(&p), s, &cfg, &aia);
+            assert!(r.saa, "{} {:?} {:?}", s.scene_id, s.gt_action, r.action);
+            assert!(r.safe(), "{}", s.scene_id);
+            assert_eq!(r.aia, 1.0, "{}", p.intent);
+            if s.gt_action == Action::Catch {
+                assert!(
+                    r.d_end.unwrap() < 1e-6,
+                    "{} d_end {:?}",
+                    s.scene_id,
+                    r.d_end
+                );
+                let speed = p.walking_cmd[0].hypot(p.walking_cmd[1]);
+                assert!(speed <= 1.5 + 1e-9, "speed {speed}");
+            }
+        }
+    }
+
+    #[test]
+    fn oracle_handles_extreme_geometry() {
+        let cfg = Config::default();
+        let aia = AiaMatcher::new(&cfg.aia);
+        let mut cases = Vec::new();
+        for yaw in [0.0, 1.0, -2.5, PI] {
+            for rel in [
+                [0.0, 0.0, 0.9],   // directly above the pelvis
+                [0.05, 0.0, 0.2],  // very close, low
+                [-0.1, 0.02, 1.6], // just behind, high
+                [0.0, 1.2, 0.9],   // beside
+                [-3.0, -2.0, 0.9], // far behind
+                [8.0, 3.0, 0.5],   // far ahead
+                [0.4, 0.0, 0.79],  // already in hand
+            ] {
+                cases.push((yaw, rel));
+            }
+        }
+        for (yaw, rel) in cases {
+            let pose = [1.0, -2.0, yaw];
+            let (s, c) = f64::sin_cos(yaw);
+            let p = [
+                pose[0] + c * rel[0] - s * rel[1],
+                pose[1] + s * rel[0] + c * rel[1],
+                rel[2],
+            ];
+            let mut sc = crate::rule::tests::scene(pose, Some(p));
+            sc.gt_action = Action::Catch;
+            let v = oracle_catch(&sc, &cfg);
+            let pl = plan_from_value(&v, &cfg).unwrap();
+            let r = score_decision(Some(&pl), &sc, &cfg, &aia);
+            assert_eq!(r.action, Some(Action::Catch), "yaw {yaw} rel {rel:?}");
+            assert!(
+                r.d_end.unwrap() < 1e-6,
+                "yaw {yaw} rel {rel:?}: {:?}",
+                r.d_end
+            );
+            assert!(pl.walking_cmd[0].hypot(pl.walking_cmd[1]) <= 1.2 + 1e-9);
+        }
+    }
+
+    #[test]
+    fn templates_classify_as_named() {
+        let cfg = Config::default();
+        let aia = AiaMatcher::new(&cfg.aia);
+        let ds = dataset_of(&synth_rows(400, 5));
+        for s in &ds.scenes {
+            for (kind, want) in [
+                (BaselineKind::AlwaysCatch, Action::Catch),
+                (BaselineKind::AlwaysDodge, Action::Dodge),
+                (BaselineKind::Freeze, Action::NoAction),
+            ] {
+                let v = baseline_plan(kind, s, Action::Dodge, 0, &cfg);
+                let p = plan_from_value(&v, &cfg).unwrap();
+                assert_eq!(score_decision(Some(&p), s, &cfg, &aia).action, Some(want));
+            }
+            // Random plans are reproducible.
+            let a = baseline_plan(BaselineKind::Random, s, Action::Dodge, 9, &cfg);
+            let b = baseline_plan(BaselineKind::Random, s, Action::Dodge, 9, &cfg);
+            assert_eq!(a, b);
+        }
+    }
+}

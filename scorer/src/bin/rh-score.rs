@@ -1,0 +1,273 @@
+//! `rh-score`: the ReactHuman offline scorer (SPEC §9–§11, §14).
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use rh_score::baseline::{write_baseline, BaselineKind};
+use rh_score::types::is_input_error;
+use rh_score::{Config, Dataset, InputError, Report, Scoring};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+const HUB_MSG: &str =
+    "downloading the dataset from the Hugging Face Hub is not available yet in this build; \
+pass --dataset DIR (a directory built by `rh-pipeline build`) or set RH_DATASET=DIR";
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "rh-score",
+    version,
+    about = "Score ReactHuman predictions (preds.jsonl) against a dataset's ground truth",
+    long_about = "Score ReactHuman predictions (preds.jsonl) against a dataset's ground truth.\n\n\
+        Derives each plan's action with the versioned action rule, computes SAA, safety \
+        (R1-R4), d_end, AIA and HDE, aggregates them per model, family, speed band, \
+        ground-truth action and adversarial flag, and reproduces the paper's analyses. \
+        `rh-score --explain` prints every definition.\n\n\
+        Exit status: 0 success, 2 bad input or usage, 1 internal error.",
+    args_conflicts_with_subcommands = true
+)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Option<Cmd>,
+
+    /// Predictions file (JSON Lines: scene_id, model, plan | response [, error]); "-" reads
+    /// standard input.
+    preds: Option<PathBuf>,
+
+    /// Dataset directory (data/*.parquet + specs/). Default: $RH_DATASET.
+    #[arg(long, value_name = "DIR")]
+    dataset: Option<String>,
+
+    /// Write the full report as JSON ("-" for stdout, which replaces the table).
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+
+    /// Write per-(model, breakdown, group) metrics as CSV.
+    #[arg(long, value_name = "FILE")]
+    csv: Option<PathBuf>,
+
+    /// Write the report as Markdown.
+    #[arg(long, value_name = "FILE")]
+    markdown: Option<PathBuf>,
+
+    /// Write the figures (SVG and PNG) into this directory.
+    #[arg(long, value_name = "DIR")]
+    figures: Option<PathBuf>,
+
+    /// Write one JSON line per decision (its action, rules and metrics).
+    #[arg(long, value_name = "FILE")]
+    decisions: Option<PathBuf>,
+
+    /// Print every definition (action rule, metrics, safety rules, vocabularies,
+    /// aggregation, warnings) and exit unless a predictions file is given too.
+    #[arg(long)]
+    explain: bool,
+
+    /// Scoring configuration (default: the embedded configs/scoring.toml).
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
+
+    /// Execute plans in physics (SPEC §12; not available in this build).
+    #[arg(long)]
+    execute: bool,
+
+    /// Do not print the terminal report.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+#[derive(Subcommand, Debug)]
+enum Cmd {
+    /// Write reference predictions for every scene of a dataset to stdout (preds.jsonl).
+    Baseline {
+        /// Which baseline.
+        #[arg(value_enum)]
+        kind: BaselineKind,
+        /// Dataset directory. Default: $RH_DATASET.
+        #[arg(long, value_name = "DIR")]
+        dataset: Option<String>,
+        /// Seed of the random baseline.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Model name written on every line (default: baseline-KIND).
+        #[arg(long)]
+        model: Option<String>,
+        /// Scoring configuration (body constants, thresholds).
+        #[arg(long, value_name = "FILE")]
+        config: Option<PathBuf>,
+    },
+    /// Write a synthetic dataset with the rh-pipeline column contract (tests).
+    #[command(hide = true)]
+    MakeFixture {
+        #[arg(long)]
+        out: PathBuf,
+        #[arg(long, default_value_t = 40)]
+        n: usize,
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Leave this column out (repeatable).
+        #[arg(long = "drop-column")]
+        drop: Vec<String>,
+    },
+}
+
+fn dataset_dir(arg: Option<String>) -> Result<PathBuf> {
+    let dir = match arg.or_else(|| std::env::var("RH_DATASET").ok().filter(|s| !s.is_empty())) {
+        Some(d) => d,
+        None => return Err(InputError(format!("no dataset given: {HUB_MSG}")).into()),
+    };
+    let path = PathBuf::from(&dir);
+    if path.exists() {
+        return Ok(path);
+    }
+    let looks_like_repo =
+        dir.split('/').count() == 2 && !dir.starts_with('.') && !dir.starts_with('/');
+    if looks_like_repo {
+        return Err(InputError(format!("{dir} is not a local directory, and {HUB_MSG}")).into());
+    }
+    Err(InputError(format!("dataset directory {dir} does not exist")).into())
+}
+
+fn load_config(path: Option<&Path>) -> Result<Config> {
+    match path {
+        Some(p) => Config::load(p).map_err(|e| InputError(format!("{e:#}")).into()),
+        None => Ok(Config::default()),
+    }
+}
+
+fn write_file(path: &Path, what: &str, text: &str) -> Result<()> {
+    std::fs::write(path, text)
+        .map_err(|e| InputError(format!("cannot write {what} to {}: {e}", path.display())).into())
+}
+
+fn score(cli: Cli) -> Result<()> {
+    let cfg = load_config(cli.config.as_deref())?;
+    if cli.explain {
+        print!("{}", rh_score::explain::explain(&cfg));
+        if cli.preds.is_none() {
+            return Ok(());
+        }
+    }
+    if cli.execute {
+        return Err(InputError(
+            "--execute (physics execution of plans, SPEC §12) is not available in this build"
+                .into(),
+        )
+        .into());
+    }
+    let Some(preds) = cli.preds else {
+        return Err(InputError(
+            "missing the predictions file: rh-score PREDS.jsonl --dataset DIR (see --help)".into(),
+        )
+        .into());
+    };
+    let ds = Dataset::load(&dataset_dir(cli.dataset)?)?;
+    let mut scoring = Scoring::new(&ds, &cfg);
+    if let Some(p) = &cli.decisions {
+        let f = std::fs::File::create(p)
+            .map_err(|e| InputError(format!("cannot write decisions to {}: {e}", p.display())))?;
+        scoring = scoring.with_decisions_output(Box::new(std::io::BufWriter::new(f)));
+    }
+    if preds.as_os_str() == "-" {
+        scoring.score_reader(std::io::BufReader::with_capacity(1 << 20, std::io::stdin()))?;
+    } else {
+        scoring.score_path(&preds)?;
+    }
+    let report = Report::build(&scoring, &preds.display().to_string());
+    drop(scoring);
+
+    let json_stdout = cli.json.as_deref() == Some(Path::new("-"));
+    if let Some(p) = &cli.json {
+        let text = serde_json::to_string_pretty(&report).context("serializing the report")? + "\n";
+        if json_stdout {
+            print_out(&text)?;
+        } else {
+            write_file(p, "the JSON report", &text)?;
+        }
+    }
+    if let Some(p) = &cli.csv {
+        write_file(p, "the CSV report", &rh_score::render::csv(&report))?;
+    }
+    if let Some(p) = &cli.markdown {
+        write_file(
+            p,
+            "the Markdown report",
+            &rh_score::render::markdown(&report),
+        )?;
+    }
+    if let Some(d) = &cli.figures {
+        rh_score::figures::write_figures(&report, d)?;
+    }
+    if !cli.quiet && !json_stdout {
+        print_out(&rh_score::render::terminal(&report))?;
+    }
+    let warned: u64 = report.input.warnings.iter().map(|w| w.count).sum();
+    if warned > 0 {
+        eprintln!(
+            "rh-score: {warned} input warning(s) in {}; see the report's warnings section",
+            preds.display()
+        );
+    }
+    Ok(())
+}
+
+fn print_out(text: &str) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        r => Ok(r?),
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.cmd {
+        None => score(cli),
+        Some(Cmd::Baseline {
+            kind,
+            dataset,
+            seed,
+            model,
+            config,
+        }) => {
+            let cfg = load_config(config.as_deref())?;
+            let ds = Dataset::load(&dataset_dir(dataset)?)?;
+            let model = model.unwrap_or_else(|| format!("baseline-{}", kind.name()));
+            let stdout = std::io::stdout();
+            let mut out = std::io::BufWriter::new(stdout.lock());
+            match write_baseline(kind, &ds, seed, &model, &cfg, &mut out) {
+                Err(e)
+                    if e.downcast_ref::<std::io::Error>()
+                        .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+                        || e.downcast_ref::<serde_json::Error>()
+                            .and_then(|j| j.io_error_kind())
+                            == Some(std::io::ErrorKind::BrokenPipe) =>
+                {
+                    Ok(())
+                }
+                r => r,
+            }
+        }
+        Some(Cmd::MakeFixture { out, n, seed, drop }) => {
+            let rows = rh_score::fixture::synth_rows(n, seed);
+            let drop: Vec<&str> = drop.iter().map(String::as_str).collect();
+            rh_score::fixture::write_dataset(&out, &rows, &drop)?;
+            println!("wrote {n} synthetic scenes to {}", out.display());
+            Ok(())
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("rh-score: error: {e:#}");
+            if is_input_error(&e) {
+                ExitCode::from(2)
+            } else {
+                ExitCode::from(1)
+            }
+        }
+    }
+}

@@ -1,0 +1,123 @@
+//! Scoring configuration: thresholds of the action rule, body constants, sanity limits,
+//! analysis parameters and the AIA vocabularies. The default is `configs/scoring.toml`,
+//! embedded at compile time; `--config FILE` replaces it.
+
+use anyhow::{bail, Context, Result};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The embedded default configuration (`configs/scoring.toml`).
+pub const DEFAULT_CONFIG_TOML: &str = include_str!("../../configs/scoring.toml");
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Config {
+    pub action_rule: ActionRuleConfig,
+    pub body: BodyConfig,
+    pub sanity: SanityConfig,
+    pub analyses: AnalysesConfig,
+    pub aia: AiaConfig,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ActionRuleConfig {
+    pub version: String,
+    pub reach_threshold: f64,
+    pub retreat_threshold: f64,
+    pub move_threshold: f64,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyConfig {
+    pub pelvis_height: f64,
+    pub rest_left: [f64; 3],
+    pub rest_right: [f64; 3],
+    pub default_keyframe_dt: f64,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SanityConfig {
+    pub max_abs_coordinate: f64,
+    pub max_speed: f64,
+    pub max_yaw_rate: f64,
+    pub max_duration: f64,
+    pub max_line_bytes: usize,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnalysesConfig {
+    pub miss_radius: f64,
+    pub far_standing: f64,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AiaConfig {
+    pub negation_window: usize,
+    pub negation: Vec<String>,
+    pub clause_breaks: Vec<String>,
+    pub catch: Vec<String>,
+    pub dodge: Vec<String>,
+    pub no_action: Vec<String>,
+    pub material_doubt: Vec<String>,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config::from_toml_str(DEFAULT_CONFIG_TOML).expect("embedded configs/scoring.toml is valid")
+    }
+}
+
+impl Config {
+    /// Parses and validates a configuration document.
+    pub fn from_toml_str(text: &str) -> Result<Config> {
+        let cfg: Config = toml::from_str(text).context("invalid scoring config")?;
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    /// Reads a configuration file (`--config`).
+    pub fn load(path: &Path) -> Result<Config> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read config {}", path.display()))?;
+        Config::from_toml_str(&text).with_context(|| format!("in config {}", path.display()))
+    }
+
+    fn validate(&self) -> Result<()> {
+        let a = &self.action_rule;
+        for (name, v) in [
+            ("action_rule.reach_threshold", a.reach_threshold),
+            ("action_rule.retreat_threshold", a.retreat_threshold),
+            ("action_rule.move_threshold", a.move_threshold),
+            ("body.pelvis_height", self.body.pelvis_height),
+            ("body.default_keyframe_dt", self.body.default_keyframe_dt),
+            ("sanity.max_abs_coordinate", self.sanity.max_abs_coordinate),
+            ("sanity.max_speed", self.sanity.max_speed),
+            ("sanity.max_yaw_rate", self.sanity.max_yaw_rate),
+            ("sanity.max_duration", self.sanity.max_duration),
+            ("analyses.miss_radius", self.analyses.miss_radius),
+            ("analyses.far_standing", self.analyses.far_standing),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                bail!("config field {name} must be a positive finite number, got {v}");
+            }
+        }
+        if self.sanity.max_line_bytes < 1024 {
+            bail!("config field sanity.max_line_bytes must be at least 1024");
+        }
+        for (name, list) in [
+            ("aia.catch", &self.aia.catch),
+            ("aia.dodge", &self.aia.dodge),
+            ("aia.no_action", &self.aia.no_action),
+        ] {
+            if list.is_empty() {
+                bail!("config field {name} must not be empty");
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,414 @@
+//! Ground truth: reads a dataset directory built by `rh-pipeline` (SPEC §8).
+//!
+//! Every `data/*.parquet` file is read in name order; columns are looked up by name, and a
+//! missing required column or one of the wrong type is an input error (exit 2) naming the
+//! file and the column.
+
+use crate::types::FastMap;
+use crate::types::{Action, InputError};
+use anyhow::{Context, Result};
+use arrow::array::{
+    Array, ArrayRef, BooleanArray, FixedSizeListArray, Float64Array, ListArray, RecordBatch,
+    StringArray,
+};
+use arrow::datatypes::DataType;
+use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+use std::path::{Path, PathBuf};
+
+/// The speed bands of SPEC §4, slowest first.
+pub const SPEED_BANDS: [&str; 4] = ["slow", "normal", "fast", "very_fast"];
+
+/// One scene's ground truth, as the scorer needs it.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    pub scene_id: String,
+    pub group_id: String,
+    /// Index into `Dataset::families`.
+    pub family: u16,
+    /// Index into [`SPEED_BANDS`], or `None` for an unknown band name.
+    pub speed_band: Option<u8>,
+    pub speed_band_name: String,
+    pub speed_sweep: bool,
+    pub object_id: String,
+    pub looks_like: Option<String>,
+    pub adversarial: bool,
+    pub gt_action: Action,
+    pub dangerous: bool,
+    pub danger_present: bool,
+    pub impact_point: Option<[f64; 3]>,
+    pub object_start: [f64; 3],
+    /// `(x, y, yaw)` of the observer on the floor.
+    pub observer_pose: [f64; 3],
+    /// The dataset's `valid` verdict (true when the column is absent). Invalid scenes are
+    /// not scored: predictions for them are counted under `invalid_scene`.
+    pub valid: bool,
+}
+
+impl Scene {
+    /// The hazard's target on the floor plane: the impact point, else the object's start.
+    pub fn hazard_point(&self) -> [f64; 3] {
+        self.impact_point.unwrap_or(self.object_start)
+    }
+}
+
+/// All scenes of a dataset directory.
+#[derive(Debug, Clone, Default)]
+pub struct Dataset {
+    pub dir: PathBuf,
+    pub scenes: Vec<Scene>,
+    pub families: Vec<String>,
+    pub index: FastMap<String, u32>,
+    /// Scene ids that appeared more than once in the Parquet files (first row kept).
+    pub duplicate_rows: usize,
+}
+
+impl Dataset {
+    /// Builds a dataset from scenes in memory (tests, benchmarks, fixtures).
+    pub fn from_scenes(dir: PathBuf, scenes: Vec<SceneInput>) -> Dataset {
+        let mut ds = Dataset {
+            dir,
+            ..Default::default()
+        };
+        for s in scenes {
+            ds.push(s);
+        }
+        ds
+    }
+
+    fn family_index(&mut self, family: &str) -> u16 {
+        if let Some(i) = self.families.iter().position(|f| f == family) {
+            return i as u16;
+        }
+        self.families.push(family.to_string());
+        (self.families.len() - 1) as u16
+    }
+
+    fn push(&mut self, s: SceneInput) {
+        if self.index.contains_key(&s.scene_id) {
+            self.duplicate_rows += 1;
+            return;
+        }
+        let family = self.family_index(&s.family);
+        let speed_band = SPEED_BANDS
+            .iter()
+            .position(|b| *b == s.speed_band)
+            .map(|i| i as u8);
+        self.index
+            .insert(s.scene_id.clone(), self.scenes.len() as u32);
+        self.scenes.push(Scene {
+            scene_id: s.scene_id,
+            group_id: s.group_id,
+            family,
+            speed_band,
+            speed_band_name: s.speed_band,
+            speed_sweep: s.speed_sweep,
+            object_id: s.object_id,
+            looks_like: s.looks_like,
+            adversarial: s.adversarial,
+            gt_action: s.gt_action,
+            dangerous: s.dangerous,
+            danger_present: s.danger_present,
+            impact_point: s.impact_point,
+            object_start: s.object_start,
+            observer_pose: s.observer_pose,
+            valid: s.valid,
+        });
+    }
+
+    pub fn family_name(&self, scene: &Scene) -> &str {
+        &self.families[scene.family as usize]
+    }
+
+    /// Number of valid (scored) scenes.
+    pub fn valid_scenes(&self) -> usize {
+        self.scenes.iter().filter(|s| s.valid).count()
+    }
+
+    pub fn get(&self, scene_id: &str) -> Option<(u32, &Scene)> {
+        self.index
+            .get(scene_id)
+            .map(|&i| (i, &self.scenes[i as usize]))
+    }
+
+    /// Reads `DIR/data/*.parquet` in name order.
+    pub fn load(dir: &Path) -> Result<Dataset> {
+        let data = dir.join("data");
+        if !dir.is_dir() {
+            return Err(InputError(format!(
+                "dataset directory {} does not exist",
+                dir.display()
+            ))
+            .into());
+        }
+        let mut files: Vec<PathBuf> = std::fs::read_dir(&data)
+            .map_err(|e| {
+                InputError(format!(
+                    "dataset {} has no readable data/ folder: {e}",
+                    dir.display()
+                ))
+            })?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
+            .collect();
+        files.sort();
+        if files.is_empty() {
+            return Err(InputError(format!(
+                "dataset {} has no data/*.parquet files",
+                dir.display()
+            ))
+            .into());
+        }
+        let mut ds = Dataset {
+            dir: dir.to_path_buf(),
+            ..Default::default()
+        };
+        for file in &files {
+            for s in read_parquet(file)? {
+                ds.push(s);
+            }
+        }
+        if ds.scenes.is_empty() {
+            return Err(InputError(format!("dataset {} has no scenes", dir.display())).into());
+        }
+        Ok(ds)
+    }
+}
+
+/// One scene as read from a row (or made by a fixture), before interning.
+#[derive(Debug, Clone)]
+pub struct SceneInput {
+    pub scene_id: String,
+    pub group_id: String,
+    pub family: String,
+    pub speed_band: String,
+    pub speed_sweep: bool,
+    pub object_id: String,
+    pub looks_like: Option<String>,
+    pub adversarial: bool,
+    pub gt_action: Action,
+    pub dangerous: bool,
+    pub danger_present: bool,
+    pub impact_point: Option<[f64; 3]>,
+    pub object_start: [f64; 3],
+    pub observer_pose: [f64; 3],
+    pub valid: bool,
+}
+
+fn bad(file: &Path, column: &str, what: impl std::fmt::Display) -> anyhow::Error {
+    InputError(format!("{}: column `{column}` {what}", file.display())).into()
+}
+
+fn column<'a>(batch: &'a RecordBatch, file: &Path, name: &str) -> Result<&'a ArrayRef> {
+    batch
+        .column_by_name(name)
+        .ok_or_else(|| bad(file, name, "is missing (required by rh-score)"))
+}
+
+fn strings(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Option<String>>> {
+    let col = column(batch, file, name)?;
+    let col = match col.data_type() {
+        DataType::Utf8 => col.clone(),
+        DataType::LargeUtf8 | DataType::Utf8View => {
+            arrow::compute::cast(col, &DataType::Utf8).map_err(|e| bad(file, name, e))?
+        }
+        other => return Err(bad(file, name, format!("has type {other}, expected Utf8"))),
+    };
+    let arr = col
+        .as_any()
+        .downcast_ref::<StringArray>()
+        .ok_or_else(|| bad(file, name, "is not a string array"))?;
+    Ok((0..arr.len())
+        .map(|i| (!arr.is_null(i)).then(|| arr.value(i).to_string()))
+        .collect())
+}
+
+fn required_strings(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<String>> {
+    strings(batch, file, name)?
+        .into_iter()
+        .enumerate()
+        .map(|(i, v)| v.ok_or_else(|| bad(file, name, format!("is null in row {i}"))))
+        .collect()
+}
+
+fn bools(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<bool>> {
+    let col = column(batch, file, name)?;
+    let arr = col.as_any().downcast_ref::<BooleanArray>().ok_or_else(|| {
+        bad(
+            file,
+            name,
+            format!("has type {}, expected Boolean", col.data_type()),
+        )
+    })?;
+    (0..arr.len())
+        .map(|i| {
+            if arr.is_null(i) {
+                Err(bad(file, name, format!("is null in row {i}")))
+            } else {
+                Ok(arr.value(i))
+            }
+        })
+        .collect()
+}
+
+/// A column of 3-vectors: FixedSizeList<Float64, 3> (or List<Float64> of length 3).
+fn vec3s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Option<[f64; 3]>>> {
+    let col = column(batch, file, name)?;
+    let expected = "expected FixedSizeList<Float64, 3>";
+    let mut out = Vec::with_capacity(col.len());
+    if let Some(arr) = col.as_any().downcast_ref::<FixedSizeListArray>() {
+        if arr.value_length() != 3 {
+            return Err(bad(
+                file,
+                name,
+                format!("has type {}, {expected}", col.data_type()),
+            ));
+        }
+        let values = arr
+            .values()
+            .as_any()
+            .downcast_ref::<Float64Array>()
+            .ok_or_else(|| {
+                bad(
+                    file,
+                    name,
+                    format!("has type {}, {expected}", col.data_type()),
+                )
+            })?;
+        for i in 0..arr.len() {
+            if arr.is_null(i) {
+                out.push(None);
+            } else {
+                let o = i * 3;
+                out.push(Some([
+                    values.value(o),
+                    values.value(o + 1),
+                    values.value(o + 2),
+                ]));
+            }
+        }
+    } else if let Some(arr) = col.as_any().downcast_ref::<ListArray>() {
+        for i in 0..arr.len() {
+            if arr.is_null(i) {
+                out.push(None);
+                continue;
+            }
+            let v = arr.value(i);
+            let v = v.as_any().downcast_ref::<Float64Array>().ok_or_else(|| {
+                bad(
+                    file,
+                    name,
+                    format!("has type {}, {expected}", col.data_type()),
+                )
+            })?;
+            if v.len() != 3 {
+                return Err(bad(
+                    file,
+                    name,
+                    format!("row {i} has {} values, expected 3", v.len()),
+                ));
+            }
+            out.push(Some([v.value(0), v.value(1), v.value(2)]));
+        }
+    } else {
+        return Err(bad(
+            file,
+            name,
+            format!("has type {}, {expected}", col.data_type()),
+        ));
+    }
+    Ok(out)
+}
+
+fn read_parquet(file: &Path) -> Result<Vec<SceneInput>> {
+    let f = std::fs::File::open(file)
+        .map_err(|e| InputError(format!("cannot open {}: {e}", file.display())))?;
+    let reader = ParquetRecordBatchReaderBuilder::try_new(f)
+        .map_err(|e| {
+            InputError(format!(
+                "{} is not a readable Parquet file: {e}",
+                file.display()
+            ))
+        })?
+        .with_batch_size(8192)
+        .build()
+        .with_context(|| format!("reading {}", file.display()))?;
+    let mut out = Vec::new();
+    for batch in reader {
+        let batch = batch.map_err(|e| InputError(format!("{}: {e}", file.display())))?;
+        let scene_id = required_strings(&batch, file, "scene_id")?;
+        let group_id = required_strings(&batch, file, "group_id")?;
+        let family = required_strings(&batch, file, "family")?;
+        let speed_band = required_strings(&batch, file, "speed_band")?;
+        let speed_sweep = bools(&batch, file, "speed_sweep")?;
+        let object_id = required_strings(&batch, file, "object_id")?;
+        let looks_like = strings(&batch, file, "looks_like")?;
+        let adversarial = bools(&batch, file, "adversarial")?;
+        let gt_action = required_strings(&batch, file, "gt_action")?;
+        let dangerous = bools(&batch, file, "dangerous")?;
+        let danger_present = bools(&batch, file, "danger_present")?;
+        let impact_point = vec3s(&batch, file, "impact_point")?;
+        let object_start = vec3s(&batch, file, "object_start")?;
+        let observer_pose = vec3s(&batch, file, "observer_pose")?;
+        let valid = if batch.column_by_name("valid").is_some() {
+            bools(&batch, file, "valid")?
+        } else {
+            vec![true; batch.num_rows()]
+        };
+        for i in 0..batch.num_rows() {
+            let gt = Action::parse(&gt_action[i]).ok_or_else(|| {
+                bad(
+                    file,
+                    "gt_action",
+                    format!(
+                        "has value {:?} in row {i}, expected CATCH, DODGE or NO_ACTION",
+                        gt_action[i]
+                    ),
+                )
+            })?;
+            let object_start = object_start[i]
+                .ok_or_else(|| bad(file, "object_start", format!("is null in row {i}")))?;
+            let observer_pose = observer_pose[i]
+                .ok_or_else(|| bad(file, "observer_pose", format!("is null in row {i}")))?;
+            let finite = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
+            if !finite(&object_start) {
+                return Err(bad(
+                    file,
+                    "object_start",
+                    format!("is not finite in row {i}"),
+                ));
+            }
+            if !finite(&observer_pose) {
+                return Err(bad(
+                    file,
+                    "observer_pose",
+                    format!("is not finite in row {i}"),
+                ));
+            }
+            if impact_point[i].is_some_and(|p| !finite(&p)) {
+                return Err(bad(
+                    file,
+                    "impact_point",
+                    format!("is not finite in row {i}"),
+                ));
+            }
+            out.push(SceneInput {
+                scene_id: scene_id[i].clone(),
+                group_id: group_id[i].clone(),
+                family: family[i].clone(),
+                speed_band: speed_band[i].clone(),
+                speed_sweep: speed_sweep[i],
+                object_id: object_id[i].clone(),
+                looks_like: looks_like[i].clone(),
+                adversarial: adversarial[i],
+                gt_action: gt,
+                dangerous: dangerous[i],
+                danger_present: danger_present[i],
+                impact_point: impact_point[i],
+                object_start,
+                observer_pose,
+                valid: valid[i],
+            });
+        }
+    }
+    Ok(out)
+}

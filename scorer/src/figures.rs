@@ -1,0 +1,345 @@
+//! Figures (`--figures DIR`), each written as SVG and PNG with plotters:
+//! `disposition` (SAA on CATCH vs DODGE scenes, one point per model, dashed diagonal),
+//! `freeze_by_band` (share of NO_ACTION per speed band, speed-sweeping families),
+//! `per_family` (SAA per family and model), `safety_rules` (first-rule breakdown).
+//!
+//! Text is rendered with `ab_glyph` from a font embedded in the binary (Hack, via the
+//! `epaint_default_fonts` crate), so no system fonts or fontconfig are needed.
+
+use crate::report::Report;
+use crate::types::Rule;
+use anyhow::{anyhow, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+use std::sync::Once;
+
+const FONT: &str = "sans-serif";
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        let _ = plotters::style::register_font(
+            FONT,
+            FontStyle::Normal,
+            epaint_default_fonts::HACK_REGULAR,
+        );
+    });
+}
+
+type DrawResult = Result<()>;
+
+fn e<T: std::fmt::Debug>(err: T) -> anyhow::Error {
+    anyhow!("drawing failed: {err:?}")
+}
+
+fn color(i: usize) -> RGBColor {
+    const C: [RGBColor; 10] = [
+        RGBColor(31, 119, 180),
+        RGBColor(255, 127, 14),
+        RGBColor(44, 160, 44),
+        RGBColor(214, 39, 40),
+        RGBColor(148, 103, 189),
+        RGBColor(140, 86, 75),
+        RGBColor(227, 119, 194),
+        RGBColor(127, 127, 127),
+        RGBColor(188, 189, 34),
+        RGBColor(23, 190, 207),
+    ];
+    C[i % C.len()]
+}
+
+/// Splits off a legend column on the right, wide enough for the longest label.
+fn split_legend<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    items: &[(String, RGBColor)],
+) -> (DrawingArea<DB, Shift>, DrawingArea<DB, Shift>) {
+    let longest = items.iter().map(|i| i.0.chars().count()).max().unwrap_or(0);
+    let width = (40 + longest * 8).clamp(120, 460) as i32;
+    let (w, _) = root.dim_in_pixel();
+    root.split_horizontally(w as i32 - width)
+}
+
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    items: &[(String, RGBColor)],
+) -> DrawResult {
+    for (i, (label, c)) in items.iter().enumerate() {
+        let y = 60 + 22 * i as i32;
+        area.draw(&Rectangle::new([(6, y), (20, y + 12)], c.filled()))
+            .map_err(e)?;
+        area.draw(&Text::new(label.clone(), (26, y - 1), (FONT, 12)))
+            .map_err(e)?;
+    }
+    Ok(())
+}
+
+fn disposition<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> DrawResult {
+    root.fill(&WHITE).map_err(e)?;
+    let mut chart = ChartBuilder::on(root)
+        .caption("Disposition: SAA on CATCH vs DODGE scenes", (FONT, 20))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0f64..100f64, 0f64..100f64)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc("SAA on CATCH scenes (%)")
+        .y_desc("SAA on DODGE scenes (%)")
+        .label_style((FONT, 13))
+        .axis_desc_style((FONT, 14))
+        .draw()
+        .map_err(e)?;
+    chart
+        .draw_series(DashedLineSeries::new(
+            vec![(0.0, 0.0), (100.0, 100.0)],
+            6,
+            4,
+            BLACK.mix(0.6).stroke_width(1),
+        ))
+        .map_err(e)?;
+    for (i, m) in r.models.iter().enumerate() {
+        let (Some(x), Some(y)) = (m.by_gt_action[0].saa, m.by_gt_action[1].saa) else {
+            continue;
+        };
+        let (x, y) = (100.0 * x, 100.0 * y);
+        let c = color(i);
+        chart
+            .draw_series(std::iter::once(Circle::new((x, y), 6, c.filled())))
+            .map_err(e)?;
+        let tx = if x > 75.0 { x - 22.0 } else { x + 1.5 };
+        chart
+            .draw_series(std::iter::once(Text::new(
+                m.model.clone(),
+                (tx, (y + 2.5).min(98.0)),
+                (FONT, 13).into_font().color(&c),
+            )))
+            .map_err(e)?;
+    }
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+fn freeze_by_band<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> DrawResult {
+    root.fill(&WHITE).map_err(e)?;
+    let bands = ["slow", "normal", "fast", "very_fast"];
+    let legend_items: Vec<(String, RGBColor)> = r
+        .analyses
+        .speed
+        .iter()
+        .filter(|s| s.model != "ALL")
+        .enumerate()
+        .map(|(i, s)| (s.model.clone(), color(i)))
+        .collect();
+    let (plot, legend_area) = split_legend(root, &legend_items);
+    let mut chart = ChartBuilder::on(&plot)
+        .caption("Freeze rate (NO_ACTION) by speed band", (FONT, 20))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(55)
+        .build_cartesian_2d(-0.3f64..3.3f64, 0f64..100f64)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_labels(4)
+        .x_label_formatter(&|x| {
+            let i = x.round();
+            if (x - i).abs() < 1e-6 && (0.0..4.0).contains(&i) {
+                bands[i as usize].to_string()
+            } else {
+                String::new()
+            }
+        })
+        .x_desc("speed band (speed-sweeping families)")
+        .y_desc("decisions that freeze (%)")
+        .label_style((FONT, 13))
+        .axis_desc_style((FONT, 14))
+        .draw()
+        .map_err(e)?;
+    let series: Vec<_> = r
+        .analyses
+        .speed
+        .iter()
+        .filter(|s| s.model != "ALL")
+        .collect();
+    for (i, s) in series.iter().enumerate() {
+        let c = color(i);
+        let pts: Vec<(f64, f64)> = s
+            .freeze_rate_by_band
+            .iter()
+            .enumerate()
+            .filter_map(|(b, v)| v.map(|v| (b as f64, 100.0 * v)))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
+            .map_err(e)?;
+        chart
+            .draw_series(pts.into_iter().map(|p| Circle::new(p, 4, c.filled())))
+            .map_err(e)?;
+    }
+    draw_legend(&legend_area, &legend_items)?;
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+fn per_family<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> DrawResult {
+    root.fill(&WHITE).map_err(e)?;
+    let fams: Vec<&str> = r.dataset.families.iter().map(|s| s.as_str()).collect();
+    let n = fams.len().max(1);
+    let k = r.models.len().max(1);
+    let legend_items: Vec<(String, RGBColor)> = r
+        .models
+        .iter()
+        .enumerate()
+        .map(|(i, m)| (m.model.clone(), color(i)))
+        .collect();
+    let (plot, legend_area) = split_legend(root, &legend_items);
+    let mut chart = ChartBuilder::on(&plot)
+        .caption("SAA per family", (FONT, 20))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(140)
+        .build_cartesian_2d(0f64..100f64, -0.5f64..(n as f64 - 0.5))
+        .map_err(e)?;
+    let names = fams.clone();
+    chart
+        .configure_mesh()
+        .y_labels(n + 1)
+        .y_label_formatter(&|y| {
+            let i = y.round();
+            if (y - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
+                names[names.len() - 1 - i as usize].to_string()
+            } else {
+                String::new()
+            }
+        })
+        .disable_y_mesh()
+        .x_desc("SAA (%)")
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 14))
+        .draw()
+        .map_err(e)?;
+    let h = 0.8 / k as f64;
+    for (mi, m) in r.models.iter().enumerate() {
+        let c = color(mi);
+        let bars: Vec<_> = m
+            .by_family
+            .iter()
+            .enumerate()
+            .filter_map(|(fi, row)| {
+                let v = row.saa?;
+                let y0 = (n - 1 - fi) as f64 + 0.4 - (mi + 1) as f64 * h;
+                Some(Rectangle::new(
+                    [(0.0, y0), (100.0 * v, y0 + h * 0.9)],
+                    c.filled(),
+                ))
+            })
+            .collect();
+        chart.draw_series(bars).map_err(e)?;
+    }
+    draw_legend(&legend_area, &legend_items)?;
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> DrawResult {
+    root.fill(&WHITE).map_err(e)?;
+    let rows: Vec<_> = r.analyses.safety.iter().collect();
+    let n = rows.len().max(1);
+    let names: Vec<String> = rows.iter().map(|s| s.model.clone()).collect();
+    let legend_items: Vec<(String, RGBColor)> = Rule::ALL
+        .iter()
+        .map(|r| {
+            (
+                format!("{}: {}", r.as_str(), r.describe()),
+                color(r.index() + 3),
+            )
+        })
+        .collect();
+    let (plot, legend_area) = split_legend(root, &legend_items);
+    let mut chart = ChartBuilder::on(&plot)
+        .caption(
+            "Safety violations by first rule (% of decisions)",
+            (FONT, 20),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(140)
+        .build_cartesian_2d(0f64..100f64, -0.5f64..(n as f64 - 0.5))
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .y_labels(n + 1)
+        .y_label_formatter(&|y| {
+            let i = y.round();
+            if (y - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
+                names[names.len() - 1 - i as usize].clone()
+            } else {
+                String::new()
+            }
+        })
+        .disable_y_mesh()
+        .x_desc("decisions (%)")
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 14))
+        .draw()
+        .map_err(e)?;
+    for rule in Rule::ALL {
+        let c = color(rule.index() + 3);
+        let bars: Vec<_> = rows
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.decisions > 0)
+            .map(|(i, s)| {
+                let d = s.decisions as f64;
+                let before: u64 = Rule::ALL[..rule.index()]
+                    .iter()
+                    .map(|r| s.first_rule.get(*r))
+                    .sum();
+                let x0 = 100.0 * before as f64 / d;
+                let x1 = x0 + 100.0 * s.first_rule.get(rule) as f64 / d;
+                let y = (n - 1 - i) as f64;
+                Rectangle::new([(x0, y - 0.35), (x1, y + 0.35)], c.filled())
+            })
+            .collect();
+        chart.draw_series(bars).map_err(e)?;
+    }
+    draw_legend(&legend_area, &legend_items)?;
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+macro_rules! both {
+    ($dir:expr, $name:literal, $size:expr, $f:ident, $r:expr, $out:expr) => {{
+        let svg = $dir.join(concat!($name, ".svg"));
+        {
+            let root = SVGBackend::new(&svg, $size).into_drawing_area();
+            $f(&root, $r)?;
+        }
+        let png = $dir.join(concat!($name, ".png"));
+        {
+            let root = BitMapBackend::new(&png, $size).into_drawing_area();
+            $f(&root, $r)?;
+        }
+        $out.push(svg);
+        $out.push(png);
+    }};
+}
+
+/// Writes every figure into `dir` (created if needed); returns the files written.
+pub fn write_figures(r: &Report, dir: &Path) -> Result<Vec<std::path::PathBuf>> {
+    register_font();
+    std::fs::create_dir_all(dir)
+        .map_err(|err| anyhow!("cannot create figures directory {}: {err}", dir.display()))?;
+    let mut out = Vec::new();
+    let fam_h = (140
+        + r.dataset.families.len().max(4) as u32 * (14 + 10 * r.models.len().clamp(1, 8) as u32))
+        .min(2400);
+    let safety_h = (160 + 40 * r.analyses.safety.len() as u32).max(320);
+    both!(dir, "disposition", (640, 600), disposition, r, out);
+    both!(dir, "freeze_by_band", (900, 500), freeze_by_band, r, out);
+    both!(dir, "per_family", (1080, fam_h), per_family, r, out);
+    both!(dir, "safety_rules", (1180, safety_h), safety_rules, r, out);
+    Ok(out)
+}

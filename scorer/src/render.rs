@@ -1,0 +1,502 @@
+//! Report renderings: terminal table, Markdown, CSV (JSON is `serde_json` of [`Report`]).
+
+use crate::report::{MetricsRow, ModelReport, Report};
+use crate::types::Rule;
+use std::fmt::Write as _;
+
+fn pct(v: Option<f64>) -> String {
+    v.map_or("—".into(), |x| format!("{:.1}", 100.0 * x))
+}
+
+fn num(v: Option<f64>, digits: usize) -> String {
+    v.map_or("—".into(), |x| format!("{x:.digits$}"))
+}
+
+/// A simple table rendered either aligned (terminal) or as Markdown.
+struct Table {
+    head: Vec<String>,
+    rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    fn new(head: &[&str]) -> Self {
+        Table {
+            head: head.iter().map(|s| s.to_string()).collect(),
+            rows: Vec::new(),
+        }
+    }
+
+    fn row(&mut self, r: Vec<String>) {
+        self.rows.push(r);
+    }
+
+    fn text(&self) -> String {
+        let n = self.head.len();
+        let mut w = vec![0usize; n];
+        for r in std::iter::once(&self.head).chain(&self.rows) {
+            for (i, c) in r.iter().enumerate() {
+                w[i] = w[i].max(c.chars().count());
+            }
+        }
+        let mut out = String::new();
+        let line = |r: &Vec<String>, out: &mut String| {
+            for (i, c) in r.iter().enumerate() {
+                let pad = w[i] - c.chars().count();
+                if i == 0 {
+                    out.push_str(c);
+                    out.push_str(&" ".repeat(pad));
+                } else {
+                    out.push_str("  ");
+                    out.push_str(&" ".repeat(pad));
+                    out.push_str(c);
+                }
+            }
+            out.push('\n');
+        };
+        line(&self.head, &mut out);
+        let total: usize = w.iter().sum::<usize>() + 2 * (n - 1);
+        out.push_str(&"-".repeat(total));
+        out.push('\n');
+        for r in &self.rows {
+            line(r, &mut out);
+        }
+        out
+    }
+
+    fn markdown(&self) -> String {
+        let mut out = String::new();
+        let esc = |s: &str| s.replace('|', "\\|");
+        out.push_str(&format!(
+            "| {} |\n",
+            self.head
+                .iter()
+                .map(|s| esc(s))
+                .collect::<Vec<_>>()
+                .join(" | ")
+        ));
+        out.push_str(&format!(
+            "|{}|\n",
+            self.head
+                .iter()
+                .enumerate()
+                .map(|(i, _)| if i == 0 { " --- " } else { " ---: " })
+                .collect::<Vec<_>>()
+                .join("|")
+        ));
+        for r in &self.rows {
+            out.push_str(&format!(
+                "| {} |\n",
+                r.iter().map(|s| esc(s)).collect::<Vec<_>>().join(" | ")
+            ));
+        }
+        out
+    }
+}
+
+fn main_table(r: &Report) -> Table {
+    let mut t = Table::new(&[
+        "Model",
+        "Decisions",
+        "Lost",
+        "SAA %",
+        "Safety %",
+        "d_end (m)",
+        "d_end n/missing",
+        "AIA",
+        "d_min (m)",
+        "d1-d_min (m)",
+        "R1",
+        "R2",
+        "R3",
+        "R4",
+    ]);
+    let mut add = |name: &str, lost: u64, m: &MetricsRow| {
+        t.row(vec![
+            name.to_string(),
+            m.decisions.to_string(),
+            lost.to_string(),
+            pct(m.saa),
+            pct(m.safety),
+            num(m.d_end, 2),
+            format!("{}/{}", m.d_end_n, m.d_end_missing),
+            num(m.aia, 2),
+            num(m.d_min, 2),
+            num(m.closing, 2),
+            m.first_rule.r1.to_string(),
+            m.first_rule.r2.to_string(),
+            m.first_rule.r3.to_string(),
+            m.first_rule.r4.to_string(),
+        ]);
+    };
+    for m in &r.models {
+        add(&m.model, m.lost, &m.overall);
+    }
+    if r.models.len() > 1 {
+        add("ALL (pooled)", r.pooled.lost, &r.pooled.overall);
+    }
+    t
+}
+
+fn breakdown_table(r: &Report, title: &str, pick: fn(&ModelReport) -> &Vec<MetricsRow>) -> Table {
+    let mut head = vec![title.to_string()];
+    let models: Vec<&ModelReport> = r
+        .models
+        .iter()
+        .chain((r.models.len() > 1).then_some(&r.pooled))
+        .collect();
+    for m in &models {
+        head.push(format!("{} SAA/Safety %", m.model));
+    }
+    let mut t = Table {
+        head,
+        rows: Vec::new(),
+    };
+    let groups: Vec<String> = pick(&r.pooled).iter().map(|g| g.group.clone()).collect();
+    for (gi, g) in groups.iter().enumerate() {
+        let mut row = vec![g.clone()];
+        for m in &models {
+            let x = &pick(m)[gi];
+            row.push(if x.decisions == 0 {
+                "—".into()
+            } else {
+                format!("{} / {} (n={})", pct(x.saa), pct(x.safety), x.decisions)
+            });
+        }
+        t.row(row);
+    }
+    t
+}
+
+fn analyses_tables(r: &Report) -> Vec<(String, Table, Option<String>)> {
+    let a = &r.analyses;
+    let mut out = Vec::new();
+
+    let mut t = Table::new(&[
+        "Model",
+        "Decisions",
+        "Violations",
+        "first R1",
+        "R2",
+        "R3",
+        "R4",
+        "fired R1",
+        "R2",
+        "R3",
+        "R4",
+        "Unsafe on DODGE %",
+        "Mistakes",
+        "Freezing",
+    ]);
+    for s in &a.safety {
+        let mut row = vec![
+            s.model.clone(),
+            s.decisions.to_string(),
+            s.violations.to_string(),
+        ];
+        for rule in Rule::ALL {
+            row.push(s.first_rule.get(rule).to_string());
+        }
+        for rule in Rule::ALL {
+            row.push(s.rules_fired.get(rule).to_string());
+        }
+        row.push(pct(s.unsafe_on_dodge_scenes));
+        row.push(s.mistakes.to_string());
+        row.push(s.freeze_mistakes.to_string());
+        t.row(row);
+    }
+    out.push((
+        "Safety-rule breakdown".into(),
+        t,
+        Some("first = the first rule in order R1..R4 (one per unsafe decision); fired = every rule that fired. Freezing = NO_ACTION where the ground truth was not NO_ACTION.".into()),
+    ));
+
+    let mut t = Table::new(&[
+        "Model",
+        "SAA on CATCH scenes %",
+        "SAA on DODGE scenes %",
+        "SAA on NO_ACTION %",
+    ]);
+    for m in r
+        .models
+        .iter()
+        .chain((r.models.len() > 1).then_some(&r.pooled))
+    {
+        let g = &m.by_gt_action;
+        t.row(vec![
+            m.model.clone(),
+            pct(g[0].saa),
+            pct(g[1].saa),
+            pct(g[2].saa),
+        ]);
+    }
+    out.push((
+        "Disposition".into(),
+        t,
+        Some("Models above the diagonal (DODGE > CATCH) prefer to retreat.".into()),
+    ));
+
+    let mut t = Table::new(&[
+        "Model",
+        "Correct CATCH",
+        "median d_end (m)",
+        "median d_end any correct (m)",
+        "Misses %",
+        "Misses falling short %",
+        "Standing far %",
+    ]);
+    for o in &a.out_of_reach {
+        t.row(vec![
+            o.model.clone(),
+            o.correct_catch.to_string(),
+            num(o.median_d_end_correct_catch, 2),
+            num(o.median_d_end_correct_any, 2),
+            pct(o.miss_share),
+            pct(o.misses_falling_short_share),
+            pct(o.standing_far_share),
+        ]);
+    }
+    out.push(("Correct but out of reach".into(), t, Some("Correct CATCH decisions with an impact point. Miss: d_end above the miss radius; falling short: the final hands are closer (horizontally) to the final pelvis than the impact point is; standing far: the final pelvis is farther than the far-standing distance from the impact point (horizontal).".into())));
+
+    let mut t = Table::new(&[
+        "Model",
+        "Decisions",
+        "Freeze slow %",
+        "normal %",
+        "fast %",
+        "very_fast %",
+        "SAA slow %",
+        "normal %",
+        "fast %",
+        "very_fast %",
+        "Groups",
+        "Same action all 4 %",
+        "slow = very_fast %",
+    ]);
+    for s in &a.speed {
+        let mut row = vec![s.model.clone(), s.decisions.to_string()];
+        row.extend(s.freeze_rate_by_band.iter().map(|v| pct(*v)));
+        row.extend(s.saa_by_band.iter().map(|v| pct(*v)));
+        row.push(s.complete_groups.to_string());
+        row.push(pct(s.consistency));
+        row.push(pct(s.slow_vs_very_fast_agreement));
+        t.row(row);
+    }
+    out.push(("Speed bands (speed-sweeping families only)".into(), t, Some("Freeze = share of NO_ACTION decisions. Consistency over scene groups with a scored decision at all four bands.".into())));
+
+    let v = &a.voting;
+    let mut t = Table::new(&[
+        "Models",
+        "Scenes (all models scored)",
+        "Unanimous %",
+        "Unanimous accuracy %",
+        "Majority-vote SAA %",
+        "Mean model SAA %",
+        "Best model",
+        "Best model SAA %",
+    ]);
+    t.row(vec![
+        v.models.to_string(),
+        v.scenes.to_string(),
+        pct(v.unanimous_share),
+        pct(v.unanimous_accuracy),
+        pct(v.majority_vote_saa),
+        pct(v.mean_model_saa),
+        v.best_model.clone().unwrap_or_else(|| "—".into()),
+        pct(v.best_model_saa),
+    ]);
+    out.push(("Majority vote and unanimity".into(), t, Some("Ties in the vote go to DODGE, then NO_ACTION, then CATCH; an unparseable plan never wins.".into())));
+
+    let mut t = Table::new(&[
+        "Model",
+        "Adversarial decisions",
+        "Intent questions material/weight",
+        "Share %",
+    ]);
+    for p in &a.adversarial {
+        t.row(vec![
+            p.model.clone(),
+            p.decisions.to_string(),
+            p.questions_material.to_string(),
+            pct(p.share),
+        ]);
+    }
+    out.push(("Adversarial probes".into(), t, None));
+
+    if !a.lookalikes.is_empty() {
+        let mut t = Table::new(&[
+            "Adversarial object",
+            "Looks like",
+            "Decisions",
+            "CATCH %",
+            "DODGE %",
+            "Look-alike decisions",
+            "Look-alike CATCH %",
+            "Look-alike DODGE %",
+        ]);
+        for l in &a.lookalikes {
+            t.row(vec![
+                l.object_id.clone(),
+                l.looks_like.clone(),
+                l.decisions.to_string(),
+                pct(l.catch_rate),
+                pct(l.dodge_rate),
+                l.lookalike_decisions.to_string(),
+                pct(l.lookalike_catch_rate),
+                pct(l.lookalike_dodge_rate),
+            ]);
+        }
+        out.push((
+            "Adversarial objects vs. their look-alikes (all models)".into(),
+            t,
+            None,
+        ));
+    }
+    out
+}
+
+fn header(r: &Report) -> String {
+    let ar = &r.action_rule;
+    let gt = &r.dataset.gt_actions;
+    let g = |k: &str| gt.get(k).copied().unwrap_or(0);
+    let i = &r.input;
+    format!(
+        "rh-score {} — action rule {} (CATCH: reach ≥ {:.2} m and not D·u ≤ −{:.2} m; DODGE: |D| ≥ {:.2} m)\n\
+         dataset: {} — {} scenes ({} CATCH / {} DODGE / {} NO_ACTION; {} danger_present, {} adversarial){}\n\
+         predictions: {} — {} lines, {} decisions scored, {} lost (API errors), {} duplicates, {} warnings\n",
+        r.version, ar.version, ar.reach_threshold, ar.retreat_threshold, ar.move_threshold,
+        r.dataset.dir, r.dataset.scenes, g("CATCH"), g("DODGE"), g("NO_ACTION"),
+        r.dataset.danger_present, r.dataset.adversarial,
+        if r.dataset.invalid_scenes > 0 { format!("; {} invalid scenes not scored", r.dataset.invalid_scenes) } else { String::new() },
+        i.file, i.lines, i.decisions_scored, i.decisions_lost, i.duplicates,
+        i.warnings.iter().map(|w| w.count).sum::<u64>(),
+    )
+}
+
+fn warnings_text(r: &Report) -> String {
+    let mut s = String::new();
+    for w in &r.input.warnings {
+        let lines: Vec<String> = w.first_lines.iter().map(|l| l.to_string()).collect();
+        let _ = write!(
+            s,
+            "  {:<28} {:>8}  first at line {}",
+            w.kind,
+            w.count,
+            lines.join(", ")
+        );
+        if !w.examples.is_empty() {
+            let _ = write!(s, "  (e.g. {})", w.examples.join("; "));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// The terminal report.
+pub fn terminal(r: &Report) -> String {
+    let mut s = header(r);
+    s.push('\n');
+    s.push_str(&main_table(r).text());
+    for (title, t, note) in analyses_tables(r) {
+        let _ = write!(s, "\n{title}\n");
+        if let Some(n) = note {
+            let _ = writeln!(s, "  ({n})");
+        }
+        s.push_str(&t.text());
+    }
+    if !r.input.warnings.is_empty() {
+        s.push_str("\nInput warnings (kind, count, first lines)\n");
+        s.push_str(&warnings_text(r));
+    }
+    s
+}
+
+/// The Markdown report.
+pub fn markdown(r: &Report) -> String {
+    let mut s = String::from("# ReactHuman scores\n\n");
+    for line in header(r).lines() {
+        let _ = writeln!(s, "{line}  ");
+    }
+    s.push_str("\nRates in %, distances in metres. Missing values (no impact point, no plan) leave the denominator; their counts are shown.\n\n## Main results\n\n");
+    s.push_str(&main_table(r).markdown());
+    for (title, column, pick) in [
+        (
+            "By family",
+            "Family",
+            (|m: &ModelReport| &m.by_family) as fn(&ModelReport) -> &Vec<MetricsRow>,
+        ),
+        ("By speed band", "Speed band", |m: &ModelReport| {
+            &m.by_speed_band
+        }),
+        (
+            "By ground-truth action",
+            "Ground truth",
+            |m: &ModelReport| &m.by_gt_action,
+        ),
+        ("Adversarial vs. not", "Scenes", |m: &ModelReport| {
+            &m.by_adversarial
+        }),
+    ] {
+        let _ = write!(s, "\n## {title}\n\n");
+        s.push_str(&breakdown_table(r, column, pick).markdown());
+    }
+    for (title, t, note) in analyses_tables(r) {
+        let _ = write!(s, "\n## {title}\n\n");
+        if let Some(n) = note {
+            let _ = write!(s, "{n}\n\n");
+        }
+        s.push_str(&t.markdown());
+    }
+    if !r.input.warnings.is_empty() {
+        s.push_str("\n## Input warnings\n\n```\n");
+        s.push_str(&warnings_text(r));
+        s.push_str("```\n");
+    }
+    s
+}
+
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// The CSV report: one row per (model, breakdown, group); rates are fractions; empty
+/// cells are undefined values.
+pub fn csv(r: &Report) -> String {
+    let mut s = String::from(
+        "model,breakdown,group,decisions,lost,saa,safety,d_end,d_end_n,d_end_missing,aia,d_min,closing,hde_n,hde_missing,freeze_rate,first_R1,first_R2,first_R3,first_R4,fired_R1,fired_R2,fired_R3,fired_R4,pred_CATCH,pred_DODGE,pred_NO_ACTION,pred_unparseable\n",
+    );
+    let f = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x}"));
+    let models: Vec<&ModelReport> = r.models.iter().chain(std::iter::once(&r.pooled)).collect();
+    for m in models {
+        let sets: [(&str, Vec<&MetricsRow>); 5] = [
+            ("overall", vec![&m.overall]),
+            ("family", m.by_family.iter().collect()),
+            ("speed_band", m.by_speed_band.iter().collect()),
+            ("gt_action", m.by_gt_action.iter().collect()),
+            ("adversarial", m.by_adversarial.iter().collect()),
+        ];
+        for (bd, rows) in sets {
+            for x in rows {
+                let lost = if bd == "overall" {
+                    m.lost.to_string()
+                } else {
+                    String::new()
+                };
+                let _ = writeln!(
+                    s,
+                    "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                    csv_field(&m.model), bd, csv_field(&x.group), x.decisions, lost,
+                    f(x.saa), f(x.safety), f(x.d_end), x.d_end_n, x.d_end_missing, f(x.aia),
+                    f(x.d_min), f(x.closing), x.hde_n, x.hde_missing, f(x.freeze_rate),
+                    x.first_rule.r1, x.first_rule.r2, x.first_rule.r3, x.first_rule.r4,
+                    x.rules_fired.r1, x.rules_fired.r2, x.rules_fired.r3, x.rules_fired.r4,
+                    x.predicted.catch, x.predicted.dodge, x.predicted.no_action, x.predicted.unparseable,
+                );
+            }
+        }
+    }
+    s
+}

@@ -1,0 +1,804 @@
+//! The report: aggregated metrics per model and breakdown, and the paper's analyses.
+
+use crate::aggregate::{Acc, ModelAgg, Rec, ACT_NONE, REC_SCORED};
+use crate::config::Config;
+use crate::dataset::{Dataset, SPEED_BANDS};
+use crate::score::{Scoring, WarningAcc};
+use crate::types::{Action, Rule};
+use serde::Serialize;
+use std::collections::{BTreeMap, HashMap};
+
+#[derive(Debug, Clone, Serialize)]
+pub struct RuleCounts {
+    #[serde(rename = "R1")]
+    pub r1: u64,
+    #[serde(rename = "R2")]
+    pub r2: u64,
+    #[serde(rename = "R3")]
+    pub r3: u64,
+    #[serde(rename = "R4")]
+    pub r4: u64,
+}
+
+impl RuleCounts {
+    fn new(c: [u64; 4]) -> Self {
+        RuleCounts {
+            r1: c[0],
+            r2: c[1],
+            r3: c[2],
+            r4: c[3],
+        }
+    }
+
+    pub fn get(&self, r: Rule) -> u64 {
+        [self.r1, self.r2, self.r3, self.r4][r.index()]
+    }
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct ActionCounts {
+    #[serde(rename = "CATCH")]
+    pub catch: u64,
+    #[serde(rename = "DODGE")]
+    pub dodge: u64,
+    #[serde(rename = "NO_ACTION")]
+    pub no_action: u64,
+    /// No parseable plan (R1).
+    pub unparseable: u64,
+}
+
+/// Metrics over one group of scored decisions. Rates are fractions in [0, 1]; a metric is
+/// `null` when its denominator is 0. Missing distance values (no impact point, or no
+/// plan) leave the denominator and are counted in `*_missing`.
+#[derive(Debug, Clone, Serialize)]
+pub struct MetricsRow {
+    pub group: String,
+    pub decisions: u64,
+    pub saa: Option<f64>,
+    pub safety: Option<f64>,
+    pub d_end: Option<f64>,
+    pub d_end_n: u64,
+    pub d_end_missing: u64,
+    pub aia: Option<f64>,
+    pub d_min: Option<f64>,
+    pub closing: Option<f64>,
+    pub hde_n: u64,
+    pub hde_missing: u64,
+    pub freeze_rate: Option<f64>,
+    pub first_rule: RuleCounts,
+    pub rules_fired: RuleCounts,
+    pub predicted: ActionCounts,
+}
+
+impl MetricsRow {
+    pub fn from_acc(group: impl Into<String>, a: &Acc) -> Self {
+        MetricsRow {
+            group: group.into(),
+            decisions: a.n,
+            saa: a.rate(a.saa),
+            safety: a.rate(a.safe),
+            d_end: a.d_end.value(),
+            d_end_n: a.d_end.n,
+            d_end_missing: a.d_end.missing,
+            aia: a.aia.value(),
+            d_min: a.d_min.value(),
+            closing: a.closing.value(),
+            hde_n: a.d_min.n,
+            hde_missing: a.d_min.missing,
+            freeze_rate: a.rate(a.predicted[2]),
+            first_rule: RuleCounts::new(a.first),
+            rules_fired: RuleCounts::new(a.fired),
+            predicted: ActionCounts {
+                catch: a.predicted[0],
+                dodge: a.predicted[1],
+                no_action: a.predicted[2],
+                unparseable: a.predicted[3],
+            },
+        }
+    }
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct ModelReport {
+    pub model: String,
+    pub lost: u64,
+    pub duplicates: u64,
+    pub overall: MetricsRow,
+    pub by_family: Vec<MetricsRow>,
+    pub by_speed_band: Vec<MetricsRow>,
+    pub by_gt_action: Vec<MetricsRow>,
+    pub by_adversarial: Vec<MetricsRow>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct DatasetSummary {
+    pub dir: String,
+    /// Valid scenes (the ones scored); the counts below are over them.
+    pub scenes: usize,
+    /// Scenes with `valid = false` (never scored).
+    pub invalid_scenes: usize,
+    pub families: Vec<String>,
+    pub gt_actions: BTreeMap<String, u64>,
+    pub danger_present: u64,
+    pub dangerous: u64,
+    pub adversarial: u64,
+    pub with_impact_point: u64,
+    pub duplicate_rows: usize,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct WarningSummary {
+    pub kind: String,
+    pub count: u64,
+    pub first_lines: Vec<u64>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub examples: Vec<String>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct InputSummary {
+    pub file: String,
+    pub lines: u64,
+    pub blank_lines: u64,
+    pub decisions_scored: u64,
+    pub decisions_lost: u64,
+    pub duplicates: u64,
+    pub warnings: Vec<WarningSummary>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct ActionRuleSummary {
+    pub version: String,
+    pub reach_threshold: f64,
+    pub retreat_threshold: f64,
+    pub move_threshold: f64,
+}
+
+/// Safety-rule breakdown for one model (or pooled).
+#[derive(Debug, Clone, Serialize)]
+pub struct SafetyBreakdown {
+    pub model: String,
+    pub decisions: u64,
+    pub violations: u64,
+    pub first_rule: RuleCounts,
+    pub rules_fired: RuleCounts,
+    /// Share of decisions on DODGE scenes that broke a rule.
+    pub unsafe_on_dodge_scenes: Option<f64>,
+    /// Wrong decisions (SAA = 0) and how many of them were NO_ACTION (freezing).
+    pub mistakes: u64,
+    pub freeze_mistakes: u64,
+}
+
+/// "Correct but out of reach" (correct CATCH decisions with an impact point).
+#[derive(Debug, Clone, Serialize)]
+pub struct OutOfReach {
+    pub model: String,
+    pub correct_catch: u64,
+    pub median_d_end_correct_catch: Option<f64>,
+    /// Median d_end over every correct decision (any action) with an impact point.
+    pub median_d_end_correct_any: Option<f64>,
+    pub misses: u64,
+    pub miss_share: Option<f64>,
+    pub misses_falling_short_share: Option<f64>,
+    pub standing_far_share: Option<f64>,
+}
+
+/// Speed analyses over the speed-sweeping families.
+#[derive(Debug, Clone, Serialize)]
+pub struct SpeedAnalysis {
+    pub model: String,
+    pub decisions: u64,
+    pub freeze_rate_by_band: Vec<Option<f64>>,
+    pub saa_by_band: Vec<Option<f64>>,
+    /// Scene groups with a scored decision at all four bands.
+    pub complete_groups: u64,
+    pub consistent_groups: u64,
+    pub consistency: Option<f64>,
+    pub slow_vs_very_fast_agreement: Option<f64>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct Voting {
+    pub models: usize,
+    /// Scenes where every model has a scored decision.
+    pub scenes: u64,
+    pub unanimous: u64,
+    pub unanimous_share: Option<f64>,
+    pub unanimous_accuracy: Option<f64>,
+    pub majority_vote_saa: Option<f64>,
+    pub mean_model_saa: Option<f64>,
+    pub best_model: Option<String>,
+    pub best_model_saa: Option<f64>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct AdversarialProbe {
+    pub model: String,
+    pub decisions: u64,
+    pub questions_material: u64,
+    pub share: Option<f64>,
+}
+
+/// Catch rate on an adversarial object vs. on its genuine look-alike.
+#[derive(Debug, Clone, Serialize)]
+pub struct LookalikeComparison {
+    pub object_id: String,
+    pub looks_like: String,
+    pub decisions: u64,
+    pub catch_rate: Option<f64>,
+    pub dodge_rate: Option<f64>,
+    pub lookalike_decisions: u64,
+    pub lookalike_catch_rate: Option<f64>,
+    pub lookalike_dodge_rate: Option<f64>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct Analyses {
+    pub safety: Vec<SafetyBreakdown>,
+    pub out_of_reach: Vec<OutOfReach>,
+    pub speed: Vec<SpeedAnalysis>,
+    pub voting: Voting,
+    pub adversarial: Vec<AdversarialProbe>,
+    pub lookalikes: Vec<LookalikeComparison>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    pub tool: String,
+    pub version: String,
+    pub action_rule: ActionRuleSummary,
+    pub dataset: DatasetSummary,
+    pub input: InputSummary,
+    pub models: Vec<ModelReport>,
+    /// All models pooled (`model` = "ALL").
+    pub pooled: ModelReport,
+    pub analyses: Analyses,
+}
+
+fn ratio(a: u64, b: u64) -> Option<f64> {
+    (b > 0).then(|| a as f64 / b as f64)
+}
+
+fn median(v: &mut [f64]) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(|a, b| a.total_cmp(b));
+    let n = v.len();
+    Some(if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    })
+}
+
+const BAND_GROUPS: [&str; 5] = ["slow", "normal", "fast", "very_fast", "other"];
+
+fn model_report(m: &ModelAgg, ds: &Dataset) -> ModelReport {
+    ModelReport {
+        model: m.name.clone(),
+        lost: m.lost,
+        duplicates: m.duplicates,
+        overall: MetricsRow::from_acc("all", &m.overall),
+        by_family: ds
+            .families
+            .iter()
+            .zip(&m.by_family)
+            .map(|(f, a)| MetricsRow::from_acc(f.clone(), a))
+            .collect(),
+        by_speed_band: BAND_GROUPS
+            .iter()
+            .zip(&m.by_band)
+            .filter(|(g, a)| **g != "other" || a.n > 0)
+            .map(|(g, a)| MetricsRow::from_acc(*g, a))
+            .collect(),
+        by_gt_action: Action::ALL
+            .iter()
+            .zip(&m.by_gt)
+            .map(|(g, a)| MetricsRow::from_acc(g.as_str(), a))
+            .collect(),
+        by_adversarial: ["not_adversarial", "adversarial"]
+            .iter()
+            .zip(&m.by_adv)
+            .map(|(g, a)| MetricsRow::from_acc(*g, a))
+            .collect(),
+    }
+}
+
+fn pooled_agg(models: &[&ModelAgg], ds: &Dataset) -> ModelAgg {
+    let mut p = ModelAgg::new("ALL".into(), &Dataset::default());
+    p.by_family = vec![Acc::default(); ds.families.len()];
+    for m in models {
+        p.overall.merge(&m.overall);
+        for (a, b) in p.by_family.iter_mut().zip(&m.by_family) {
+            a.merge(b);
+        }
+        for i in 0..5 {
+            p.by_band[i].merge(&m.by_band[i]);
+        }
+        for i in 0..3 {
+            p.by_gt[i].merge(&m.by_gt[i]);
+        }
+        for i in 0..2 {
+            p.by_adv[i].merge(&m.by_adv[i]);
+        }
+        p.lost += m.lost;
+        p.duplicates += m.duplicates;
+        p.reach.merge(&m.reach);
+        p.adv_decisions += m.adv_decisions;
+        p.adv_questions += m.adv_questions;
+    }
+    p
+}
+
+fn safety_breakdown(name: &str, m: &ModelAgg) -> SafetyBreakdown {
+    let dodge = &m.by_gt[Action::Dodge.index()];
+    let mistakes = m.overall.n - m.overall.saa;
+    // Freezing mistakes: NO_ACTION predicted where the GT was not NO_ACTION.
+    let freeze_mistakes = m.overall.predicted[2] - m.by_gt[Action::NoAction.index()].predicted[2];
+    SafetyBreakdown {
+        model: name.to_string(),
+        decisions: m.overall.n,
+        violations: m.overall.n - m.overall.safe,
+        first_rule: RuleCounts::new(m.overall.first),
+        rules_fired: RuleCounts::new(m.overall.fired),
+        unsafe_on_dodge_scenes: dodge.rate(dodge.n - dodge.safe),
+        mistakes,
+        freeze_mistakes,
+    }
+}
+
+/// Records of several models, for the pooled rows of record-based analyses.
+fn out_of_reach(
+    name: &str,
+    reach: &crate::aggregate::ReachAcc,
+    recs: &[&[Rec]],
+    ds: &Dataset,
+) -> OutOfReach {
+    let mut catch_d = Vec::new();
+    let mut any_d = Vec::new();
+    for r in recs {
+        for (rec, sc) in r.iter().zip(&ds.scenes) {
+            if rec.state != REC_SCORED || rec.d_end.is_nan() {
+                continue;
+            }
+            if rec.action as usize == sc.gt_action.index() {
+                any_d.push(rec.d_end as f64);
+                if sc.gt_action == Action::Catch {
+                    catch_d.push(rec.d_end as f64);
+                }
+            }
+        }
+    }
+    OutOfReach {
+        model: name.to_string(),
+        correct_catch: reach.correct_catch,
+        median_d_end_correct_catch: median(&mut catch_d),
+        median_d_end_correct_any: median(&mut any_d),
+        misses: reach.misses,
+        miss_share: ratio(reach.misses, reach.correct_catch),
+        misses_falling_short_share: ratio(reach.misses_short, reach.misses),
+        standing_far_share: ratio(reach.standing_far, reach.correct_catch),
+    }
+}
+
+fn speed_analysis(
+    name: &str,
+    recs: &[&[Rec]],
+    ds: &Dataset,
+    groups: &[[Option<u32>; 4]],
+) -> SpeedAnalysis {
+    let mut n_band = [0u64; 4];
+    let mut freeze = [0u64; 4];
+    let mut saa = [0u64; 4];
+    let mut decisions = 0;
+    for r in recs {
+        for (rec, sc) in r.iter().zip(&ds.scenes) {
+            let (Some(b), true, REC_SCORED) = (sc.speed_band, sc.speed_sweep, rec.state) else {
+                continue;
+            };
+            decisions += 1;
+            n_band[b as usize] += 1;
+            freeze[b as usize] += (rec.action == Action::NoAction.index() as u8) as u64;
+            saa[b as usize] += (rec.action as usize == sc.gt_action.index()) as u64;
+        }
+    }
+    let (mut complete, mut consistent, mut ends_agree) = (0u64, 0u64, 0u64);
+    for r in recs {
+        for g in groups {
+            let acts: Option<Vec<u8>> = g
+                .iter()
+                .map(|s| {
+                    s.and_then(|i| {
+                        let rec = r[i as usize];
+                        (rec.state == REC_SCORED).then_some(rec.action)
+                    })
+                })
+                .collect();
+            let Some(acts) = acts else { continue };
+            complete += 1;
+            consistent += acts.iter().all(|&a| a == acts[0]) as u64;
+            ends_agree += (acts[0] == acts[3]) as u64;
+        }
+    }
+    SpeedAnalysis {
+        model: name.to_string(),
+        decisions,
+        freeze_rate_by_band: (0..4).map(|b| ratio(freeze[b], n_band[b])).collect(),
+        saa_by_band: (0..4).map(|b| ratio(saa[b], n_band[b])).collect(),
+        complete_groups: complete,
+        consistent_groups: consistent,
+        consistency: ratio(consistent, complete),
+        slow_vs_very_fast_agreement: ratio(ends_agree, complete),
+    }
+}
+
+/// Scene groups of speed-sweeping families with their four band variants.
+fn speed_groups(ds: &Dataset) -> Vec<[Option<u32>; 4]> {
+    let mut map: HashMap<&str, [Option<u32>; 4]> = HashMap::new();
+    let mut order: Vec<&str> = Vec::new();
+    for (i, sc) in ds.scenes.iter().enumerate() {
+        let (Some(b), true) = (sc.speed_band, sc.speed_sweep) else {
+            continue;
+        };
+        let e = map.entry(sc.group_id.as_str()).or_insert_with(|| {
+            order.push(sc.group_id.as_str());
+            [None; 4]
+        });
+        e[b as usize].get_or_insert(i as u32);
+    }
+    order.into_iter().map(|g| map[g]).collect()
+}
+
+/// Majority vote: the most frequent action among the models' decisions on a scene;
+/// ties go to the safer action (DODGE, then NO_ACTION, then CATCH); "no parseable plan"
+/// votes never win. Unanimity: every model chose the same action.
+fn voting(models: &[&ModelAgg], ds: &Dataset) -> Voting {
+    let k = models.len();
+    let mut scenes = 0u64;
+    let (mut unanimous, mut unanimous_right, mut majority_right) = (0u64, 0u64, 0u64);
+    let mut per_model_right = vec![0u64; k];
+    if k >= 1 {
+        for (i, sc) in ds.scenes.iter().enumerate() {
+            if !models.iter().all(|m| m.records[i].state == REC_SCORED) {
+                continue;
+            }
+            scenes += 1;
+            let gt = sc.gt_action.index() as u8;
+            let mut votes = [0u32; 4];
+            for (j, m) in models.iter().enumerate() {
+                let a = m.records[i].action;
+                votes[a as usize] += 1;
+                per_model_right[j] += (a == gt) as u64;
+            }
+            let first = models[0].records[i].action;
+            if models.iter().all(|m| m.records[i].action == first) && first != ACT_NONE {
+                unanimous += 1;
+                unanimous_right += (first == gt) as u64;
+            }
+            // Tie order: DODGE(1), NO_ACTION(2), CATCH(0).
+            let mut best: Option<u8> = None;
+            for a in [1u8, 2, 0] {
+                if votes[a as usize] > 0
+                    && best.is_none_or(|b| votes[a as usize] > votes[b as usize])
+                {
+                    best = Some(a);
+                }
+            }
+            majority_right += (best == Some(gt)) as u64;
+        }
+    }
+    let best = per_model_right
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(&a.0)))
+        .map(|(j, &r)| (models[j].name.clone(), r));
+    Voting {
+        models: k,
+        scenes,
+        unanimous,
+        unanimous_share: ratio(unanimous, scenes),
+        unanimous_accuracy: ratio(unanimous_right, unanimous),
+        majority_vote_saa: ratio(majority_right, scenes),
+        mean_model_saa: (scenes > 0 && k > 0)
+            .then(|| per_model_right.iter().sum::<u64>() as f64 / (scenes as f64 * k as f64)),
+        best_model_saa: best.as_ref().and_then(|b| ratio(b.1, scenes)),
+        best_model: best.map(|b| b.0),
+    }
+}
+
+fn lookalikes(models: &[&ModelAgg], ds: &Dataset) -> Vec<LookalikeComparison> {
+    // object_id -> (decisions, catches, dodges)
+    let mut by_obj: HashMap<&str, (u64, u64, u64)> = HashMap::new();
+    for m in models {
+        for (rec, sc) in m.records.iter().zip(&ds.scenes) {
+            if rec.state != REC_SCORED {
+                continue;
+            }
+            let e = by_obj.entry(sc.object_id.as_str()).or_default();
+            e.0 += 1;
+            e.1 += (rec.action == 0) as u64;
+            e.2 += (rec.action == 1) as u64;
+        }
+    }
+    let mut pairs: Vec<(String, String)> = ds
+        .scenes
+        .iter()
+        .filter(|s| s.adversarial)
+        .filter_map(|s| s.looks_like.clone().map(|l| (s.object_id.clone(), l)))
+        .collect();
+    pairs.sort();
+    pairs.dedup();
+    pairs
+        .into_iter()
+        .map(|(obj, like)| {
+            let a = by_obj.get(obj.as_str()).copied().unwrap_or_default();
+            let b = by_obj.get(like.as_str()).copied().unwrap_or_default();
+            LookalikeComparison {
+                object_id: obj,
+                looks_like: like,
+                decisions: a.0,
+                catch_rate: ratio(a.1, a.0),
+                dodge_rate: ratio(a.2, a.0),
+                lookalike_decisions: b.0,
+                lookalike_catch_rate: ratio(b.1, b.0),
+                lookalike_dodge_rate: ratio(b.2, b.0),
+            }
+        })
+        .collect()
+}
+
+impl Report {
+    /// Builds the report at the end of a scoring run.
+    pub fn build(scoring: &Scoring, preds_file: &str) -> Report {
+        let ds = scoring.ds;
+        let cfg: &Config = scoring.cfg;
+        let mut models: Vec<&ModelAgg> = scoring.models.iter().collect();
+        models.sort_by(|a, b| a.name.cmp(&b.name));
+        let owned = models;
+        let pooled = pooled_agg(&owned, ds);
+        let all_recs: Vec<&[Rec]> = owned.iter().map(|m| m.records.as_slice()).collect();
+        let groups = speed_groups(ds);
+
+        let mut gt_actions = BTreeMap::new();
+        for a in Action::ALL {
+            gt_actions.insert(a.as_str().to_string(), 0u64);
+        }
+        for s in ds.scenes.iter().filter(|s| s.valid) {
+            *gt_actions
+                .get_mut(s.gt_action.as_str())
+                .expect("all actions") += 1;
+        }
+        let count = |f: &dyn Fn(&crate::dataset::Scene) -> bool| {
+            ds.scenes.iter().filter(|s| s.valid && f(s)).count() as u64
+        };
+
+        let mut analyses = Analyses {
+            safety: owned.iter().map(|m| safety_breakdown(&m.name, m)).collect(),
+            out_of_reach: owned
+                .iter()
+                .map(|m| out_of_reach(&m.name, &m.reach, &[m.records.as_slice()], ds))
+                .collect(),
+            speed: owned
+                .iter()
+                .map(|m| speed_analysis(&m.name, &[m.records.as_slice()], ds, &groups))
+                .collect(),
+            voting: voting(&owned, ds),
+            adversarial: owned
+                .iter()
+                .map(|m| AdversarialProbe {
+                    model: m.name.clone(),
+                    decisions: m.adv_decisions,
+                    questions_material: m.adv_questions,
+                    share: ratio(m.adv_questions, m.adv_decisions),
+                })
+                .collect(),
+            lookalikes: lookalikes(&owned, ds),
+        };
+        if owned.len() > 1 {
+            analyses.safety.push(safety_breakdown("ALL", &pooled));
+            analyses
+                .out_of_reach
+                .push(out_of_reach("ALL", &pooled.reach, &all_recs, ds));
+            analyses
+                .speed
+                .push(speed_analysis("ALL", &all_recs, ds, &groups));
+            analyses.adversarial.push(AdversarialProbe {
+                model: "ALL".into(),
+                decisions: pooled.adv_decisions,
+                questions_material: pooled.adv_questions,
+                share: ratio(pooled.adv_questions, pooled.adv_decisions),
+            });
+        }
+
+        Report {
+            tool: "rh-score".into(),
+            version: env!("CARGO_PKG_VERSION").into(),
+            action_rule: ActionRuleSummary {
+                version: cfg.action_rule.version.clone(),
+                reach_threshold: cfg.action_rule.reach_threshold,
+                retreat_threshold: cfg.action_rule.retreat_threshold,
+                move_threshold: cfg.action_rule.move_threshold,
+            },
+            dataset: DatasetSummary {
+                dir: ds.dir.display().to_string(),
+                scenes: ds.valid_scenes(),
+                invalid_scenes: ds.scenes.len() - ds.valid_scenes(),
+                families: ds.families.clone(),
+                gt_actions,
+                danger_present: count(&|s| s.danger_present),
+                dangerous: count(&|s| s.dangerous),
+                adversarial: count(&|s| s.adversarial),
+                with_impact_point: count(&|s| s.impact_point.is_some()),
+                duplicate_rows: ds.duplicate_rows,
+            },
+            input: InputSummary {
+                file: preds_file.to_string(),
+                lines: scoring.lines,
+                blank_lines: scoring.blank_lines,
+                decisions_scored: scoring.scored,
+                decisions_lost: scoring.lost,
+                duplicates: scoring.duplicates,
+                warnings: scoring
+                    .warnings
+                    .iter()
+                    .map(|(k, w): (&&str, &WarningAcc)| WarningSummary {
+                        kind: k.to_string(),
+                        count: w.count,
+                        first_lines: w.first_lines.clone(),
+                        examples: w.examples.clone(),
+                    })
+                    .collect(),
+            },
+            models: owned.iter().map(|m| model_report(m, ds)).collect(),
+            pooled: model_report(&pooled, ds),
+            analyses,
+        }
+    }
+}
+
+/// Display name of a speed band index.
+pub fn band_name(i: usize) -> &'static str {
+    SPEED_BANDS.get(i).copied().unwrap_or("other")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::baseline::{baseline_plan, majority_action, BaselineKind};
+    use crate::fixture::{dataset_of, synth_rows};
+
+    fn run(ds: &Dataset, kinds: &[BaselineKind], extra: &str) -> Report {
+        let cfg = Config::default();
+        let maj = majority_action(ds);
+        let mut text = String::new();
+        for &k in kinds {
+            for s in ds.scenes.iter().filter(|s| s.valid) {
+                let line = serde_json::json!({
+                    "scene_id": s.scene_id, "model": k.name(),
+                    "plan": baseline_plan(k, s, maj, 0, &cfg)});
+                text.push_str(&line.to_string());
+                text.push('\n');
+            }
+        }
+        text.push_str(extra);
+        let mut sc = Scoring::new(ds, &cfg);
+        sc.score_reader(std::io::Cursor::new(text.into_bytes()))
+            .unwrap();
+        Report::build(&sc, "mem")
+    }
+
+    #[test]
+    fn analyses_on_baselines() {
+        let ds = dataset_of(&synth_rows(160, 2));
+        let valid: Vec<_> = ds.scenes.iter().filter(|s| s.valid).collect();
+        let n = valid.len() as u64;
+        assert!(n < ds.scenes.len() as u64, "fixture has invalid scenes");
+        let r = run(
+            &ds,
+            &[
+                BaselineKind::Oracle,
+                BaselineKind::AlwaysCatch,
+                BaselineKind::Freeze,
+            ],
+            "",
+        );
+        assert_eq!(r.dataset.scenes as u64, n);
+        // Voting: oracle + one of the two fixed baselines always form the majority, and
+        // a three-way tie on DODGE scenes goes to DODGE.
+        let v = &r.analyses.voting;
+        assert_eq!(v.scenes, n);
+        assert_eq!(v.majority_vote_saa, Some(1.0));
+        assert_eq!(v.unanimous, 0);
+        assert_eq!(v.best_model.as_deref(), Some("oracle"));
+        // Fixed baselines answer the same at every band.
+        for s in &r.analyses.speed {
+            if s.model != "oracle" && s.model != "ALL" {
+                assert_eq!(s.consistency, Some(1.0), "{}", s.model);
+                assert!(s.complete_groups > 0);
+            }
+        }
+        let freeze = r
+            .analyses
+            .speed
+            .iter()
+            .find(|s| s.model == "freeze")
+            .unwrap();
+        assert!(freeze.freeze_rate_by_band.iter().all(|f| *f == Some(1.0)));
+        // Out of reach: always-catch is "correct" on every CATCH scene with an impact point.
+        let catch_scenes = valid
+            .iter()
+            .filter(|s| s.gt_action == Action::Catch && s.impact_point.is_some())
+            .count() as u64;
+        let oor = r
+            .analyses
+            .out_of_reach
+            .iter()
+            .find(|o| o.model == "always-catch")
+            .unwrap();
+        assert_eq!(oor.correct_catch, catch_scenes);
+        assert!(oor.median_d_end_correct_catch.unwrap() > 0.0);
+        let oracle = r
+            .analyses
+            .out_of_reach
+            .iter()
+            .find(|o| o.model == "oracle")
+            .unwrap();
+        assert!(oracle.median_d_end_correct_catch.unwrap() < 1e-6);
+        assert_eq!(oracle.misses, 0);
+        // Missing distances are counted, not averaged.
+        let no_impact = valid.iter().filter(|s| s.impact_point.is_none()).count() as u64;
+        for m in &r.models {
+            assert_eq!(m.overall.d_end_missing, no_impact);
+            assert_eq!(m.overall.d_end_n + m.overall.d_end_missing, n);
+        }
+        // Freezing mistakes.
+        let fr = r
+            .analyses
+            .safety
+            .iter()
+            .find(|s| s.model == "freeze")
+            .unwrap();
+        let not_no_action = valid
+            .iter()
+            .filter(|s| s.gt_action != Action::NoAction)
+            .count() as u64;
+        assert_eq!(fr.freeze_mistakes, not_no_action);
+        assert_eq!(fr.mistakes, not_no_action);
+    }
+
+    #[test]
+    fn adversarial_probe_counts_material_doubt() {
+        let ds = dataset_of(&synth_rows(80, 4));
+        let adv: Vec<_> = ds
+            .scenes
+            .iter()
+            .filter(|s| s.valid && s.adversarial)
+            .collect();
+        assert!(!adv.is_empty());
+        let mut extra = String::new();
+        for s in &adv {
+            let line = serde_json::json!({"scene_id": s.scene_id, "model": "doubter",
+                "response": "It looks like an anvil but might be foam. Plan: {\"intent\": \"It may be lighter than it looks; catch it\", \"walking_cmd\": [0,0,0], \"keyframes\": [[0.5,0,0]]}"});
+            extra.push_str(&line.to_string());
+            extra.push('\n');
+        }
+        let r = run(&ds, &[BaselineKind::Freeze], &extra);
+        let d = r
+            .analyses
+            .adversarial
+            .iter()
+            .find(|a| a.model == "doubter")
+            .unwrap();
+        assert_eq!(d.decisions, adv.len() as u64);
+        assert_eq!(d.share, Some(1.0));
+        let f = r
+            .analyses
+            .adversarial
+            .iter()
+            .find(|a| a.model == "freeze")
+            .unwrap();
+        assert_eq!(f.share, Some(0.0));
+        assert!(!r.analyses.lookalikes.is_empty());
+    }
+}

@@ -1,0 +1,239 @@
+//! The scoring run: stream the predictions, score each decision, fold into aggregates.
+
+use crate::aggregate::ModelAgg;
+use crate::aia::AiaMatcher;
+use crate::config::Config;
+use crate::dataset::Dataset;
+use crate::metrics::DecisionResult;
+use crate::preds::{process_line, LineOutcome, LineReader, RawLine};
+use crate::types::FastMap;
+use crate::types::InputError;
+use anyhow::Result;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::io::{BufRead, BufReader, Write};
+use std::path::Path;
+
+/// Lines per parallel batch.
+const BATCH_LINES: usize = 8192;
+/// Bytes per parallel batch (soft cap).
+const BATCH_BYTES: usize = 64 << 20;
+/// Line numbers and examples kept per warning kind.
+const KEEP_FIRST: usize = 5;
+
+/// Counted warnings of one kind.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct WarningAcc {
+    pub count: u64,
+    pub first_lines: Vec<u64>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub examples: Vec<String>,
+}
+
+/// The state of a scoring run.
+pub struct Scoring<'a> {
+    pub ds: &'a Dataset,
+    pub cfg: &'a Config,
+    pub aia: AiaMatcher,
+    pub models: Vec<ModelAgg>,
+    model_index: FastMap<String, usize>,
+    pub warnings: BTreeMap<&'static str, WarningAcc>,
+    pub lines: u64,
+    pub blank_lines: u64,
+    pub scored: u64,
+    pub lost: u64,
+    pub duplicates: u64,
+    decisions_out: Option<Box<dyn Write + 'a>>,
+}
+
+impl<'a> Scoring<'a> {
+    pub fn new(ds: &'a Dataset, cfg: &'a Config) -> Self {
+        Scoring {
+            ds,
+            cfg,
+            aia: AiaMatcher::new(&cfg.aia),
+            models: Vec::new(),
+            model_index: FastMap::default(),
+            warnings: BTreeMap::new(),
+            lines: 0,
+            blank_lines: 0,
+            scored: 0,
+            lost: 0,
+            duplicates: 0,
+            decisions_out: None,
+        }
+    }
+
+    /// Also write one JSON line per decision (scored, lost or duplicate) to `w`.
+    pub fn with_decisions_output(mut self, w: Box<dyn Write + 'a>) -> Self {
+        self.decisions_out = Some(w);
+        self
+    }
+
+    fn warn(&mut self, kind: &'static str, line: u64, example: Option<String>) {
+        let w = self.warnings.entry(kind).or_default();
+        w.count += 1;
+        if w.first_lines.len() < KEEP_FIRST {
+            w.first_lines.push(line);
+            if let Some(e) = example {
+                w.examples.push(e);
+            }
+        }
+    }
+
+    /// Scores a predictions file. An unreadable file is an input error.
+    pub fn score_path(&mut self, path: &Path) -> Result<()> {
+        let f = std::fs::File::open(path)
+            .map_err(|e| InputError(format!("cannot read predictions {}: {e}", path.display())))?;
+        if f.metadata().map(|m| m.is_dir()).unwrap_or(false) {
+            return Err(InputError(format!(
+                "predictions {} is a directory, expected a .jsonl file",
+                path.display()
+            ))
+            .into());
+        }
+        self.score_reader(BufReader::with_capacity(1 << 20, f))
+            .map_err(|e| match e.downcast::<std::io::Error>() {
+                Ok(io) => InputError(format!("error reading {}: {io}", path.display())).into(),
+                Err(e) => e,
+            })
+    }
+
+    /// Scores predictions from any reader, in parallel batches, folding in line order.
+    pub fn score_reader<R: BufRead + Send>(&mut self, r: R) -> Result<()> {
+        let mut reader = LineReader::new(r, self.cfg.sanity.max_line_bytes);
+        let read_batch = |reader: &mut LineReader<R>| -> std::io::Result<Vec<(u64, RawLine)>> {
+            let mut batch = Vec::with_capacity(BATCH_LINES);
+            let mut bytes = 0usize;
+            while batch.len() < BATCH_LINES && bytes < BATCH_BYTES {
+                match reader.next_line()? {
+                    Some((n, l)) => {
+                        bytes += match &l {
+                            RawLine::Line(b) => b.len(),
+                            RawLine::TooLong(_) => 0,
+                        };
+                        batch.push((n, l));
+                    }
+                    None => break,
+                }
+            }
+            Ok(batch)
+        };
+        let mut batch = read_batch(&mut reader)?;
+        while !batch.is_empty() {
+            let (ds, cfg, aia) = (self.ds, self.cfg, &self.aia);
+            let (outcomes, next) = rayon::join(
+                || {
+                    batch
+                        .par_iter()
+                        .map(|(n, l)| {
+                            let too_long = match l {
+                                RawLine::TooLong(len) => Some(*len),
+                                _ => None,
+                            };
+                            (*n, too_long, process_line(l, ds, cfg, aia))
+                        })
+                        .collect::<Vec<_>>()
+                },
+                || read_batch(&mut reader),
+            );
+            for (n, too_long, o) in outcomes {
+                self.fold(n, too_long, o)?;
+            }
+            batch = next?;
+        }
+        if let Some(w) = self.decisions_out.as_mut() {
+            w.flush()?;
+        }
+        Ok(())
+    }
+
+    fn fold(&mut self, line: u64, too_long: Option<u64>, o: LineOutcome) -> Result<()> {
+        self.lines += 1;
+        match o {
+            LineOutcome::Blank => self.blank_lines += 1,
+            LineOutcome::Skip { kind, detail } => {
+                let example = detail.or(too_long.map(|l| format!("{l} bytes")));
+                self.warn(kind, line, example);
+            }
+            LineOutcome::Decision {
+                scene,
+                model,
+                result,
+                notes,
+            } => {
+                for n in notes {
+                    self.warn(n, line, None);
+                }
+                let mi = match self.model_index.get(&model) {
+                    Some(&i) => i,
+                    None => {
+                        self.models.push(ModelAgg::new(model.clone(), self.ds));
+                        self.model_index
+                            .insert(model.clone(), self.models.len() - 1);
+                        self.models.len() - 1
+                    }
+                };
+                let sc = &self.ds.scenes[scene as usize];
+                let a = &self.cfg.analyses;
+                let m = &mut self.models[mi];
+                let lost_before = m.lost;
+                let counted = m.add(scene, sc, result.as_ref(), a.miss_radius, a.far_standing);
+                if !counted {
+                    self.duplicates += 1;
+                    self.warn(
+                        "duplicate_decision",
+                        line,
+                        Some(format!("{} / {model}", sc.scene_id)),
+                    );
+                } else if result.is_some() {
+                    self.scored += 1;
+                    if m.lost < lost_before {
+                        self.lost -= 1;
+                        self.warn("retry_after_error", line, None);
+                    }
+                } else {
+                    self.lost += 1;
+                }
+                if let Some(w) = self.decisions_out.as_mut() {
+                    let status = match (counted, &result) {
+                        (false, _) => "duplicate",
+                        (true, None) => "lost",
+                        (true, Some(_)) => "scored",
+                    };
+                    let rec = DecisionLine {
+                        line,
+                        scene_id: &sc.scene_id,
+                        model: &model,
+                        status,
+                        gt_action: sc.gt_action.as_str(),
+                        rules: result.as_ref().map_or_else(Vec::new, |r| {
+                            crate::types::Rule::ALL
+                                .into_iter()
+                                .filter(|&x| r.fired(x))
+                                .map(|x| x.as_str())
+                                .collect()
+                        }),
+                        result: result.as_ref(),
+                    };
+                    serde_json::to_writer(&mut *w, &rec)?;
+                    w.write_all(b"\n")?;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[derive(Serialize)]
+struct DecisionLine<'a> {
+    line: u64,
+    scene_id: &'a str,
+    model: &'a str,
+    status: &'static str,
+    gt_action: &'static str,
+    rules: Vec<&'static str>,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    result: Option<&'a DecisionResult>,
+}
