@@ -174,3 +174,150 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labe
         strike_speed,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Config;
+    use crate::randomize::{randomize, SceneKey};
+    use crate::simulate::{BodyState, TOUCH_FLOOR};
+    use crate::spec::Selection;
+    use rh_catalog::Catalog;
+
+    /// A real spec (thrown apple) whose observer stands at the origin facing +x.
+    fn spec(object: &str) -> SceneSpec {
+        let catalog = Catalog::embedded().unwrap();
+        let config = Config::embedded().unwrap();
+        let selection = Selection {
+            family: "thrown_object".into(),
+            object_id: object.into(),
+            room_id: "kitchen".into(),
+            description: None,
+        };
+        let mut spec = randomize(&selection, &SceneKey::new(0, 1, 0), &catalog, &config).unwrap();
+        spec.observer.x = 0.0;
+        spec.observer.y = 0.0;
+        spec
+    }
+
+    /// A one-body simulation following `path(t)` (velocity by finite differences).
+    fn synthetic(spec: &SceneSpec, steps: u32, path: impl Fn(f64) -> [f64; 3]) -> Simulation {
+        let dt = spec.physics.dt;
+        let mut sim = Simulation {
+            dt,
+            dynamic_bodies: vec![spec.hazard],
+            states: vec![],
+            hazard_slot: 0,
+            hazard_lowest_z: vec![],
+            hazard_contacts: vec![],
+            energy: vec![],
+            initial_penetration: 0.0,
+            strike: None,
+            state_hash: String::new(),
+        };
+        let r = 0.04;
+        for k in 0..=steps {
+            let t = k as f64 * dt;
+            let p = path(t);
+            let q = path(t + dt);
+            let v = [(q[0] - p[0]) / dt, (q[1] - p[1]) / dt, (q[2] - p[2]) / dt];
+            sim.states.push(BodyState {
+                position: p.map(|c| c as f32),
+                rotation: [0.0, 0.0, 0.0, 1.0],
+                linvel: v.map(|c| c as f32),
+                angvel: [0.0; 3],
+            });
+            sim.hazard_lowest_z.push(p[2] - r);
+            sim.hazard_contacts.push(if p[2] - r <= 0.005 { TOUCH_FLOOR } else { 0 });
+            sim.energy.push(0.0);
+        }
+        sim
+    }
+
+    fn falling_at(x: f64) -> impl Fn(f64) -> [f64; 3] {
+        move |t| [x, 0.0, (2.0 - 0.5 * 9.81 * t * t).max(0.04)]
+    }
+
+    #[test]
+    fn reach_plane_crossing_is_interpolated() {
+        let s = spec("apple");
+        let sim = synthetic(&s, 240, falling_at(0.5));
+        let l = label(&s, &sim, None);
+        assert_eq!(l.impact_kind, Some(ImpactKind::ReachPlane));
+        let p = l.impact_point.unwrap();
+        assert!((p[2] - s.labels.reach_plane_z).abs() < 1e-9);
+        // Free fall from 2 m to 0.9 m: t = sqrt(2·1.1/g).
+        let t = (2.0 * 1.1 / 9.81f64).sqrt();
+        assert!((l.time_to_impact.unwrap() - t).abs() < 2.0 * s.physics.dt);
+        assert!((l.impact_speed.unwrap() - 9.81 * t).abs() < 0.1);
+    }
+
+    #[test]
+    fn benign_reachable_object_is_caught_and_far_one_is_no_action() {
+        let s = spec("apple");
+        let near = label(&s, &synthetic(&s, 240, falling_at(0.5)), None);
+        assert!(near.reachable && !near.dangerous && !near.danger_present);
+        assert_eq!(near.gt_action, Action::Catch);
+        let far = label(&s, &synthetic(&s, 240, falling_at(3.0)), None);
+        assert!(!far.reachable);
+        assert_eq!(far.gt_action, Action::NoAction);
+    }
+
+    #[test]
+    fn dangerous_or_fast_objects_are_dodged() {
+        // Sharp.
+        let knife = spec("chef_knife");
+        let l = label(&knife, &synthetic(&knife, 240, falling_at(0.5)), None);
+        assert!(l.dangerous && l.danger_reasons.contains(&"sharp".to_string()));
+        assert_eq!(l.gt_action, Action::Dodge);
+        // Heavy by mass (a steel apple looks like an apple).
+        let steel = spec("steel_apple");
+        let l = label(&steel, &synthetic(&steel, 240, falling_at(0.5)), None);
+        assert!(l.danger_reasons.contains(&"heavy_mass".to_string()));
+        assert_eq!(l.gt_action, Action::Dodge);
+        // Too fast to catch: a benign apple arriving at 12 m/s.
+        let apple = spec("apple");
+        let l = label(&apple, &synthetic(&apple, 120, |t| [0.5, 3.0 - 12.0 * t, 1.0]), None);
+        assert!(!l.dangerous);
+        assert!(l.impact_speed.unwrap() > apple.labels.catch_speed_max);
+        assert_eq!(l.gt_action, Action::Dodge);
+    }
+
+    #[test]
+    fn closest_approach_is_used_when_the_reach_plane_is_never_crossed() {
+        let s = spec("apple");
+        // Rolling along the floor, passing 0.4 m from the observer.
+        let sim = synthetic(&s, 480, |t| [2.0 - 1.0 * t, 0.4, 0.04]);
+        let l = label(&s, &sim, None);
+        assert_eq!(l.impact_kind, Some(ImpactKind::ClosestApproach));
+        let p = l.impact_point.unwrap();
+        assert!(p[0].abs() < 0.01 && (p[1] - 0.4).abs() < 1e-6);
+        assert!((l.closest_approach - 0.4).abs() < 1e-3);
+        // Never within 1.5 m: no impact point at all.
+        let sim = synthetic(&s, 480, |t| [2.0 - 1.0 * t, 2.0, 0.04]);
+        let l = label(&s, &sim, None);
+        assert_eq!(l.impact_point, None);
+        assert_eq!(l.gt_action, Action::NoAction);
+    }
+
+    #[test]
+    fn strike_in_the_counterfactual_sets_danger_present() {
+        let s = spec("apple");
+        let sim = synthetic(&s, 240, falling_at(3.0));
+        let fast = label(&s, &sim, Some(Strike { step: 10, speed: 3.0 }));
+        assert!(fast.danger_present && fast.reachable);
+        assert_ne!(fast.gt_action, Action::NoAction);
+        let gentle = label(&s, &sim, Some(Strike { step: 10, speed: 0.1 }));
+        assert!(!gentle.danger_present);
+    }
+
+    #[test]
+    fn time_to_floor_is_refined_within_the_step() {
+        let s = spec("apple");
+        let sim = synthetic(&s, 240, falling_at(0.5));
+        // The lowest point (centre − 4 cm) falls 1.96 m.
+        let expected = (2.0 * 1.96 / 9.81f64).sqrt();
+        let measured = time_to_floor(&sim, 9.81).unwrap();
+        assert!((measured - expected).abs() / expected < 0.005, "{measured} vs {expected}");
+    }
+}
