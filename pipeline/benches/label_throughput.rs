@@ -28,7 +28,8 @@ fn main() {
             .into_par_iter()
             .map(|g| {
                 let selection = plan_group(&catalog, &families, seed, g).expect("plan");
-                let results = produce_group(&selection, seed, g * 4, 4, &catalog, &config).expect("produce");
+                let results =
+                    produce_group(&selection, seed, g * 4, 4, &catalog, &config).expect("produce");
                 let steps: u64 = results.iter().map(|r| r.steps as u64).sum();
                 let attempts: u64 = results.iter().map(|r| r.spec.attempt as u64).sum();
                 (results.len() as u64, steps, attempts)
@@ -39,7 +40,13 @@ fn main() {
     // Warm-up (page faults, allocator), then the measured run on a different seed.
     run(1);
     let (scenes, steps, attempts, secs) = run(2);
-    println!("label throughput: {scenes} scenes in {secs:.3} s on {threads} threads = {:.1} scenes/s", scenes as f64 / secs);
-    println!("  mean simulated steps per scene: {:.0}; resampling attempts beyond the first: {attempts}", steps as f64 / scenes as f64);
+    println!(
+        "label throughput: {scenes} scenes in {secs:.3} s on {threads} threads = {:.1} scenes/s",
+        scenes as f64 / secs
+    );
+    println!(
+        "  mean simulated steps per scene: {:.0}; resampling attempts beyond the first: {attempts}",
+        steps as f64 / scenes as f64
+    );
     println!("  families: {}", families.join(", "));
 }

@@ -228,7 +228,8 @@ mod tests {
                 angvel: [0.0; 3],
             });
             sim.hazard_lowest_z.push(p[2] - r);
-            sim.hazard_contacts.push(if p[2] - r <= 0.005 { TOUCH_FLOOR } else { 0 });
+            sim.hazard_contacts
+                .push(if p[2] - r <= 0.005 { TOUCH_FLOOR } else { 0 });
             sim.energy.push(0.0);
         }
         sim
@@ -277,7 +278,11 @@ mod tests {
         assert_eq!(l.gt_action, Action::Dodge);
         // Too fast to catch: a benign apple arriving at 12 m/s.
         let apple = spec("apple");
-        let l = label(&apple, &synthetic(&apple, 120, |t| [0.5, 3.0 - 12.0 * t, 1.0]), None);
+        let l = label(
+            &apple,
+            &synthetic(&apple, 120, |t| [0.5, 3.0 - 12.0 * t, 1.0]),
+            None,
+        );
         assert!(!l.dangerous);
         assert!(l.impact_speed.unwrap() > apple.labels.catch_speed_max);
         assert_eq!(l.gt_action, Action::Dodge);
@@ -304,10 +309,24 @@ mod tests {
     fn strike_in_the_counterfactual_sets_danger_present() {
         let s = spec("apple");
         let sim = synthetic(&s, 240, falling_at(3.0));
-        let fast = label(&s, &sim, Some(Strike { step: 10, speed: 3.0 }));
+        let fast = label(
+            &s,
+            &sim,
+            Some(Strike {
+                step: 10,
+                speed: 3.0,
+            }),
+        );
         assert!(fast.danger_present && fast.reachable);
         assert_ne!(fast.gt_action, Action::NoAction);
-        let gentle = label(&s, &sim, Some(Strike { step: 10, speed: 0.1 }));
+        let gentle = label(
+            &s,
+            &sim,
+            Some(Strike {
+                step: 10,
+                speed: 0.1,
+            }),
+        );
         assert!(!gentle.danger_present);
     }
 
@@ -318,6 +337,9 @@ mod tests {
         // The lowest point (centre − 4 cm) falls 1.96 m.
         let expected = (2.0 * 1.96 / 9.81f64).sqrt();
         let measured = time_to_floor(&sim, 9.81).unwrap();
-        assert!((measured - expected).abs() / expected < 0.005, "{measured} vs {expected}");
+        assert!(
+            (measured - expected).abs() / expected < 0.005,
+            "{measured} vs {expected}"
+        );
     }
 }

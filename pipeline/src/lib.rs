@@ -6,6 +6,7 @@
 //! `simulate::simulate`, `label::label`; `scene::produce_group` chains them for one
 //! scene group, and `build::build` runs the groups in parallel.
 
+pub mod balance;
 pub mod build;
 pub mod cameras;
 pub mod cli;

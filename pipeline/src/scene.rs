@@ -32,7 +32,13 @@ pub fn run_scene(mut spec: SceneSpec, config: &Config) -> SceneResult {
     spec.cameras = framed.unwrap_or_default();
     let verdicts = validate(&spec, &sim, family, &config.validators, in_frame);
     let strike = if may_touch_observer(&spec, &sim) {
-        simulate(&spec, SimOptions { observer_collider: true }).strike
+        simulate(
+            &spec,
+            SimOptions {
+                observer_collider: true,
+            },
+        )
+        .strike
     } else {
         None
     };
@@ -60,7 +66,8 @@ pub fn may_touch_observer(spec: &SceneSpec, sim: &Simulation) -> bool {
     let o = &spec.observer;
     sim.dynamic_bodies.iter().enumerate().any(|(slot, &body)| {
         let reach = spec.bodies[body].bounding_radius() + o.torso_radius + OBSERVER_CLEARANCE;
-        (0..=sim.steps()).any(|k| o.torso_axis_distance(sim.state(k, slot).position.map(f64::from)) <= reach)
+        (0..=sim.steps())
+            .any(|k| o.torso_axis_distance(sim.state(k, slot).position.map(f64::from)) <= reach)
     })
 }
 

@@ -99,7 +99,8 @@ impl Simulation {
             return None;
         }
         (1..=self.steps()).find(|&k| {
-            self.hazard_lowest_z[k as usize] <= FLOOR_EPS && self.hazard_contacts[k as usize] & TOUCH_FLOOR != 0
+            self.hazard_lowest_z[k as usize] <= FLOOR_EPS
+                && self.hazard_contacts[k as usize] & TOUCH_FLOOR != 0
         })
     }
 }

@@ -135,8 +135,14 @@ impl ShapeSpec {
         match *self {
             ShapeSpec::Box { half_extents: h } => (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt(),
             ShapeSpec::Sphere { radius } => radius,
-            ShapeSpec::Cylinder { half_height, radius } => (half_height * half_height + radius * radius).sqrt(),
-            ShapeSpec::Capsule { half_height, radius } => half_height + radius,
+            ShapeSpec::Cylinder {
+                half_height,
+                radius,
+            } => (half_height * half_height + radius * radius).sqrt(),
+            ShapeSpec::Capsule {
+                half_height,
+                radius,
+            } => half_height + radius,
         }
     }
 }

@@ -37,7 +37,12 @@ fn ceiling_drop_time_to_floor_matches_free_fall() {
     let results = scenes("ceiling_drop", 6, 3);
     assert_eq!(results.len(), 24);
     for r in &results {
-        assert!(r.verdicts.all(), "{} invalid: {:?}", r.spec.scene_id, r.verdicts.failures());
+        assert!(
+            r.verdicts.all(),
+            "{} invalid: {:?}",
+            r.spec.scene_id,
+            r.verdicts.failures()
+        );
         // The fixture is released from rest (plus the band's downward speed) without
         // spin and falls clear: its lowest point drops `drop_height_m`.
         let h = r.spec.family_params["drop_height_m"];
@@ -45,7 +50,12 @@ fn ceiling_drop_time_to_floor_matches_free_fall() {
         let expected = (-v0 + (v0 * v0 + 2.0 * G * h).sqrt()) / G;
         let measured = r.labels.time_to_floor.expect("reaches the floor");
         let err = (measured - expected).abs() / expected;
-        assert!(err < 0.01, "{}: time_to_floor {measured:.4} vs closed form {expected:.4} ({:.2}%)", r.spec.scene_id, err * 100.0);
+        assert!(
+            err < 0.01,
+            "{}: time_to_floor {measured:.4} vs closed form {expected:.4} ({:.2}%)",
+            r.spec.scene_id,
+            err * 100.0
+        );
     }
 }
 
@@ -54,11 +64,19 @@ fn object_drop_falls_ballistically_once_clear_of_the_table() {
     let results = scenes("object_drop", 10, 5);
     let mut clear_falls = 0;
     for r in &results {
-        assert!(r.verdicts.all(), "{} invalid: {:?}", r.spec.scene_id, r.verdicts.failures());
+        assert!(
+            r.verdicts.all(),
+            "{} invalid: {:?}",
+            r.spec.scene_id,
+            r.verdicts.failures()
+        );
         let sim = plain(r);
         let floor = sim.time_to_floor_step().expect("reaches the floor");
         // Release: the step after the last contact with the table before the floor.
-        let Some(last_table) = (0..floor).rev().find(|&k| sim.hazard_contacts[k as usize] & TOUCH_SOURCE != 0) else {
+        let Some(last_table) = (0..floor)
+            .rev()
+            .find(|&k| sim.hazard_contacts[k as usize] & TOUCH_SOURCE != 0)
+        else {
             continue;
         };
         let release = last_table + 1;
@@ -73,7 +91,11 @@ fn object_drop_falls_ballistically_once_clear_of_the_table() {
             let t = (k - release) as f64 * sim.dt;
             let expected = z_r + v_r * t - 0.5 * G * t * t;
             let z = sim.hazard_position(k)[2];
-            assert!((z - expected).abs() < 0.01 * drop.max(0.05), "{}: step {k} z {z:.4} vs {expected:.4}", r.spec.scene_id);
+            assert!(
+                (z - expected).abs() < 0.01 * drop.max(0.05),
+                "{}: step {k} z {z:.4} vs {expected:.4}",
+                r.spec.scene_id
+            );
         }
         // "Falls clear": the body hardly turns in flight, so its lowest point falls like its
         // centre and time_to_floor has a closed form from the release height.
@@ -84,10 +106,17 @@ fn object_drop_falls_ballistically_once_clear_of_the_table() {
         let h = sim.hazard_lowest_z[release as usize];
         let expected = release as f64 * sim.dt + (v_r + (v_r * v_r + 2.0 * G * h).sqrt()) / G;
         let measured = r.labels.time_to_floor.unwrap();
-        assert!((measured - expected).abs() / expected < 0.01, "{}: {measured} vs {expected}", r.spec.scene_id);
+        assert!(
+            (measured - expected).abs() / expected < 0.01,
+            "{}: {measured} vs {expected}",
+            r.spec.scene_id
+        );
         clear_falls += 1;
     }
-    assert!(clear_falls >= 3, "only {clear_falls} object_drop scenes fell clear; the check needs examples");
+    assert!(
+        clear_falls >= 3,
+        "only {clear_falls} object_drop scenes fell clear; the check needs examples"
+    );
 }
 
 #[test]
@@ -95,14 +124,26 @@ fn ramp_sliding_acceleration_matches_incline_formula() {
     let results = scenes("sliding_object", 8, 7);
     let mut checked = 0;
     for r in &results {
-        assert!(r.verdicts.all(), "{} invalid: {:?}", r.spec.scene_id, r.verdicts.failures());
+        assert!(
+            r.verdicts.all(),
+            "{} invalid: {:?}",
+            r.spec.scene_id,
+            r.verdicts.failures()
+        );
         let body = r.spec.hazard_body();
-        if !body.parts.iter().all(|p| matches!(p.shape, ShapeSpec::Box { .. })) {
+        if !body
+            .parts
+            .iter()
+            .all(|p| matches!(p.shape, ShapeSpec::Box { .. }))
+        {
             continue; // upright cylinders slide too, but the formula below is for boxes
         }
         let theta = r.spec.family_params["ramp_angle_rad"];
         let mu = r.spec.family_params["mu_effective"];
-        assert!(theta.tan() > mu, "ramp angle must be above the friction cone");
+        assert!(
+            theta.tan() > mu,
+            "ramp angle must be above the friction cone"
+        );
         let expected = G * (theta.sin() - mu * theta.cos());
         let sim = plain(r);
         let ramp = &r.spec.bodies[r.spec.source_support.unwrap()];
@@ -110,12 +151,16 @@ fn ramp_sliding_acceleration_matches_incline_formula() {
         // Sliding phase: on the ramp only, after a short settling of the contact, and
         // while the whole footprint is still on the incline (past that the front
         // overhangs the lower end and the box pivots over it).
-        let ShapeSpec::Box { half_extents } = body.parts[0].shape else { unreachable!() };
+        let ShapeSpec::Box { half_extents } = body.parts[0].shape else {
+            unreachable!()
+        };
         let on_ramp = r.spec.family_params["slide_distance_m"] - half_extents[0];
         let p0 = sim.hazard_position(0);
         let along = |k: u32| {
             let p = sim.hazard_position(k);
-            (p[0] - p0[0]) * downhill[0] + (p[1] - p0[1]) * downhill[1] + (p[2] - p0[2]) * downhill[2]
+            (p[0] - p0[0]) * downhill[0]
+                + (p[1] - p0[1]) * downhill[1]
+                + (p[2] - p0[2]) * downhill[2]
         };
         let steps: Vec<u32> = (12..=sim.steps())
             .take_while(|&k| sim.hazard_contacts[k as usize] == TOUCH_SOURCE && along(k) < on_ramp)
@@ -126,12 +171,22 @@ fn ramp_sliding_acceleration_matches_incline_formula() {
             .iter()
             .map(|&k| {
                 let p = sim.hazard_position(k);
-                (k as f64 * sim.dt, p[0] * downhill[0] + p[1] * downhill[1] + p[2] * downhill[2])
+                (
+                    k as f64 * sim.dt,
+                    p[0] * downhill[0] + p[1] * downhill[1] + p[2] * downhill[2],
+                )
             })
             .collect();
         let a = fit_quadratic(&s) * 2.0;
         let err = (a - expected).abs() / expected;
-        assert!(err < 0.03, "{} ({}, {} m/s): a {a:.4} vs g(sinθ−μcosθ) {expected:.4} ({:.2}%)", r.spec.scene_id, r.spec.selection.object_id, r.spec.speed_value, err * 100.0);
+        assert!(
+            err < 0.03,
+            "{} ({}, {} m/s): a {a:.4} vs g(sinθ−μcosθ) {expected:.4} ({:.2}%)",
+            r.spec.scene_id,
+            r.spec.selection.object_id,
+            r.spec.speed_value,
+            err * 100.0
+        );
         checked += 1;
     }
     assert!(checked >= 8, "only {checked} box slides checked");
@@ -155,7 +210,8 @@ fn fit_quadratic(points: &[(f64, f64)]) -> f64 {
         }
     }
     let det = |m: [[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
             + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
     };
     let mut m2 = m;
@@ -170,7 +226,12 @@ fn thrown_object_apex_and_range_are_ballistic() {
     let results = scenes("thrown_object", 8, 11);
     let mut apexes = 0;
     for r in &results {
-        assert!(r.verdicts.all(), "{} invalid: {:?}", r.spec.scene_id, r.verdicts.failures());
+        assert!(
+            r.verdicts.all(),
+            "{} invalid: {:?}",
+            r.spec.scene_id,
+            r.verdicts.failures()
+        );
         let sim = plain(r);
         let contact = sim.first_contact_step().expect("lands somewhere");
         let p0 = r.spec.hazard_body().position;
@@ -180,10 +241,16 @@ fn thrown_object_apex_and_range_are_ballistic() {
         let p = sim.hazard_position(contact);
         let range = ((p[0] - p0[0]).powi(2) + (p[1] - p0[1]).powi(2)).sqrt();
         let expected_range = (v0[0] * v0[0] + v0[1] * v0[1]).sqrt() * t;
-        assert!((range - expected_range).abs() / expected_range < 0.02, "{}: range {range} vs {expected_range}", r.spec.scene_id);
+        assert!(
+            (range - expected_range).abs() / expected_range < 0.02,
+            "{}: range {range} vs {expected_range}",
+            r.spec.scene_id
+        );
         // Apex: z0 + vz²/2g when thrown upward.
         if v0[2] > 0.5 {
-            let apex = (0..contact).map(|k| sim.hazard_position(k)[2]).fold(f64::MIN, f64::max);
+            let apex = (0..contact)
+                .map(|k| sim.hazard_position(k)[2])
+                .fold(f64::MIN, f64::max);
             let expected_apex = p0[2] + v0[2] * v0[2] / (2.0 * G);
             // 2% of the rise, but never below the integrator's own resolution: a fixed
             // step moves the apex by up to half a step's travel (v_z·dt/2).
@@ -204,7 +271,9 @@ fn thrown_object_apex_and_range_are_ballistic() {
 fn twin_labels(family: &str, real: &str, twin: &str) -> Option<(SceneResult, SceneResult)> {
     let (catalog, config) = setup();
     for seed in 0..40u64 {
-        let room = plan_group(&catalog, &[family.to_string()], seed, 0).unwrap().room_id;
+        let room = plan_group(&catalog, &[family.to_string()], seed, 0)
+            .unwrap()
+            .room_id;
         let pick = |object: &str| {
             let selection = Selection {
                 family: family.into(),
@@ -213,12 +282,21 @@ fn twin_labels(family: &str, real: &str, twin: &str) -> Option<(SceneResult, Sce
                 description: None,
             };
             // The normal band of group 0.
-            produce_group(&selection, seed, 0, 2, &catalog, &config).unwrap().remove(1)
+            produce_group(&selection, seed, 0, 2, &catalog, &config)
+                .unwrap()
+                .remove(1)
         };
         let (a, b) = (pick(real), pick(twin));
         // Same layout, same look: only the physics (mass, flags) differs.
-        let light = if a.spec.hazard_body().mass < b.spec.hazard_body().mass { &a } else { &b };
-        if a.spec.attempt == b.spec.attempt && light.labels.reachable && light.labels.gt_action == Action::Catch {
+        let light = if a.spec.hazard_body().mass < b.spec.hazard_body().mass {
+            &a
+        } else {
+            &b
+        };
+        if a.spec.attempt == b.spec.attempt
+            && light.labels.reachable
+            && light.labels.gt_action == Action::Catch
+        {
             return Some((a, b));
         }
     }
@@ -232,15 +310,27 @@ fn labels_follow_physics_not_appearance() {
     let anvil = catalog.object("anvil").unwrap();
     let foam = catalog.object("foam_anvil").unwrap();
     assert_eq!(catalog.appearance_source(foam).appearance, anvil.appearance);
-    let (real, twin) = twin_labels("object_drop", "anvil", "foam_anvil").expect("a reachable layout");
-    assert_eq!(real.spec.hazard_body().parts, twin.spec.hazard_body().parts, "twins share their shape");
+    let (real, twin) =
+        twin_labels("object_drop", "anvil", "foam_anvil").expect("a reachable layout");
+    assert_eq!(
+        real.spec.hazard_body().parts,
+        twin.spec.hazard_body().parts,
+        "twins share their shape"
+    );
     assert_eq!(real.labels.gt_action, Action::Dodge);
-    assert!(real.labels.dangerous && real.labels.danger_reasons.contains(&"heavy_mass".to_string()));
+    assert!(
+        real.labels.dangerous
+            && real
+                .labels
+                .danger_reasons
+                .contains(&"heavy_mass".to_string())
+    );
     assert_eq!(twin.labels.gt_action, Action::Catch);
     assert!(!twin.labels.dangerous);
 
     // A steel twin of a light object is dangerous; the real apple is caught.
-    let (apple, steel) = twin_labels("thrown_object", "apple", "steel_apple").expect("a reachable layout");
+    let (apple, steel) =
+        twin_labels("thrown_object", "apple", "steel_apple").expect("a reachable layout");
     assert_eq!(apple.labels.gt_action, Action::Catch);
     assert!(!apple.labels.dangerous);
     assert_eq!(steel.labels.gt_action, Action::Dodge);
@@ -255,7 +345,10 @@ fn replay_is_identical_across_runs_and_thread_counts() {
         .chain(scenes("object_drop", 2, 1))
         .collect::<Vec<_>>();
     let hashes_with = |threads: usize| -> Vec<String> {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             use rayon::prelude::*;
             results.par_iter().map(|r| plain(r).state_hash).collect()
@@ -278,11 +371,24 @@ fn counterfactual_strike_matches_a_full_counterfactual_run() {
     let (_, config) = setup();
     for family in ["thrown_object", "ceiling_drop", "rolling_ball"] {
         for r in scenes(family, 3, 21) {
-            let full = simulate(&r.spec, SimOptions { observer_collider: true });
+            let full = simulate(
+                &r.spec,
+                SimOptions {
+                    observer_collider: true,
+                },
+            );
             let rerun = run_scene(r.spec.clone(), &config);
-            assert_eq!(rerun.labels.strike_speed, full.strike.map(|s| s.speed), "{}", r.spec.scene_id);
+            assert_eq!(
+                rerun.labels.strike_speed,
+                full.strike.map(|s| s.speed),
+                "{}",
+                r.spec.scene_id
+            );
             // Floor contacts happen in every scene's plain run.
-            assert!(plain(&r).hazard_contacts.iter().any(|c| c & TOUCH_FLOOR != 0));
+            assert!(plain(&r)
+                .hazard_contacts
+                .iter()
+                .any(|c| c & TOUCH_FLOOR != 0));
         }
     }
 }

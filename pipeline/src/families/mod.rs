@@ -8,20 +8,34 @@
 
 use crate::simulate::Simulation;
 use crate::spec::{
-    quat, BodyKind, BodyRole, BodySpec, JointSpec, PartSpec, Quat, SceneSpec, ShapeSpec, Vec3,
-    IDENTITY,
+    quat, BodyKind, BodyRole, BodySpec, JointKind, JointSpec, PartSpec, Quat, SceneSpec, ShapeSpec,
+    Vec3, IDENTITY,
 };
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use rh_catalog::{Object, Room, ShapeKind};
 use std::collections::BTreeMap;
 
-mod ceiling_drop;
-mod object_drop;
-mod rolling_ball;
-mod shelf_slide;
-mod sliding_object;
-mod thrown_object;
+pub mod bouncing_object;
+pub mod ceiling_drop;
+pub mod chain_reaction;
+pub mod door_swing;
+pub mod furniture_tip;
+pub mod hanging_fall;
+pub mod ladder_slip;
+pub mod multi_object;
+pub mod object_drop;
+pub mod pendulum_swing;
+pub mod rolling_ball;
+pub mod shelf_slide;
+pub mod sliding_object;
+pub mod stack_collapse;
+pub mod stair_tumble;
+pub mod surface_cascade;
+pub mod thrown_object;
+
+pub use door_swing::hinge_inertia;
+pub use ladder_slip::required_floor_friction;
 
 pub const GRAVITY: f64 = 9.81;
 
@@ -76,10 +90,21 @@ pub fn all() -> Vec<&'static dyn Family> {
     vec![
         &object_drop::ObjectDrop,
         &shelf_slide::ShelfSlide,
+        &hanging_fall::HangingFall,
         &ceiling_drop::CeilingDrop,
         &sliding_object::SlidingObject,
         &rolling_ball::RollingBall,
+        &surface_cascade::SurfaceCascade,
+        &furniture_tip::FurnitureTip,
+        &stack_collapse::StackCollapse,
+        &ladder_slip::LadderSlip,
+        &door_swing::DoorSwing,
+        &pendulum_swing::PendulumSwing,
         &thrown_object::ThrownObject,
+        &bouncing_object::BouncingObject,
+        &stair_tumble::StairTumble,
+        &chain_reaction::ChainReaction,
+        &multi_object::MultiObject,
     ]
 }
 
@@ -250,6 +275,230 @@ pub fn event_origin(rng: &mut ChaCha8Rng, room: &Room, dir: [f64; 2], back: f64)
     ]
 }
 
+/// Distance from the object's origin up to its highest point, unrotated.
+pub fn top_offset(object: &Object) -> f64 {
+    object
+        .parts
+        .iter()
+        .map(|p| p.half_extents()[2] + p.offset[2])
+        .fold(0.0, f64::max)
+}
+
+/// Centre of mass in the object frame: the simulator spreads a body's mass over its
+/// parts by volume, so this is the volume-weighted mean of the part centres.
+pub fn com_offset(object: &Object) -> Vec3 {
+    let total: f64 = object.parts.iter().map(|p| p.volume()).sum();
+    let mut c = [0.0; 3];
+    for p in &object.parts {
+        let w = p.volume() / total;
+        for (k, ck) in c.iter_mut().enumerate() {
+            *ck += w * p.offset[k];
+        }
+    }
+    c
+}
+
+/// Floor-plane point `p + dir * d`.
+pub fn ahead(p: [f64; 2], dir: [f64; 2], d: f64) -> [f64; 2] {
+    [p[0] + dir[0] * d, p[1] + dir[1] * d]
+}
+
+/// The horizontal unit vector 90° counter-clockwise of `dir` (`ẑ × dir`).
+pub fn left_of(dir: [f64; 2]) -> [f64; 2] {
+    [-dir[1], dir[0]]
+}
+
+pub fn cross3(a: Vec3, b: Vec3) -> Vec3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Velocity of the point `p` of a body spinning with `omega` about the fixed point `pivot`.
+pub fn velocity_about(omega: Vec3, pivot: Vec3, p: Vec3) -> Vec3 {
+    cross3(omega, [p[0] - pivot[0], p[1] - pivot[1], p[2] - pivot[2]])
+}
+
+/// A spot on one of the room's four walls: `base` is a point of the wall plane at floor
+/// level and `normal_angle` the heading of the wall's normal into the room.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WallSite {
+    pub normal_angle: f64,
+    pub base: [f64; 2],
+}
+
+/// Draws a wall (uniformly among the four) and a point along it, at least `margin` from
+/// the corners. Always makes two draws.
+pub fn wall_site(rng: &mut ChaCha8Rng, room: &Room, margin: f64) -> WallSite {
+    let side = uniform(rng, 0.0, 4.0).floor().min(3.0) as usize;
+    let t = uniform(rng, -1.0, 1.0);
+    let [hx, hy] = [room.size[0] / 2.0, room.size[1] / 2.0];
+    let (normal_angle, base) = match side {
+        0 => (std::f64::consts::PI, [hx, t * (hy - margin).max(0.0)]),
+        1 => (0.0, [-hx, t * (hy - margin).max(0.0)]),
+        2 => (
+            -std::f64::consts::FRAC_PI_2,
+            [t * (hx - margin).max(0.0), hy],
+        ),
+        _ => (
+            std::f64::consts::FRAC_PI_2,
+            [t * (hx - margin).max(0.0), -hy],
+        ),
+    };
+    WallSite { normal_angle, base }
+}
+
+/// The wall behind a `WallSite` as a fixed slab (0.2 m thick, its face on the wall
+/// plane), `half_width` along the wall, from the floor to `height`.
+pub fn wall_body(site: &WallSite, half_width: f64, height: f64, friction: f64) -> BodySpec {
+    let n = heading(site.normal_angle);
+    fixed_box(
+        "wall",
+        [0.1, half_width, height / 2.0],
+        [
+            site.base[0] - n[0] * 0.1,
+            site.base[1] - n[1] * 0.1,
+            height / 2.0,
+        ],
+        yaw_quat(site.normal_angle),
+        friction,
+        0.1,
+    )
+}
+
+/// How an object rests on a flat surface: its natural pose, except that capsules (which
+/// would balance on a round cap) lie on their side. Returns the rotation in the object
+/// frame, the distance from its origin down to the surface, and its height.
+pub fn resting_pose(object: &Object) -> (Quat, f64, f64) {
+    if object.parts.iter().any(|p| p.shape == ShapeKind::Capsule) {
+        // About x by 90°: a part's y extent becomes vertical (z' = y).
+        let q = quat::from_axis_angle([1.0, 0.0, 0.0], std::f64::consts::FRAC_PI_2);
+        let bottom = object
+            .parts
+            .iter()
+            .map(|p| p.half_extents()[1] - p.offset[1])
+            .fold(0.0, f64::max);
+        let top = object
+            .parts
+            .iter()
+            .map(|p| p.half_extents()[1] + p.offset[1])
+            .fold(0.0, f64::max);
+        (q, bottom, bottom + top)
+    } else {
+        let b = bottom_offset(object);
+        (IDENTITY, b, b + top_offset(object))
+    }
+}
+
+/// A fixed table block from the floor, its local x along `heading_angle`.
+pub fn table_block(
+    name: &str,
+    centre: [f64; 2],
+    half: [f64; 2],
+    height: f64,
+    heading_angle: f64,
+    friction: f64,
+) -> BodySpec {
+    fixed_box(
+        name,
+        [half[0], half[1], height / 2.0],
+        [centre[0], centre[1], height / 2.0],
+        yaw_quat(heading_angle),
+        friction,
+        0.2,
+    )
+}
+
+/// A moving copy of a catalog object that is not the hazard (a neighbour in a stack or a
+/// row): same parts and physics, role `Prop`.
+pub fn prop_copy(
+    object: &Object,
+    name: &str,
+    position: Vec3,
+    rotation: Quat,
+    linvel: Vec3,
+) -> BodySpec {
+    BodySpec {
+        name: name.to_string(),
+        role: BodyRole::Prop,
+        ..hazard_body(object, position, rotation, linvel, [0.0; 3])
+    }
+}
+
+/// A dynamic plain box that is not the hazard (a trigger block).
+#[allow(clippy::too_many_arguments)]
+pub fn prop_box(
+    name: &str,
+    half_extents: Vec3,
+    position: Vec3,
+    rotation: Quat,
+    mass: f64,
+    friction: f64,
+    restitution: f64,
+    linvel: Vec3,
+) -> BodySpec {
+    BodySpec {
+        name: name.to_string(),
+        role: BodyRole::Prop,
+        kind: BodyKind::Dynamic,
+        catalog_id: None,
+        parts: vec![PartSpec {
+            shape: ShapeSpec::Box { half_extents },
+            offset: [0.0; 3],
+            rotation: IDENTITY,
+        }],
+        position,
+        rotation,
+        mass,
+        friction,
+        restitution,
+        linvel,
+        angvel: [0.0; 3],
+        ccd: true,
+    }
+}
+
+/// World z component of a body's local z axis (1 upright, 0 lying on its side).
+pub fn up_z(rotation: [f32; 4]) -> f64 {
+    let [x, y, _, _] = rotation.map(f64::from);
+    1.0 - 2.0 * (x * x + y * y)
+}
+
+/// Index among `sim.dynamic_bodies` of spec body `body`.
+pub fn slot_of(sim: &Simulation, body: usize) -> Option<usize> {
+    sim.dynamic_bodies.iter().position(|&i| i == body)
+}
+
+/// Whether the object rests in its natural pose on a flat face (not on a round cap or
+/// a single sphere, which roll or balance).
+pub fn is_single_sphere(object: &Object) -> bool {
+    object.parts.len() == 1 && object.parts[0].shape == ShapeKind::Sphere
+}
+
+/// The hazard's largest distance from its start position over the run (m).
+pub fn max_displacement(sim: &Simulation) -> f64 {
+    let a = sim.hazard_position(0);
+    (0..=sim.steps())
+        .map(|k| {
+            let b = sim.hazard_position(k);
+            ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Extra distance to shift an event away from its observer's side of the room when the
+/// observer stands far (so that the far observer still stands inside the room). Depends
+/// on the group's `far_observer`, never on the band.
+pub fn far_shift(input: &FamilyInput) -> f64 {
+    if input.far_observer {
+        1.0
+    } else {
+        0.0
+    }
+}
+
 /// The hazard's speed at the end of the run is small and it touched the floor.
 pub fn reached_floor(sim: &Simulation) -> bool {
     sim.time_to_floor_step().is_some()
@@ -361,6 +610,9 @@ mod tests {
                     b.angvel = [0.0; 3];
                 }
                 l.params.retain(|k, _| !k.contains("elevation"));
+                // door_swing records the push impulse that gives its door the band's edge
+                // speed (`J = I_hinge·v/w²`): a momentum, like the velocities above.
+                l.params.retain(|k, _| k != "push_impulse_ns");
                 l
             };
             assert_eq!(

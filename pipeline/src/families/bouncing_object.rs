@@ -1,0 +1,91 @@
+//! bouncing_object: an object is thrown down at the floor and bounces toward the observer
+//! (SPEC §4).
+//!
+//! Launched from hand height, pitched down by a drawn angle, at the band's speed, along the
+//! line to the observer. The observer stands beyond the fastest band's first bounce, so in
+//! every band the object reaches them bouncing (then rolling). In far-observer groups the
+//! observer stands well off to the side of that line instead.
+
+use super::*;
+
+pub struct BouncingObject;
+
+/// Horizontal distance to the first floor contact of a centre launched at height `h`
+/// (above its resting height) with speed `v`, pitched `pitch` below horizontal.
+pub fn first_bounce_distance(v: f64, pitch: f64, h: f64) -> f64 {
+    let vz = v * pitch.sin();
+    let t = (-vz + (vz * vz + 2.0 * GRAVITY * h).sqrt()) / GRAVITY;
+    v * pitch.cos() * t
+}
+
+impl Family for BouncingObject {
+    fn name(&self) -> &'static str {
+        "bouncing_object"
+    }
+    fn speed_parameter(&self) -> &'static str {
+        "launch_speed_mps"
+    }
+    fn speed_sweep(&self) -> bool {
+        true
+    }
+
+    fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
+        let object = input.object;
+        let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
+        let dir = heading(heading_angle);
+        let side = left_of(dir);
+        let launch_height = uniform(rng, 0.9, 1.4);
+        let pitch = uniform(rng, 0.3, 0.6);
+        let beyond = uniform(rng, 0.4, 0.9);
+        let near_lateral = uniform(rng, -0.25, 0.25);
+        let far_lateral = uniform(rng, 2.0, 2.4)
+            * if uniform(rng, 0.0, 1.0) < 0.5 {
+                -1.0
+            } else {
+                1.0
+            };
+        let fastest = input.band_speeds.iter().copied().fold(0.0, f64::max);
+        let r = bottom_offset(object);
+        let distance = first_bounce_distance(fastest, pitch, launch_height - r) + beyond;
+        let origin = event_origin(rng, input.room, dir, distance / 2.0);
+
+        let start = [origin[0], origin[1], launch_height];
+        let v = input.speed;
+        let linvel = [
+            dir[0] * v * pitch.cos(),
+            dir[1] * v * pitch.cos(),
+            -v * pitch.sin(),
+        ];
+        let hazard = hazard_body(object, start, yaw_quat(heading_angle), linvel, [0.0; 3]);
+        let lateral = if input.far_observer {
+            far_lateral
+        } else {
+            near_lateral
+        };
+        let obs = ahead(ahead(origin, dir, distance), side, lateral);
+        Layout {
+            bodies: vec![hazard],
+            joints: vec![],
+            hazard: 0,
+            source_support: None,
+            observer: ObserverPose {
+                x: obs[0],
+                y: obs[1],
+                yaw: (origin[1] - obs[1]).atan2(origin[0] - obs[0]),
+            },
+            params: BTreeMap::from([
+                ("launch_height_m".into(), launch_height),
+                ("pitch_down_rad".into(), pitch),
+                ("observer_distance_m".into(), distance),
+            ]),
+        }
+    }
+
+    fn event_happened(&self, _spec: &SceneSpec, sim: &Simulation) -> bool {
+        // It bounced: after its first floor contact it moved up again.
+        let Some(k) = sim.time_to_floor_step() else {
+            return false;
+        };
+        (k..=sim.steps()).any(|j| sim.hazard_velocity(j)[2] > 0.1)
+    }
+}

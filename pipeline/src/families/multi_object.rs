@@ -1,0 +1,105 @@
+//! multi_object: momentum runs down a row of objects (SPEC §4).
+//!
+//! Three or four copies of the object stand in a row on a table, a few millimetres apart,
+//! the last one (the hazard) near the edge — all placed exactly on the table, at rest.
+//! The first is shoved toward the others at the band's speed; each collision passes the
+//! momentum on, and the last object is pushed toward (and usually off) the edge.
+
+use super::*;
+
+pub struct MultiObject;
+
+impl Family for MultiObject {
+    fn name(&self) -> &'static str {
+        "multi_object"
+    }
+    fn speed_parameter(&self) -> &'static str {
+        "shove_speed_mps"
+    }
+    fn speed_sweep(&self) -> bool {
+        true
+    }
+
+    fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
+        let object = input.object;
+        let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
+        let dir = heading(heading_angle);
+        let side = left_of(dir);
+        let height = uniform(rng, input.room.table_height[0], input.room.table_height[1]);
+        let half_width = uniform(rng, 0.35, 0.6);
+        let friction = uniform(rng, 0.1, 0.25);
+        let count = if uniform(rng, 0.0, 1.0) < 0.5 { 3 } else { 4 };
+        let gaps = [0, 1, 2].map(|_| uniform(rng, 0.005, 0.03));
+        let behind = uniform(rng, 0.2, 0.5);
+        let lateral = uniform(rng, -0.12, 0.12);
+        let origin = event_origin(rng, input.room, dir, 0.7 + far_shift(input));
+
+        let (pose, bottom, _) = resting_pose(object);
+        let rotation = quat::mul(yaw_quat(heading_angle), pose);
+        let half_len = object.half_extents()[0];
+        let row: f64 = 2.0 * half_len * count as f64 + gaps[..count - 1].iter().sum::<f64>();
+        let half_depth = ((row + 0.2) / 2.0).max(0.3);
+        let table = table_block(
+            "table",
+            origin,
+            [half_depth, half_width],
+            height,
+            heading_angle,
+            friction,
+        );
+        let edge = ahead(origin, dir, half_depth);
+        let last = ahead(ahead(edge, dir, -behind * half_len), side, lateral);
+        let mut bodies = vec![table];
+        // Items from the first (the shoved one) to the last (the hazard).
+        let mut offsets = vec![0.0; count];
+        for i in (0..count - 1).rev() {
+            offsets[i] = offsets[i + 1] + 2.0 * half_len + gaps[i];
+        }
+        for (i, off) in offsets.iter().enumerate() {
+            let xy = ahead(last, dir, -off);
+            let position = [xy[0], xy[1], height + bottom];
+            let v = if i == 0 { input.speed } else { 0.0 };
+            let linvel = [dir[0] * v, dir[1] * v, 0.0];
+            if i + 1 == count {
+                bodies.push(hazard_body(object, position, rotation, linvel, [0.0; 3]));
+            } else {
+                bodies.push(prop_copy(
+                    object,
+                    &format!("{}_{i}", object.id),
+                    position,
+                    rotation,
+                    linvel,
+                ));
+            }
+        }
+        let landing = ahead(edge, dir, 0.25);
+        let observer = observer_beyond(
+            rng,
+            landing,
+            dir,
+            (0.35, 0.9),
+            (2.3, 2.8),
+            0.35,
+            input.far_observer,
+            last,
+        );
+        Layout {
+            hazard: bodies.len() - 1,
+            bodies,
+            joints: vec![],
+            source_support: Some(0),
+            observer,
+            params: BTreeMap::from([
+                ("table_height_m".into(), height),
+                ("row_count".into(), count as f64),
+                ("com_behind_edge_m".into(), behind * half_len),
+                ("drop_height_m".into(), height),
+            ]),
+        }
+    }
+
+    fn event_happened(&self, _spec: &SceneSpec, sim: &Simulation) -> bool {
+        // Momentum reached the last object: it moved at least 5 cm.
+        max_displacement(sim) >= 0.05
+    }
+}

@@ -1,0 +1,95 @@
+//! pendulum_swing: a suspended mass (chandelier, punching bag, lamp) swings in (SPEC §4).
+//!
+//! The object hangs from a ceiling anchor on a real spherical joint: a rigid, massless
+//! suspension rod from the anchor to the top of the object (a physical pendulum). It
+//! starts hanging straight down and moving: the band's value is the speed of its centre
+//! of mass through the lowest point, toward the observer (amplitude follows from it:
+//! `v² = 2 g d (1 − cos θ)`), with the matching spin about the anchor.
+
+use super::*;
+
+pub struct PendulumSwing;
+
+impl Family for PendulumSwing {
+    fn name(&self) -> &'static str {
+        "pendulum_swing"
+    }
+    fn speed_parameter(&self) -> &'static str {
+        "swing_speed_mps"
+    }
+    fn speed_sweep(&self) -> bool {
+        true
+    }
+
+    fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
+        let object = input.object;
+        let room = input.room;
+        let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
+        let dir = heading(heading_angle);
+        let com_height = uniform(rng, 1.0, 1.45);
+        let yaw = uniform(rng, 0.0, std::f64::consts::TAU);
+        let origin = event_origin(rng, room, dir, 0.5 + far_shift(input));
+
+        let com = com_offset(object);
+        let top = top_offset(object);
+        let ceiling = room.ceiling_height;
+        // At least 25 cm of suspension between the ceiling and the object's top.
+        let z = (com_height - com[2]).min(ceiling - 0.25 - top);
+        let rod = ceiling - (z + top);
+        let anchor = [origin[0], origin[1], ceiling];
+        let com_world = [origin[0], origin[1], z + com[2]];
+        let arm = ceiling - com_world[2];
+        // Swing about the horizontal axis ŝ = ẑ × dir: ω = −(v/d) ŝ moves the mass along dir.
+        let s = left_of(dir);
+        let omega = [-s[0], -s[1], 0.0].map(|c| c * input.speed / arm);
+        let linvel = velocity_about(omega, anchor, com_world);
+        let hazard = hazard_body(
+            object,
+            [origin[0], origin[1], z],
+            yaw_quat(yaw),
+            linvel,
+            omega,
+        );
+        let observer = observer_beyond(
+            rng,
+            origin,
+            dir,
+            (0.45, 0.95),
+            (2.5, 2.9),
+            0.25,
+            input.far_observer,
+            origin,
+        );
+        Layout {
+            bodies: vec![hazard],
+            joints: vec![JointSpec {
+                kind: JointKind::Spherical,
+                body_a: None,
+                body_b: 0,
+                anchor_a: anchor,
+                anchor_b: [0.0, 0.0, top + rod],
+            }],
+            hazard: 0,
+            source_support: None,
+            observer,
+            params: BTreeMap::from([
+                ("pivot_to_com_m".into(), arm),
+                ("rod_length_m".into(), rod),
+                ("anchor_height_m".into(), ceiling),
+            ]),
+        }
+    }
+
+    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
+        // It swung: the arm turned at least 0.1 rad from vertical.
+        let Some(joint) = spec.joints.first() else {
+            return false;
+        };
+        let a = joint.anchor_a;
+        (0..=sim.steps()).any(|k| {
+            let p = sim.hazard_position(k);
+            let horizontal = ((p[0] - a[0]).powi(2) + (p[1] - a[1]).powi(2)).sqrt();
+            horizontal.atan2(a[2] - p[2]) >= 0.1
+        })
+    }
+}

@@ -1,0 +1,152 @@
+//! stair_tumble: an object tumbles down a flight of stairs (SPEC §4).
+//!
+//! A real staircase of fixed boxes: a top landing and `n − 1` steps below it (rise and
+//! run drawn), descending toward the observer who stands beyond the bottom step. The
+//! object is pushed (a ball: rolled) toward the top edge at the band's speed, from where
+//! even the slowest band goes over the edge still sliding at 0.8 m/s.
+
+use super::*;
+
+pub struct StairTumble;
+
+/// The slowest band still moves this fast as it goes over the top edge (m/s).
+const LEAVE_SPEED: f64 = 0.8;
+
+impl Family for StairTumble {
+    fn name(&self) -> &'static str {
+        "stair_tumble"
+    }
+    fn speed_parameter(&self) -> &'static str {
+        "push_speed_mps"
+    }
+    fn speed_sweep(&self) -> bool {
+        true
+    }
+
+    fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
+        let object = input.object;
+        let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
+        let dir = heading(heading_angle);
+        let steps = uniform(rng, 3.0, 6.0).floor().min(5.0) as usize;
+        let rise = uniform(rng, 0.16, 0.2);
+        let run = uniform(rng, 0.22, 0.27);
+        let half_width = uniform(rng, 0.45, 0.6);
+        let friction = uniform(rng, 0.25, 0.45);
+        let lateral = uniform(rng, -0.15, 0.15);
+        let relative_yaw = uniform(rng, -0.2, 0.2);
+        let rolling = is_single_sphere(object);
+        let overshoot = uniform(rng, 0.8, 1.2);
+        let com_to_edge = if rolling {
+            0.05 + 0.15 * (overshoot - 0.8) / 0.4
+        } else {
+            // Where the slowest band, sliding, would still move at LEAVE_SPEED with its
+            // centre `overshoot` half-lengths past the edge: it goes over with momentum.
+            let mu = combined_friction(object.friction, friction);
+            let slowest = input
+                .band_speeds
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min);
+            let half_len = footprint_half_length(object, 0.0);
+            let run_up =
+                (slowest * slowest - LEAVE_SPEED * LEAVE_SPEED).max(0.0) / (2.0 * mu * GRAVITY);
+            (run_up - overshoot * half_len).clamp(-0.4 * half_len, 0.25)
+        };
+        let flight = (steps - 1) as f64 * run;
+        let origin = event_origin(rng, input.room, dir, flight / 2.0 + 0.8 + far_shift(input));
+
+        let top_height = steps as f64 * rise;
+        let landing = EdgeLaunch {
+            surface_name: "landing",
+            surface_height: top_height,
+            surface_half: [0.35, half_width],
+            surface_friction: friction,
+            heading_angle,
+            com_to_edge,
+            lateral,
+            relative_yaw: if rolling { 0.0 } else { relative_yaw },
+            origin,
+            board_thickness: None,
+            rolling,
+        };
+        let (mut bodies, edge, start) = landing.build(object, input.speed);
+        for j in 1..steps {
+            let h = (steps - j) as f64 * rise;
+            let c = ahead(edge, dir, (j as f64 - 0.5) * run);
+            bodies.insert(
+                j,
+                fixed_box(
+                    &format!("step_{j}"),
+                    [run / 2.0, half_width, h / 2.0],
+                    [c[0], c[1], h / 2.0],
+                    yaw_quat(heading_angle),
+                    friction,
+                    0.2,
+                ),
+            );
+        }
+        let hazard = bodies.len() - 1;
+        let foot = ahead(edge, dir, flight);
+        let observer = observer_beyond(
+            rng,
+            foot,
+            dir,
+            (0.2, 0.7),
+            (2.6, 3.0),
+            0.3,
+            input.far_observer,
+            [start[0], start[1]],
+        );
+        Layout {
+            bodies,
+            joints: vec![],
+            hazard,
+            source_support: Some(0),
+            observer,
+            params: BTreeMap::from([
+                ("steps".into(), steps as f64),
+                ("rise_m".into(), rise),
+                ("run_m".into(), run),
+                ("top_height_m".into(), top_height),
+                ("com_behind_edge_m".into(), com_to_edge),
+                ("heading_rad".into(), heading_angle),
+            ]),
+        }
+    }
+
+    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
+        // It tumbled down at least two steps.
+        let p = &spec.family_params;
+        let (top, rise) = (p["top_height_m"], p["rise_m"]);
+        let bottom = sim.hazard_lowest_z[sim.steps() as usize];
+        bottom <= top - 2.0 * rise + 0.01
+    }
+}
+
+/// The hazard centre's height where it first crosses each step edge (distance
+/// `k · run` past the top edge along the stairs, k = 0 … steps − 1), in order.
+pub fn step_crossing_heights(spec: &SceneSpec, sim: &Simulation) -> Vec<f64> {
+    let p = &spec.family_params;
+    let dir = heading(p["heading_rad"]);
+    let landing = &spec.bodies[0];
+    let edge = ahead([landing.position[0], landing.position[1]], dir, 0.35);
+    let along = |q: [f64; 3]| (q[0] - edge[0]) * dir[0] + (q[1] - edge[1]) * dir[1];
+    let mut out = Vec::new();
+    let steps = p["steps"] as usize;
+    // Edges the centre already starts beyond (an object overhanging the top edge) are not
+    // crossings.
+    let mut k = ((along(sim.hazard_position(0)) / p["run_m"]).floor() + 1.0).max(0.0) as usize;
+    for j in 1..=sim.steps() {
+        if k >= steps {
+            break;
+        }
+        let line = k as f64 * p["run_m"];
+        let (a, b) = (sim.hazard_position(j - 1), sim.hazard_position(j));
+        if along(a) < line && along(b) >= line {
+            let f = (line - along(a)) / (along(b) - along(a));
+            out.push(a[2] + f * (b[2] - a[2]));
+            k += 1;
+        }
+    }
+    out
+}
