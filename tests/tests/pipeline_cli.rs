@@ -344,3 +344,23 @@ fn plan_maps_descriptions_and_rejects_nonsense() {
     );
     assert_bad_input(&["plan", "zzzz qqqq"], "close catalogue names");
 }
+
+#[test]
+fn all_seventeen_families_build_valid_and_replay() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("all");
+    let summary = run_ok("rh-pipeline", &["build", "--n", "340", "--no-render", "--quiet", "--json", "--out", out.to_str().unwrap()]);
+    let summary: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    assert_eq!(summary["scenes"], 340);
+    assert_eq!(summary["valid"], 340, "invalid scenes: {}", summary["invalid_scene_ids"]);
+    let per_family = summary["per_family"].as_object().unwrap();
+    assert_eq!(per_family.len(), 17);
+    assert!(per_family.values().all(|c| c == 20), "{per_family:?}");
+    let script = format!(
+        "import pyarrow.parquet as pq, collections\nt = pq.read_table('{}/data/test-00000-of-00001.parquet').to_pylist()\nc = collections.Counter((r['family'], r['speed_band']) for r in t)\nprint(len(c), min(c.values()))",
+        out.display()
+    );
+    assert_eq!(python(&script).trim(), "68 5", "every family × band pair");
+    let report: serde_json::Value = serde_json::from_str(&run_ok("rh-pipeline", &["verify", out.to_str().unwrap(), "--json"])).unwrap();
+    assert_eq!(report["matched"], 340);
+}
