@@ -9,7 +9,7 @@ apt_packages=(
   libavfilter-dev libavdevice-dev libswresample-dev
   clang libclang-dev pkg-config ffmpeg
 )
-python_packages=(pyarrow)
+python_packages=(pyarrow datasets)
 
 missing=()
 for pkg in "${apt_packages[@]}"; do

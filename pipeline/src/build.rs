@@ -4,12 +4,28 @@
 //! Determinism: a group's output depends only on (build seed, group index, config,
 //! catalog); results are gathered and written in scene-index order, so `--jobs` and
 //! sharding never change a byte.
+//!
+//! Crash safety and resume (SPEC §13). The output directory holds, in this order:
+//! 1. `build.json` (the manifest: what is being built), written before anything else;
+//! 2. per finished group, its specs and then its rows as a small Parquet record
+//!    `.rh-build/groups/<g>.parquet`;
+//! 3. when every group is done: `data/…parquet`, `eval/…parquet` (whole builds) and
+//!    `README.md`, built from the records alone; then `.rh-build/` is removed.
+//!
+//! Every file is written to a temporary name and renamed, so a reader never sees half a
+//! file. A build killed at any moment and started again with the same arguments finds
+//! the same manifest, loads the finished groups' records instead of simulating them, and
+//! writes the same bytes: finished and fresh groups reach the final table by the same
+//! path (their records). The directory is locked (`flock`) while a build runs in it.
 
+use crate::card;
 use crate::config::Config;
 use crate::dataset;
 use crate::families;
+use crate::manifest::{Manifest, MANIFEST_FILE};
 use crate::plan::plan_group;
-use crate::scene::{produce_group, SceneResult};
+use crate::scene::produce_group;
+use arrow::array::RecordBatch;
 use rayon::prelude::*;
 use rh_catalog::Catalog;
 use serde::Serialize;
@@ -17,6 +33,9 @@ use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Work-in-progress folder of an unfinished build (removed when the build completes).
+pub const WORK_DIR: &str = ".rh-build";
 
 #[derive(Debug, Clone)]
 pub struct BuildOptions {
@@ -50,6 +69,12 @@ pub struct BuildSummary {
     pub per_family: BTreeMap<String, usize>,
     pub per_action: BTreeMap<String, usize>,
     pub data_file: String,
+    /// Groups whose finished records a previous, interrupted run left (not recomputed).
+    pub resumed_groups: usize,
+    /// Groups simulated by this run.
+    pub computed_groups: usize,
+    /// Scenes in the `eval` config (whole builds only).
+    pub eval_scenes: Option<usize>,
 }
 
 /// Checks the options against the catalog and configuration before any work.
@@ -102,17 +127,6 @@ pub fn check_options(
     Ok(())
 }
 
-fn prepare_out(out: &Path) -> Result<(), BuildError> {
-    let fail = |e: std::io::Error| {
-        BuildError::Input(format!("cannot write to --out {}: {e}", out.display()))
-    };
-    std::fs::create_dir_all(out.join("specs")).map_err(fail)?;
-    std::fs::create_dir_all(out.join("data")).map_err(fail)?;
-    let probe = out.join(".rh-write-probe");
-    dataset::write_atomic(&probe, b"probe").map_err(fail)?;
-    std::fs::remove_file(&probe).map_err(fail)
-}
-
 struct Progress {
     bar: Option<indicatif::ProgressBar>,
     done: AtomicU64,
@@ -163,6 +177,121 @@ impl Progress {
     }
 }
 
+fn internal(path: &Path, e: impl std::fmt::Display) -> BuildError {
+    BuildError::Internal(format!("{}: {e}", path.display()))
+}
+
+/// Path of group `g`'s record.
+pub fn record_path(out: &Path, g: u64) -> PathBuf {
+    out.join(WORK_DIR)
+        .join("groups")
+        .join(format!("{g:08}.parquet"))
+}
+
+/// Holds an exclusive `flock` on a directory while alive (released by the kernel when
+/// the process dies, even by SIGKILL).
+pub struct DirLock(#[allow(dead_code)] std::fs::File);
+
+/// Locks `dir` against a second `rh-pipeline` writing into it at the same time.
+pub fn lock_dir(dir: &Path) -> Result<DirLock, BuildError> {
+    let file = std::fs::File::open(dir)
+        .map_err(|e| BuildError::Input(format!("cannot open {}: {e}", dir.display())))?;
+    match file.try_lock() {
+        Ok(()) => Ok(DirLock(file)),
+        Err(std::fs::TryLockError::WouldBlock) => Err(BuildError::Input(format!(
+            "{} is being written by another rh-pipeline process",
+            dir.display()
+        ))),
+        // A file system without locks: go on unlocked.
+        Err(std::fs::TryLockError::Error(_)) => Ok(DirLock(file)),
+    }
+}
+
+/// Removes temporary files (`.NAME.PID.tmp`) a killed writer left in the dataset's
+/// folders, and retired work folders (`.rh-build.done.PID`) a killed build did not finish
+/// deleting.
+fn remove_stale_temporaries(out: &Path) {
+    if let Ok(entries) = std::fs::read_dir(out) {
+        for e in entries.flatten() {
+            if e.file_name()
+                .to_string_lossy()
+                .starts_with(&format!("{WORK_DIR}.done."))
+            {
+                let _ = std::fs::remove_dir_all(e.path());
+            }
+        }
+    }
+    for sub in ["", "data", "eval", "specs", ".rh-build/groups"] {
+        let Ok(entries) = std::fs::read_dir(out.join(sub)) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let name = e.file_name();
+            let name = name.to_string_lossy();
+            if name.starts_with('.') && name.ends_with(".tmp") {
+                let _ = std::fs::remove_file(e.path());
+            }
+        }
+    }
+}
+
+/// Checks that `out` is new, empty, or holds this very build, and records the manifest.
+/// Returns whether the directory already holds the finished build.
+pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError> {
+    let fail = |e: std::io::Error| {
+        BuildError::Input(format!("cannot write to --out {}: {e}", out.display()))
+    };
+    std::fs::create_dir_all(out).map_err(fail)?;
+    match Manifest::read(out).map_err(BuildError::Input)? {
+        Some(existing) => {
+            let diff = existing.differences(manifest);
+            if !diff.is_empty() {
+                return Err(BuildError::Input(format!(
+                    "{} holds a different build ({}); use a new --out or delete it",
+                    out.display(),
+                    diff.join("; ")
+                )));
+            }
+        }
+        None => {
+            let occupied = ["data", "specs", "eval", WORK_DIR, "README.md"]
+                .iter()
+                .any(|p| out.join(p).exists());
+            if occupied {
+                return Err(BuildError::Input(format!(
+                    "{} holds files but no {MANIFEST_FILE} (not a build of this version); use a new --out or delete it",
+                    out.display()
+                )));
+            }
+            dataset::write_atomic(&out.join(MANIFEST_FILE), manifest.to_json().as_bytes())
+                .map_err(fail)?;
+        }
+    }
+    let data = out.join(dataset::data_file_name(
+        manifest.shard[0] as usize,
+        manifest.shard[1] as usize,
+    ));
+    Ok(!out.join(WORK_DIR).exists() && data.exists() && out.join("README.md").exists())
+}
+
+/// Reads group `g`'s record if it is there and whole (right rows, specs present).
+fn load_record(out: &Path, manifest: &Manifest, g: u64) -> Option<RecordBatch> {
+    let path = record_path(out, g);
+    if !path.exists() {
+        return None;
+    }
+    let batch = dataset::read_batch(&path).ok()?;
+    let indices = dataset::u64_column(&batch, "scene_index");
+    let expected: Vec<u64> = (g * 4..g * 4 + manifest.group_size(g)).collect();
+    if indices != expected {
+        return None;
+    }
+    let specs_there = dataset::string_column(&batch, "spec_file")
+        .iter()
+        .all(|f| out.join(f).exists());
+    specs_there.then_some(batch)
+}
+
 /// Builds the dataset described by `opts`.
 pub fn build(
     opts: &BuildOptions,
@@ -177,68 +306,172 @@ pub fn build(
             "note: this build has no render stage yet; building without videos (as --no-render)"
         );
     }
-    prepare_out(&opts.out)?;
+    let manifest = Manifest::new(
+        opts.seed,
+        opts.n,
+        &opts.families,
+        opts.shard,
+        opts.render,
+        catalog,
+        config,
+    );
+    let out = &opts.out;
+    std::fs::create_dir_all(out)
+        .map_err(|e| BuildError::Input(format!("cannot write to --out {}: {e}", out.display())))?;
+    let _lock = lock_dir(out)?;
+    let complete = claim_out_dir(out, &manifest)?;
+    remove_stale_temporaries(out);
+    let data_file = dataset::data_file_name(opts.shard.0 as usize, opts.shard.1 as usize);
+    let groups = manifest.groups();
 
-    let n_groups = opts.n.div_ceil(4);
-    let groups: Vec<u64> = (0..n_groups)
-        .filter(|g| g % opts.shard.1 == opts.shard.0)
-        .collect();
-    let scenes_here: u64 = groups.iter().map(|g| (opts.n - g * 4).min(4)).sum();
-    let progress = Progress::new(scenes_here, opts.progress);
+    if complete {
+        if opts.progress {
+            eprintln!(
+                "{} already holds this build, complete; nothing to do",
+                out.display()
+            );
+        }
+        let rows = dataset::read_batch(&out.join(&data_file)).map_err(BuildError::Internal)?;
+        let eval = out
+            .join(card::EVAL_FILE)
+            .exists()
+            .then(|| card::eval_selection(&rows).0.len());
+        return Ok(summarize(out, &rows, data_file, groups.len(), 0, eval));
+    }
+
+    for sub in ["specs", "data", ".rh-build/groups"] {
+        std::fs::create_dir_all(out.join(sub)).map_err(|e| internal(&out.join(sub), e))?;
+    }
+    let (done, todo): (Vec<u64>, Vec<u64>) = groups
+        .iter()
+        .copied()
+        .partition(|&g| load_record(out, &manifest, g).is_some());
+    if !done.is_empty() && opts.progress {
+        eprintln!(
+            "resumed {} groups from {} (finished before the last run stopped)",
+            done.len(),
+            out.join(WORK_DIR).display()
+        );
+    }
+
+    let scenes_todo: u64 = todo.iter().map(|&g| manifest.group_size(g)).sum();
+    let progress = Progress::new(scenes_todo, opts.progress);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs)
         .build()
         .map_err(|e| BuildError::Internal(format!("thread pool: {e}")))?;
-
-    let per_group: Result<Vec<Vec<SceneResult>>, BuildError> = pool.install(|| {
-        groups
-            .par_iter()
-            .map(|&g| {
+    pool.install(|| {
+        todo.par_iter()
+            .try_for_each(|&g| -> Result<(), BuildError> {
                 let selection = plan_group(catalog, &opts.families, opts.seed, g)
                     .map_err(|e| BuildError::Input(e.to_string()))?;
-                let count = (opts.n - g * 4).min(4);
+                let count = manifest.group_size(g);
                 let results = produce_group(&selection, opts.seed, g * 4, count, catalog, config)
                     .map_err(|e| BuildError::Input(e.to_string()))?;
                 for r in &results {
-                    let path = opts.out.join(dataset::spec_path(&r.spec.scene_id));
+                    let path = out.join(dataset::spec_path(&r.spec.scene_id));
                     dataset::write_atomic(&path, r.spec.to_json().as_bytes())
-                        .map_err(|e| BuildError::Internal(format!("{}: {e}", path.display())))?;
+                        .map_err(|e| internal(&path, e))?;
                 }
+                // The record last: its presence says the group (specs included) is done.
+                let path = record_path(out, g);
+                let bytes = dataset::parquet_bytes(&dataset::record_batch(&results, catalog));
+                dataset::write_atomic(&path, &bytes).map_err(|e| internal(&path, e))?;
                 progress.advance(count, opts.progress);
-                Ok(results)
+                Ok(())
             })
-            .collect()
-    });
+    })?;
     progress.finish();
-    let mut results: Vec<SceneResult> = per_group?.into_iter().flatten().collect();
-    results.sort_by_key(|r| r.spec.scene_index);
 
-    let data_file = dataset::data_file_name(opts.shard.0 as usize, opts.shard.1 as usize);
-    let batch = dataset::record_batch(&results, catalog);
-    let path = opts.out.join(&data_file);
-    dataset::write_atomic(&path, &dataset::parquet_bytes(&batch))
-        .map_err(|e| BuildError::Internal(format!("{}: {e}", path.display())))?;
+    // Every group's rows, from the records, in scene-index order.
+    let batches: Vec<RecordBatch> = groups
+        .iter()
+        .map(|&g| {
+            let path = record_path(out, g);
+            dataset::read_batch(&path).map_err(BuildError::Internal)
+        })
+        .collect::<Result<_, _>>()?;
+    let rows = dataset::concat(&batches).map_err(BuildError::Internal)?;
+    let eval = finalize(out, &manifest, &rows)?;
+    // Retire the records in one atomic step (a rename), then delete them: a crash in
+    // between leaves a finished build whose next run only removes the leftover.
+    let work = out.join(WORK_DIR);
+    let retired = out.join(format!("{WORK_DIR}.done.{}", std::process::id()));
+    std::fs::rename(&work, &retired).map_err(|e| internal(&work, e))?;
+    std::fs::remove_dir_all(&retired).map_err(|e| internal(&retired, e))?;
+    Ok(summarize(
+        out,
+        &rows,
+        data_file,
+        done.len(),
+        todo.len(),
+        eval,
+    ))
+}
 
+/// Writes the dataset's final files from its rows (in scene-index order): the data
+/// Parquet, the eval subset (whole builds), and the card. Returns the eval subset's size.
+pub fn finalize(
+    out: &Path,
+    manifest: &Manifest,
+    rows: &RecordBatch,
+) -> Result<Option<usize>, BuildError> {
+    let data_file = dataset::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
+    let path = out.join(&data_file);
+    dataset::write_atomic(&path, &dataset::parquet_bytes(rows)).map_err(|e| internal(&path, e))?;
+    let eval = if manifest.is_whole() {
+        let (indices, counts) = card::eval_selection(rows);
+        let subset = dataset::take_rows(rows, &indices);
+        let path = out.join(card::EVAL_FILE);
+        dataset::write_atomic(&path, &dataset::parquet_bytes(&subset))
+            .map_err(|e| internal(&path, e))?;
+        Some(counts)
+    } else {
+        None
+    };
+    let readme = card::render(&card::CardInput {
+        manifest,
+        rows,
+        data_files: std::slice::from_ref(&data_file),
+        eval: eval.as_ref(),
+    });
+    let path = out.join("README.md");
+    dataset::write_atomic(&path, readme.as_bytes()).map_err(|e| internal(&path, e))?;
+    Ok(eval.map(|c| c.values().sum()))
+}
+
+fn summarize(
+    out: &Path,
+    rows: &RecordBatch,
+    data_file: String,
+    resumed_groups: usize,
+    computed_groups: usize,
+    eval_scenes: Option<usize>,
+) -> BuildSummary {
+    let ids = dataset::string_column(rows, "scene_id");
+    let valid = dataset::bool_column(rows, "valid");
+    let family = dataset::string_column(rows, "family");
+    let action = dataset::string_column(rows, "gt_action");
     let mut summary = BuildSummary {
-        out: opts.out.display().to_string(),
-        scenes: results.len(),
+        out: out.display().to_string(),
+        scenes: rows.num_rows(),
         valid: 0,
         invalid_scene_ids: vec![],
         per_family: BTreeMap::new(),
         per_action: BTreeMap::new(),
         data_file,
+        resumed_groups,
+        computed_groups,
+        eval_scenes,
     };
-    for r in &results {
-        if r.verdicts.all() {
+    for i in 0..rows.num_rows() {
+        if valid[i] {
             summary.valid += 1;
         } else {
-            summary.invalid_scene_ids.push(r.spec.scene_id.clone());
+            summary.invalid_scene_ids.push(ids[i].clone());
         }
-        *summary.per_family.entry(r.spec.family.clone()).or_default() += 1;
-        *summary
-            .per_action
-            .entry(r.labels.gt_action.name().to_string())
-            .or_default() += 1;
+        *summary.per_family.entry(family[i].clone()).or_default() += 1;
+        *summary.per_action.entry(action[i].clone()).or_default() += 1;
     }
-    Ok(summary)
+    summary
 }

@@ -68,6 +68,30 @@ pub enum Command {
         #[arg(long, default_value_t = 0)]
         seed: u64,
     },
+    /// Combine the outputs of `build --shard i/N` (all N of them) into one dataset equal to
+    /// the unsharded build.
+    Merge {
+        /// Output directory (must not exist, or be empty).
+        out: PathBuf,
+        /// The shard directories, in any order.
+        #[arg(required = true, value_name = "SHARD_DIR")]
+        shards: Vec<PathBuf>,
+        /// Print the merge summary as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Download a dataset from the Hugging Face Hub into the HF cache (offline: use the
+    /// cache) and print its local path. Honours HF_ENDPOINT, HF_HOME, HF_TOKEN, HF_HUB_OFFLINE.
+    Download {
+        /// Dataset repository id, owner/name.
+        repo: String,
+        /// Branch, tag or commit (default: main).
+        #[arg(long)]
+        revision: Option<String>,
+        /// Also copy the files into this directory as a plain dataset directory.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
     /// Replay every spec of a dataset and compare per-step state hashes (exit 2 on any mismatch).
     Verify {
         /// Dataset directory built by `rh-pipeline build`.
@@ -122,9 +146,73 @@ fn load(cli: &Cli) -> Result<(Catalog, Config), Failure> {
     Ok((catalog, config))
 }
 
+fn build_failure(e: BuildError) -> Failure {
+    match e {
+        BuildError::Input(m) => input(m),
+        BuildError::Internal(m) => Failure {
+            code: 1,
+            message: m,
+        },
+    }
+}
+
+fn print_json<T: serde::Serialize>(value: &T) {
+    println!(
+        "{}",
+        serde_json::to_string_pretty(value).expect("summary serializes")
+    );
+}
+
 pub fn run(cli: Cli) -> Result<(), Failure> {
+    // Commands that need neither the catalog nor the configuration.
+    match &cli.command {
+        Command::Merge { out, shards, json } => {
+            let summary = crate::merge::merge(out, shards).map_err(build_failure)?;
+            if *json {
+                print_json(&summary);
+            } else {
+                println!(
+                    "merged {} shards: {} scenes ({} valid) into {} — {}",
+                    summary.shards, summary.scenes, summary.valid, summary.out, summary.data_file
+                );
+            }
+            return Ok(());
+        }
+        Command::Download {
+            repo,
+            revision,
+            out,
+        } => {
+            let snapshot = rh_hub::fetch(repo, revision.as_deref()).map_err(|e| Failure {
+                code: e.exit_code(),
+                message: e.to_string(),
+            })?;
+            if snapshot.from_cache_only {
+                eprintln!(
+                    "the Hub at {} was not used; {repo} comes from the Hugging Face cache",
+                    rh_hub::endpoint()
+                );
+            }
+            let path = match out {
+                Some(dir) => {
+                    let files =
+                        rh_hub::copy_snapshot(&snapshot.path, dir).map_err(|e| Failure {
+                            code: 1,
+                            message: format!("cannot copy {repo} into {}: {e}", dir.display()),
+                        })?;
+                    eprintln!("copied {files} files into {}", dir.display());
+                    dir.clone()
+                }
+                None => snapshot.path,
+            };
+            println!("{}", path.display());
+            return Ok(());
+        }
+        _ => {}
+    }
     let (catalog, config) = load(&cli)?;
     match cli.command {
+        Command::Merge { .. } | Command::Download { .. } => unreachable!("handled above"),
         Command::Build {
             n,
             out,
@@ -150,22 +238,21 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                 render: !no_render,
                 progress: !quiet,
             };
-            let summary = build(&opts, &catalog, &config).map_err(|e| match e {
-                BuildError::Input(m) => input(m),
-                BuildError::Internal(m) => Failure {
-                    code: 1,
-                    message: m,
-                },
-            })?;
+            let summary = build(&opts, &catalog, &config).map_err(build_failure)?;
             if json {
-                println!(
-                    "{}",
-                    serde_json::to_string_pretty(&summary).expect("summary serializes")
-                );
+                print_json(&summary);
             } else {
                 println!(
-                    "built {} scenes ({} valid) into {} — {}",
-                    summary.scenes, summary.valid, summary.out, summary.data_file
+                    "built {} scenes ({} valid) into {} — {}{}",
+                    summary.scenes,
+                    summary.valid,
+                    summary.out,
+                    summary.data_file,
+                    if summary.resumed_groups > 0 {
+                        format!(" (resumed {} groups)", summary.resumed_groups)
+                    } else {
+                        String::new()
+                    }
                 );
                 let actions: Vec<String> = summary
                     .per_action

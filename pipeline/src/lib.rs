@@ -9,11 +9,14 @@
 pub mod balance;
 pub mod build;
 pub mod cameras;
+pub mod card;
 pub mod cli;
 pub mod config;
 pub mod dataset;
 pub mod families;
 pub mod label;
+pub mod manifest;
+pub mod merge;
 pub mod plan;
 pub mod randomize;
 pub mod scene;

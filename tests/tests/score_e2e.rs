@@ -302,22 +302,49 @@ fn dataset_from_environment_and_missing_dataset() {
     let work = scratch("env");
     let p = work.join("p.jsonl");
     baseline(ds, "freeze", &p);
-    // No --dataset, no RH_DATASET: exit 2 with a message about the Hub.
+    // No --dataset, no RH_DATASET: the released dataset from the Hub. Here the Hub is a
+    // closed loopback port and the HF cache is empty: exit 1 naming the repo and endpoint.
+    let hf_home = scratch("env-hf-home");
+    let closed = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let endpoint = format!("http://{}", closed.local_addr().unwrap());
+    drop(closed);
     let out = std::process::Command::new(rh_e2e::bin("rh-score"))
         .arg(&p)
         .env_remove("RH_DATASET")
+        .env_remove("HF_HUB_OFFLINE")
+        .env("HF_ENDPOINT", &endpoint)
+        .env("HF_HOME", &hf_home)
+        .env_remove("HF_HUB_CACHE")
+        .env_remove("HF_TOKEN")
         .output()
         .unwrap();
-    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("Hub") && err.contains("RH_DATASET"), "{err}");
-    // owner/name that is not a directory: the same message.
+    assert!(
+        err.contains("Alan123/reacthuman-benchmark-scaled") && err.contains(&endpoint),
+        "{err}"
+    );
+    // owner/name that is not a directory, offline with an empty cache: the same, no network.
+    let out = std::process::Command::new(rh_e2e::bin("rh-score"))
+        .args([p.to_str().unwrap(), "--dataset", "someone/reacthuman"])
+        .env("HF_HUB_OFFLINE", "1")
+        .env("HF_HOME", &hf_home)
+        .env_remove("HF_HUB_CACHE")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("someone/reacthuman") && err.contains("cache"),
+        "{err}"
+    );
+    // A path that is neither a directory nor an owner/name id: exit 2.
     let out = run(
         "rh-score",
-        &[p.to_str().unwrap(), "--dataset", "someone/reacthuman"],
+        &[p.to_str().unwrap(), "--dataset", "./no/such/dir"],
     );
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("Hub"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("does not exist"));
     // RH_DATASET is used.
     let out = std::process::Command::new(rh_e2e::bin("rh-score"))
         .arg(&p)

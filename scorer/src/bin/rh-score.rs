@@ -9,10 +9,6 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-const HUB_MSG: &str =
-    "downloading the dataset from the Hugging Face Hub is not available yet in this build; \
-pass --dataset DIR (a directory built by `rh-pipeline build`) or set RH_DATASET=DIR";
-
 #[derive(Parser, Debug)]
 #[command(
     name = "rh-score",
@@ -34,8 +30,10 @@ struct Cli {
     /// standard input.
     preds: Option<PathBuf>,
 
-    /// Dataset directory (data/*.parquet + specs/). Default: $RH_DATASET.
-    #[arg(long, value_name = "DIR")]
+    /// Dataset directory (data/*.parquet + specs/), or a Hugging Face Hub dataset id
+    /// owner/name[@revision], downloaded once into the HF cache and then used offline.
+    /// Default: $RH_DATASET, else the released dataset (Alan123/reacthuman-benchmark-scaled).
+    #[arg(long, value_name = "DIR|owner/name")]
     dataset: Option<String>,
 
     /// Write the full report as JSON ("-" for stdout, which replaces the table).
@@ -83,8 +81,9 @@ enum Cmd {
         /// Which baseline.
         #[arg(value_enum)]
         kind: BaselineKind,
-        /// Dataset directory. Default: $RH_DATASET.
-        #[arg(long, value_name = "DIR")]
+        /// Dataset directory or Hub dataset id owner/name[@revision]. Default: $RH_DATASET,
+        /// else the released dataset.
+        #[arg(long, value_name = "DIR|owner/name")]
         dataset: Option<String>,
         /// Seed of the random baseline.
         #[arg(long, default_value_t = 0)]
@@ -111,21 +110,45 @@ enum Cmd {
     },
 }
 
+/// Resolves `--dataset` / `$RH_DATASET` / the released dataset to a local directory: an
+/// existing path is used as is; `owner/name[@revision]` is downloaded from the Hub into the
+/// Hugging Face cache (or found there when the Hub is unreachable).
 fn dataset_dir(arg: Option<String>) -> Result<PathBuf> {
-    let dir = match arg.or_else(|| std::env::var("RH_DATASET").ok().filter(|s| !s.is_empty())) {
-        Some(d) => d,
-        None => return Err(InputError(format!("no dataset given: {HUB_MSG}")).into()),
+    let given = arg.or_else(|| std::env::var("RH_DATASET").ok().filter(|s| !s.is_empty()));
+    let id = match given {
+        Some(d) => {
+            let path = PathBuf::from(&d);
+            if path.exists() {
+                return Ok(path);
+            }
+            let (repo, _) = d.split_once('@').unwrap_or((&d, ""));
+            if !rh_hub::is_repo_id(repo) {
+                return Err(InputError(format!(
+                    "dataset directory {d} does not exist (nor is it a Hub dataset id owner/name)"
+                ))
+                .into());
+            }
+            d
+        }
+        None => rh_hub::RELEASED_DATASET.to_string(),
     };
-    let path = PathBuf::from(&dir);
-    if path.exists() {
-        return Ok(path);
+    let (repo, revision) = match id.split_once('@') {
+        Some((r, rev)) => (r, Some(rev)),
+        None => (id.as_str(), None),
+    };
+    match rh_hub::fetch(repo, revision) {
+        Ok(snapshot) => {
+            if snapshot.from_cache_only {
+                eprintln!(
+                    "rh-score: the Hub at {} was not used; {repo} comes from the Hugging Face cache",
+                    rh_hub::endpoint()
+                );
+            }
+            Ok(snapshot.path)
+        }
+        Err(e) if e.exit_code() == 2 => Err(InputError(e.to_string()).into()),
+        Err(e) => Err(anyhow::anyhow!("{e}")),
     }
-    let looks_like_repo =
-        dir.split('/').count() == 2 && !dir.starts_with('.') && !dir.starts_with('/');
-    if looks_like_repo {
-        return Err(InputError(format!("{dir} is not a local directory, and {HUB_MSG}")).into());
-    }
-    Err(InputError(format!("dataset directory {dir} does not exist")).into())
 }
 
 fn load_config(path: Option<&Path>) -> Result<Config> {

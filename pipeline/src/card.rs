@@ -1,0 +1,434 @@
+//! The dataset card (`README.md`) and the balanced evaluation subset (SPEC §8).
+//!
+//! The card is `dataset/card_template.md` with its `{{placeholders}}` filled from the
+//! build manifest, the label thresholds of the build's configuration, the schema (feature
+//! table, from `dataset::schema()` and `dataset::column_description`), and counts over the
+//! rows. Everything is a pure function of (manifest, rows): a merged build and a single
+//! build get the same card.
+
+use crate::dataset;
+use crate::manifest::Manifest;
+use arrow::array::{Array, RecordBatch};
+use arrow::datatypes::DataType;
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+const TEMPLATE: &str = include_str!("../../dataset/card_template.md");
+
+/// Scenes per family in the evaluation subset (17 families × 18 = 306).
+pub const EVAL_PER_FAMILY: usize = 18;
+
+/// The `eval` config's Parquet file.
+pub const EVAL_FILE: &str = "eval/test-00000-of-00001.parquet";
+
+/// Per-family counts of a set of rows.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FamilyCounts {
+    pub scenes: usize,
+    pub valid: usize,
+    /// Ground-truth labels of the valid scenes.
+    pub catch: usize,
+    pub dodge: usize,
+    pub no_action: usize,
+}
+
+/// Counts per family (keys sorted by name).
+pub fn family_counts(batch: &RecordBatch) -> BTreeMap<String, FamilyCounts> {
+    let family = dataset::string_column(batch, "family");
+    let valid = dataset::bool_column(batch, "valid");
+    let action = dataset::string_column(batch, "gt_action");
+    let mut out: BTreeMap<String, FamilyCounts> = BTreeMap::new();
+    for i in 0..batch.num_rows() {
+        let c = out.entry(family[i].clone()).or_default();
+        c.scenes += 1;
+        if valid[i] {
+            c.valid += 1;
+            match action[i].as_str() {
+                "CATCH" => c.catch += 1,
+                "DODGE" => c.dodge += 1,
+                _ => c.no_action += 1,
+            }
+        }
+    }
+    out
+}
+
+/// The balanced evaluation subset: per family, valid scenes taken first as whole
+/// speed-band groups (all four bands valid) in scene-index order while they fit in 18,
+/// then single valid scenes in scene-index order up to 18. Returns row indices in
+/// scene-index order and how many scenes each family got.
+pub fn eval_selection(batch: &RecordBatch) -> (Vec<u32>, BTreeMap<String, usize>) {
+    let family = dataset::string_column(batch, "family");
+    let valid = dataset::bool_column(batch, "valid");
+    let index = dataset::u64_column(batch, "scene_index");
+    let rows: Vec<(&str, u64, bool)> = (0..batch.num_rows())
+        .map(|i| (family[i].as_str(), index[i], valid[i]))
+        .collect();
+    select_eval(&rows)
+}
+
+/// `eval_selection` over `(family, scene_index, valid)` rows.
+pub fn select_eval(rows: &[(&str, u64, bool)]) -> (Vec<u32>, BTreeMap<String, usize>) {
+    let mut by_family: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
+    for (i, &(fam, _, valid)) in rows.iter().enumerate() {
+        if valid {
+            by_family.entry(fam).or_default().push(i);
+        }
+    }
+    let index = |r: usize| rows[r].1;
+    let mut chosen = Vec::new();
+    let mut counts = BTreeMap::new();
+    for (fam, mut members) in by_family {
+        members.sort_by_key(|&r| index(r));
+        let mut groups: BTreeMap<u64, Vec<usize>> = BTreeMap::new();
+        for &r in &members {
+            groups.entry(index(r) / 4).or_default().push(r);
+        }
+        let mut taken: Vec<usize> = Vec::new();
+        for group in groups.values() {
+            if group.len() == 4 && taken.len() + 4 <= EVAL_PER_FAMILY {
+                taken.extend(group);
+            }
+        }
+        for &r in &members {
+            if taken.len() >= EVAL_PER_FAMILY {
+                break;
+            }
+            if !taken.contains(&r) {
+                taken.push(r);
+            }
+        }
+        counts.insert(fam.to_string(), taken.len());
+        chosen.extend(taken);
+    }
+    chosen.sort_by_key(|&r| index(r));
+    (chosen.into_iter().map(|r| r as u32).collect(), counts)
+}
+
+/// Hugging Face size category of a row count.
+pub fn size_category(n: usize) -> &'static str {
+    match n {
+        0..1_000 => "n<1K",
+        1_000..10_000 => "1K<n<10K",
+        10_000..100_000 => "10K<n<100K",
+        100_000..1_000_000 => "100K<n<1M",
+        _ => "1M<n<10M",
+    }
+}
+
+fn type_name(t: &DataType) -> String {
+    match t {
+        DataType::Utf8 => "string".into(),
+        DataType::Boolean => "bool".into(),
+        DataType::Float64 => "float64".into(),
+        DataType::Float32 => "float32".into(),
+        DataType::UInt64 => "uint64".into(),
+        DataType::UInt32 => "uint32".into(),
+        DataType::FixedSizeList(item, n) => format!("{}[{n}]", type_name(item.data_type())),
+        DataType::List(item) => format!("list<{}>", type_name(item.data_type())),
+        other => other.to_string(),
+    }
+}
+
+fn fill(template: &str, values: &BTreeMap<&str, String>) -> String {
+    let mut out = template.to_string();
+    for (k, v) in values {
+        out = out.replace(&format!("{{{{{k}}}}}"), v);
+    }
+    assert!(
+        !out.contains("{{"),
+        "dataset/card_template.md has an unfilled placeholder"
+    );
+    out
+}
+
+/// Where the card's numbers come from.
+pub struct CardInput<'a> {
+    pub manifest: &'a Manifest,
+    /// Every row of this directory's `data/` file(s).
+    pub rows: &'a RecordBatch,
+    /// The data files, relative to the dataset directory.
+    pub data_files: &'a [String],
+    /// Eval subset per-family counts, when this directory has the eval config.
+    pub eval: Option<&'a BTreeMap<String, usize>>,
+}
+
+/// Renders `README.md`.
+pub fn render(input: &CardInput) -> String {
+    let m = input.manifest;
+    let n_rows = input.rows.num_rows();
+    let counts = family_counts(input.rows);
+    let labels = m
+        .labels()
+        .expect("a manifest written by this version holds the label config");
+    let mut v: BTreeMap<&str, String> = BTreeMap::new();
+    v.insert("size_category", size_category(n_rows).into());
+    v.insert("repo_id", rh_hub::RELEASED_DATASET.into());
+    v.insert("row_group_size", dataset::ROW_GROUP_SIZE.to_string());
+    v.insert("rule_version", labels.rule_version.clone());
+    let window = m
+        .config
+        .pointer("/observation/window_s")
+        .and_then(|w| w.as_f64())
+        .unwrap_or(0.6);
+    v.insert("window_s", format!("{window}"));
+
+    // configs
+    let mut configs = String::from(
+        "- config_name: default\n  default: true\n  data_files:\n  - split: test\n    path: data/test-*.parquet\n",
+    );
+    let mut table = format!(
+        "| `default` | `data/test-*.parquet` | {n_rows} | every scene of this {} |\n",
+        if m.is_whole() { "build" } else { "shard" }
+    );
+    let total_eval: usize = input.eval.map(|e| e.values().sum()).unwrap_or(0);
+    if input.eval.is_some() {
+        configs.push_str(
+            "- config_name: eval\n  data_files:\n  - split: test\n    path: eval/test-*.parquet\n",
+        );
+        let _ = writeln!(
+            table,
+            "| `eval` | `{EVAL_FILE}` | {total_eval} | balanced evaluation subset: {EVAL_PER_FAMILY} valid scenes per family |"
+        );
+        v.insert(
+            "eval_example",
+            format!(
+                "subset = load_dataset(\"{}\", \"eval\", split=\"test\")  # {total_eval} scenes\n",
+                rh_hub::RELEASED_DATASET
+            ),
+        );
+    } else {
+        v.insert("eval_example", String::new());
+    }
+    v.insert("configs", configs.trim_end().to_string());
+    v.insert("config_table", table.trim_end().to_string());
+
+    let mut scope = if m.is_whole() {
+        format!(
+            "This build holds **{n_rows} scenes** ({} valid) of {} famil{} in {} scene groups \
+             (four speed bands per group: slow, normal, fast, very_fast).",
+            counts.values().map(|c| c.valid).sum::<usize>(),
+            counts.len(),
+            if counts.len() == 1 { "y" } else { "ies" },
+            m.n_groups()
+        )
+    } else {
+        format!(
+            "This directory is **shard {} of {}** of a {}-scene build: {n_rows} scenes, the groups g \
+             with g mod {} = {}. Combine all shards with `rh-pipeline merge OUT SHARD_DIR...`; \
+             the merged dataset equals an unsharded build byte for byte and has the `eval` config.",
+            m.shard[0], m.shard[1], m.n, m.shard[1], m.shard[0]
+        )
+    };
+    if let Some(eval) = input.eval {
+        let short: Vec<String> = m
+            .families
+            .iter()
+            .filter(|f| eval.get(*f).copied().unwrap_or(0) < EVAL_PER_FAMILY)
+            .map(|f| format!("`{f}` ({})", eval.get(f).copied().unwrap_or(0)))
+            .collect();
+        if !short.is_empty() {
+            let _ = write!(
+                scope,
+                "\n\n**Note:** the `eval` config should hold {EVAL_PER_FAMILY} scenes per family, but this \
+                 build has fewer valid scenes in {}; the subset holds all of them.",
+                short.join(", ")
+            );
+        }
+    }
+    v.insert("scope", scope);
+    let rendered = input
+        .rows
+        .column_by_name("ego_file_name")
+        .is_some_and(|c| c.null_count() < c.len());
+    v.insert(
+        "render_note",
+        if rendered {
+            "Observation frames are under `frames/<scene_id>/`; videos under `videos/<cam>/`."
+                .into()
+        } else {
+            "This build has no rendered videos: the `*_file_name` columns are null and there is \
+             no `videos/` or `frames/` folder (`--no-render`, or a build without the render stage)."
+                .into()
+        },
+    );
+
+    // Per-family table, in the build's family order.
+    let mut ft = String::from(
+        "Label counts are over valid scenes.\n\n| family | scenes | valid | CATCH | DODGE | NO_ACTION |",
+    );
+    if input.eval.is_some() {
+        ft.push_str(" eval |");
+    }
+    ft.push_str("\n|---|---|---|---|---|---|");
+    if input.eval.is_some() {
+        ft.push_str("---|");
+    }
+    ft.push('\n');
+    let mut total = FamilyCounts::default();
+    for f in &m.families {
+        let c = counts.get(f).cloned().unwrap_or_default();
+        let _ = write!(
+            ft,
+            "| {f} | {} | {} | {} | {} | {} |",
+            c.scenes, c.valid, c.catch, c.dodge, c.no_action
+        );
+        if let Some(e) = input.eval {
+            let _ = write!(ft, " {} |", e.get(f).copied().unwrap_or(0));
+        }
+        ft.push('\n');
+        total.scenes += c.scenes;
+        total.valid += c.valid;
+        total.catch += c.catch;
+        total.dodge += c.dodge;
+        total.no_action += c.no_action;
+    }
+    let _ = write!(
+        ft,
+        "| **total** | {} | {} | {} | {} | {} |",
+        total.scenes, total.valid, total.catch, total.dodge, total.no_action
+    );
+    if input.eval.is_some() {
+        let _ = write!(ft, " {total_eval} |");
+    }
+    v.insert("family_table", ft);
+
+    // Features.
+    let schema = dataset::schema();
+    let mut features = String::new();
+    for field in schema.fields() {
+        let _ = writeln!(
+            features,
+            "| `{}` | {}{} | {} |",
+            field.name(),
+            type_name(field.data_type()),
+            if field.is_nullable() {
+                ", nullable"
+            } else {
+                ""
+            },
+            dataset::column_description(field.name()).unwrap_or_default()
+        );
+    }
+    v.insert("features_table", features.trim_end().to_string());
+
+    let l = &labels;
+    v.insert(
+        "label_rule",
+        format!(
+            "* **Impact point**: the hazard's centre where it first descends through the reach \
+plane z = {} m after t = 0 (interpolated within the physics step); for a body that never \
+does, its closest approach to the observer's torso axis if within {} m; else null.
+* **dangerous**: the object is sharp, hot, or large and fragile (catalog hazard flags of its \
+true physics), or its mass is ≥ {} kg, or its impact momentum is ≥ {} kg·m/s.
+* **danger_present**: in a counterfactual simulation with the observer's body (a capsule of \
+radius {} m, floor to {} m) as a static collider, the hazard touches it at ≥ {} m/s.
+* **reachable**: the hazard passes within {} m of the torso axis, or danger is present.
+* **gt_action**: `NO_ACTION` when not reachable; else `DODGE` when dangerous, or the impact \
+speed is > {} m/s, or the impact kinetic energy is > {} J; else `CATCH`.",
+            l.reach_plane_z,
+            l.closest_approach_max,
+            l.heavy_mass_kg,
+            l.heavy_momentum,
+            m.config
+                .pointer("/observer/torso_radius")
+                .and_then(|x| x.as_f64())
+                .unwrap_or(0.18),
+            m.config
+                .pointer("/observer/height")
+                .and_then(|x| x.as_f64())
+                .unwrap_or(1.32),
+            l.strike_speed_min,
+            l.reach_radius,
+            l.catch_speed_max,
+            l.catch_energy_max,
+        ),
+    );
+
+    let default_config = crate::config::Config::embedded()
+        .map(|c| crate::manifest::config_sha256(&c) == m.config_sha256)
+        .unwrap_or(false);
+    v.insert(
+        "build_summary",
+        format!(
+            "| | |\n|---|---|\n| build seed | {} |\n| scenes (whole build) | {} |\n| scene groups | {} |\n\
+| families | {} |\n| shard | {}/{} |\n| render | {} |\n| configuration | {} (sha256 `{}`) |\n\
+| catalog | sha256 `{}` |\n| rh-pipeline | {} |\n| data files | {} |",
+            m.seed,
+            m.n,
+            m.n_groups(),
+            m.families.join(", "),
+            m.shard[0],
+            m.shard[1],
+            if m.render { "requested" } else { "no (--no-render)" },
+            if default_config { "the default `configs/default.toml`" } else { "custom" },
+            m.config_sha256,
+            m.catalog_sha256,
+            m.rh_pipeline_version,
+            input
+                .data_files
+                .iter()
+                .map(|f| format!("`{f}`"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        ),
+    );
+    v.insert(
+        "rebuild_command",
+        format!(
+            "rh-pipeline{} build --n {} --seed {} --families {}{}{} --out DIR",
+            if default_config {
+                ""
+            } else {
+                " --config YOUR_CONFIG.toml"
+            },
+            m.n,
+            m.seed,
+            m.families.join(","),
+            if m.render { "" } else { " --no-render" },
+            if m.is_whole() {
+                String::new()
+            } else {
+                format!(" --shard {}/{}", m.shard[0], m.shard[1])
+            }
+        ),
+    );
+    fill(TEMPLATE, &v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn eval_prefers_whole_groups_then_fills_by_index() {
+        // Family a: groups 0..6 (scenes 0..24); group 1 has an invalid scene.
+        let mut rows: Vec<(&str, u64, bool)> = (0..24).map(|i| ("a", i, i != 5)).collect();
+        // Family b: 6 valid scenes only.
+        rows.extend((24..30).map(|i| ("b", i, true)));
+        let (chosen, counts) = select_eval(&rows);
+        assert_eq!(counts["a"], 18);
+        assert_eq!(counts["b"], 6);
+        let a: Vec<u64> = chosen
+            .iter()
+            .map(|&r| rows[r as usize])
+            .filter(|r| r.0 == "a")
+            .map(|r| r.1)
+            .collect();
+        // Whole groups 0, 2, 3, 4 (16 scenes), then the first two valid leftovers: 4, 6.
+        let mut expected: Vec<u64> = (0..4).chain(8..20).collect();
+        expected.extend([4, 6]);
+        expected.sort();
+        assert_eq!(a, expected);
+        assert!(chosen
+            .windows(2)
+            .all(|w| rows[w[0] as usize].1 < rows[w[1] as usize].1));
+    }
+
+    #[test]
+    fn size_categories() {
+        assert_eq!(size_category(306), "n<1K");
+        assert_eq!(size_category(10_000), "10K<n<100K");
+        assert_eq!(size_category(9_999), "1K<n<10K");
+    }
+}

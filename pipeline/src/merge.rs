@@ -1,0 +1,215 @@
+//! `rh-pipeline merge OUT SHARD_DIR...`: combines the outputs of `build --shard i/N`
+//! (i = 0 … N−1) into one dataset equal, byte for byte, to the unsharded build: the same
+//! `build.json`, `data/test-00000-of-00001.parquet`, `eval/`, `README.md` and specs.
+//!
+//! The shards must be finished builds of the same manifest (seed, n, families,
+//! configuration, catalog, render flag) and cover every group exactly once; anything else
+//! is a usage error naming the directory and the problem. The merged dataset is written
+//! into a hidden sibling folder and renamed onto OUT at the end, so OUT appears whole or
+//! not at all.
+
+use crate::build::{finalize, BuildError, WORK_DIR};
+use crate::dataset;
+use crate::manifest::{Manifest, MANIFEST_FILE};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, Serialize)]
+pub struct MergeSummary {
+    pub out: String,
+    pub shards: usize,
+    pub scenes: usize,
+    pub valid: usize,
+    pub data_file: String,
+    pub eval_scenes: Option<usize>,
+}
+
+fn input(msg: String) -> BuildError {
+    BuildError::Input(msg)
+}
+
+/// Reads and checks one shard directory; returns its manifest and rows.
+fn read_shard(dir: &Path) -> Result<(Manifest, arrow::array::RecordBatch), BuildError> {
+    let manifest = Manifest::read(dir).map_err(input)?.ok_or_else(|| {
+        input(format!(
+            "{}: no {MANIFEST_FILE}; not a directory written by `rh-pipeline build`",
+            dir.display()
+        ))
+    })?;
+    let data = dir.join(dataset::data_file_name(
+        manifest.shard[0] as usize,
+        manifest.shard[1] as usize,
+    ));
+    if dir.join(WORK_DIR).exists() || !data.exists() {
+        return Err(input(format!(
+            "{}: shard {}/{} is unfinished; run its build command again to finish it",
+            dir.display(),
+            manifest.shard[0],
+            manifest.shard[1]
+        )));
+    }
+    let rows = dataset::read_batch(&data).map_err(input)?;
+    let indices = dataset::u64_column(&rows, "scene_index");
+    let expected: Vec<u64> = manifest
+        .groups()
+        .iter()
+        .flat_map(|&g| g * 4..g * 4 + manifest.group_size(g))
+        .collect();
+    if indices != expected {
+        return Err(input(format!(
+            "{}: {} does not hold exactly the scenes of shard {}/{} ({} rows, expected {})",
+            dir.display(),
+            data.display(),
+            manifest.shard[0],
+            manifest.shard[1],
+            indices.len(),
+            expected.len()
+        )));
+    }
+    for spec in dataset::string_column(&rows, "spec_file") {
+        if !dir.join(&spec).is_file() {
+            return Err(input(format!("{}: {spec} is missing", dir.display())));
+        }
+    }
+    Ok((manifest, rows))
+}
+
+/// Merges `shards` into `out`.
+pub fn merge(out: &Path, shards: &[PathBuf]) -> Result<MergeSummary, BuildError> {
+    if shards.is_empty() {
+        return Err(input("merge needs at least one SHARD_DIR".into()));
+    }
+    let mut read = Vec::new();
+    for dir in shards {
+        if !dir.is_dir() {
+            return Err(input(format!("{}: no such directory", dir.display())));
+        }
+        read.push((dir.clone(), read_shard(dir)?));
+    }
+    let (first_dir, (first, _)) = &read[0];
+    let whole = first.whole();
+    let n_shards = first.shard[1];
+    let mut by_index: BTreeMap<u64, &Path> = BTreeMap::new();
+    for (dir, (m, _)) in &read {
+        let diff = whole.differences(&m.whole());
+        if !diff.is_empty() {
+            return Err(input(format!(
+                "{} and {} are shards of different builds ({})",
+                first_dir.display(),
+                dir.display(),
+                diff.join("; ")
+            )));
+        }
+        if m.shard[1] != n_shards {
+            return Err(input(format!(
+                "{} is shard {}/{} but {} is shard {}/{}: all shards must split the build the same way",
+                dir.display(),
+                m.shard[0],
+                m.shard[1],
+                first_dir.display(),
+                first.shard[0],
+                first.shard[1]
+            )));
+        }
+        if let Some(other) = by_index.insert(m.shard[0], dir.as_path()) {
+            return Err(input(format!(
+                "shard {}/{n_shards} is given twice: {} and {}",
+                m.shard[0],
+                other.display(),
+                dir.display()
+            )));
+        }
+    }
+    let missing: Vec<String> = (0..n_shards)
+        .filter(|i| !by_index.contains_key(i))
+        .map(|i| format!("{i}/{n_shards}"))
+        .collect();
+    if !missing.is_empty() {
+        return Err(input(format!(
+            "the shards do not cover the build: missing shard(s) {}",
+            missing.join(", ")
+        )));
+    }
+
+    // OUT must be new or an empty directory.
+    if out.exists() {
+        let empty = std::fs::read_dir(out)
+            .map(|mut d| d.next().is_none())
+            .unwrap_or(false);
+        if !empty {
+            return Err(input(format!(
+                "{} already exists and is not empty; merge writes a new directory",
+                out.display()
+            )));
+        }
+    }
+    let out_name = out
+        .file_name()
+        .and_then(|n| n.to_str())
+        .ok_or_else(|| input(format!("{}: not a usable output path", out.display())))?;
+    let parent = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&parent)
+        .map_err(|e| input(format!("cannot create {}: {e}", parent.display())))?;
+    let staging = parent.join(format!(".{out_name}.rh-merge.{}", std::process::id()));
+    let result = write_merged(&staging, &whole, &read);
+    if let Err(e) = result {
+        let _ = std::fs::remove_dir_all(&staging);
+        return Err(e);
+    }
+    if out.exists() {
+        std::fs::remove_dir(out)
+            .map_err(|e| BuildError::Internal(format!("{}: {e}", out.display())))?;
+    }
+    std::fs::rename(&staging, out).map_err(|e| {
+        let _ = std::fs::remove_dir_all(&staging);
+        BuildError::Internal(format!(
+            "cannot move the merged dataset to {}: {e}",
+            out.display()
+        ))
+    })?;
+    let rows = dataset::read_batch(&out.join(dataset::data_file_name(0, 1)))
+        .map_err(BuildError::Internal)?;
+    Ok(MergeSummary {
+        out: out.display().to_string(),
+        shards: read.len(),
+        scenes: rows.num_rows(),
+        valid: dataset::bool_column(&rows, "valid")
+            .iter()
+            .filter(|v| **v)
+            .count(),
+        data_file: dataset::data_file_name(0, 1),
+        eval_scenes: out
+            .join(crate::card::EVAL_FILE)
+            .exists()
+            .then(|| crate::card::eval_selection(&rows).0.len()),
+    })
+}
+
+type Shard = (PathBuf, (Manifest, arrow::array::RecordBatch));
+
+fn write_merged(staging: &Path, whole: &Manifest, shards: &[Shard]) -> Result<(), BuildError> {
+    let internal =
+        |p: &Path, e: std::io::Error| BuildError::Internal(format!("{}: {e}", p.display()));
+    std::fs::create_dir_all(staging.join("specs")).map_err(|e| internal(staging, e))?;
+    dataset::write_atomic(&staging.join(MANIFEST_FILE), whole.to_json().as_bytes())
+        .map_err(|e| internal(staging, e))?;
+    let mut batches = Vec::new();
+    for (dir, (_, rows)) in shards {
+        for spec in dataset::string_column(rows, "spec_file") {
+            let (from, to) = (dir.join(&spec), staging.join(&spec));
+            std::fs::copy(&from, &to).map_err(|e| internal(&from, e))?;
+        }
+        batches.push(rows.clone());
+    }
+    let all = dataset::concat(&batches).map_err(BuildError::Internal)?;
+    let index = dataset::u64_column(&all, "scene_index");
+    let mut order: Vec<u32> = (0..all.num_rows() as u32).collect();
+    order.sort_by_key(|&i| index[i as usize]);
+    let rows = dataset::take_rows(&all, &order);
+    finalize(staging, whole, &rows)?;
+    Ok(())
+}

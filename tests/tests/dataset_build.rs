@@ -1,0 +1,302 @@
+//! End-to-end tests of the dataset as a Hugging Face dataset (SPEC §8, §13): sharded
+//! builds merged equal a single build byte for byte, a build killed with SIGKILL and
+//! restarted equals an uninterrupted one, and pyarrow and `datasets` load the card's
+//! configs.
+
+use rh_e2e::{bin, python, run, run_ok};
+use std::collections::BTreeMap;
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+const FAMILIES: &str =
+    "object_drop,shelf_slide,ceiling_drop,sliding_object,rolling_ball,thrown_object";
+
+fn build_args<'a>(n: &'a str, seed: &'a str, out: &'a Path) -> Vec<&'a str> {
+    vec![
+        "build",
+        "--n",
+        n,
+        "--seed",
+        seed,
+        "--no-render",
+        "--quiet",
+        "--families",
+        FAMILIES,
+        "--out",
+        out.to_str().unwrap(),
+    ]
+}
+
+/// A single 40-scene build (seed 11), shared by the tests that only read it.
+fn single() -> &'static (tempfile::TempDir, PathBuf) {
+    static SINGLE: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    SINGLE.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("single");
+        run_ok("rh-pipeline", &build_args("40", "11", &out));
+        (dir, out)
+    })
+}
+
+fn files_under(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                let rel = path
+                    .strip_prefix(dir)
+                    .unwrap()
+                    .to_string_lossy()
+                    .to_string();
+                out.insert(rel, fs::read(&path).unwrap());
+            }
+        }
+    }
+    out
+}
+
+fn assert_same_tree(a: &Path, b: &Path) {
+    let (fa, fb) = (files_under(a), files_under(b));
+    assert_eq!(
+        fa.keys().collect::<Vec<_>>(),
+        fb.keys().collect::<Vec<_>>(),
+        "{} and {} hold different files",
+        a.display(),
+        b.display()
+    );
+    for (name, bytes) in &fa {
+        assert!(bytes == &fb[name], "{name} differs");
+    }
+}
+
+fn assert_exit2(args: &[&str], needle: &str) {
+    let out = run("rh-pipeline", args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert!(
+        err.contains(needle),
+        "{args:?}: expected '{needle}' in: {err}"
+    );
+}
+
+#[test]
+fn dataset_build_layout_card_and_manifest() {
+    let (_, dir) = single();
+    let files = files_under(dir);
+    for f in [
+        "README.md",
+        "build.json",
+        "data/test-00000-of-00001.parquet",
+        "eval/test-00000-of-00001.parquet",
+    ] {
+        assert!(files.contains_key(f), "missing {f}");
+    }
+    assert_eq!(files.keys().filter(|k| k.starts_with("specs/")).count(), 40);
+    assert!(
+        !files
+            .keys()
+            .any(|k| k.starts_with(".rh-build") || k.ends_with(".tmp")),
+        "work files left: {:?}",
+        files.keys().collect::<Vec<_>>()
+    );
+    let card = String::from_utf8(files["README.md"].clone()).unwrap();
+    for needle in [
+        "license: cc-by-4.0",
+        "config_name: default",
+        "path: data/test-*.parquet",
+        "config_name: eval",
+        "path: eval/test-*.parquet",
+        "n<1K",
+        "| `impact_point` | float64[3], nullable |",
+        "reach plane z = 0.9 m",
+        "≥ 2 kg",
+        "> 7 m/s",
+        "> 30 J",
+        "| object_drop |",
+        "@inproceedings{li2027reacthuman",
+        "Bang",
+        "| build seed | 11 |",
+        "fewer valid scenes",
+    ] {
+        assert!(card.contains(needle), "card lacks {needle:?}:\n{card}");
+    }
+    let manifest: serde_json::Value = serde_json::from_slice(&files["build.json"]).unwrap();
+    assert_eq!(manifest["seed"], 11);
+    assert_eq!(manifest["n"], 40);
+    assert_eq!(manifest["shard"], serde_json::json!([0, 1]));
+    assert_eq!(manifest["config"]["labels"]["rule_version"], "v1");
+}
+
+#[test]
+fn dataset_sharded_build_merges_to_the_single_build() {
+    let (_, single) = single();
+    let tmp = tempfile::tempdir().unwrap();
+    let shard = |i: u32| tmp.path().join(format!("shard{i}"));
+    for i in 0..3 {
+        let out = shard(i);
+        let s = format!("{i}/3");
+        let mut args = build_args("40", "11", &out);
+        args.extend(["--shard", &s]);
+        run_ok("rh-pipeline", &args);
+        assert!(out
+            .join(format!("data/test-0000{i}-of-00003.parquet"))
+            .exists());
+        assert!(!out.join("eval").exists(), "a shard has no eval subset");
+    }
+    let merged = tmp.path().join("merged");
+    let (s0, s1, s2) = (shard(0), shard(1), shard(2));
+    let (s0, s1, s2) = (
+        s0.to_str().unwrap(),
+        s1.to_str().unwrap(),
+        s2.to_str().unwrap(),
+    );
+    // Any order of shard directories.
+    let summary = run_ok(
+        "rh-pipeline",
+        &["merge", merged.to_str().unwrap(), s2, s0, s1, "--json"],
+    );
+    let summary: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    assert_eq!(summary["scenes"], 40);
+    assert_same_tree(single, &merged);
+
+    // Problems are usage errors that name them.
+    let m2 = tmp.path().join("m2");
+    let m2 = m2.to_str().unwrap();
+    assert_exit2(&["merge", m2, s0, s1], "missing shard(s) 2/3");
+    assert_exit2(&["merge", m2, s0, s1, s1], "given twice");
+    assert_exit2(
+        &["merge", merged.to_str().unwrap(), s0, s1, s2],
+        "not empty",
+    );
+    let other = tmp.path().join("other-seed");
+    let mut args = build_args("40", "12", &other);
+    args.extend(["--shard", "2/3"]);
+    run_ok("rh-pipeline", &args);
+    assert_exit2(
+        &["merge", m2, s0, s1, other.to_str().unwrap()],
+        "different builds (seed 11 vs 12)",
+    );
+    assert_exit2(&["merge", m2, s0, s1, single.to_str().unwrap()], "shard");
+    assert!(!Path::new(m2).exists(), "a failed merge leaves no output");
+}
+
+#[test]
+fn dataset_killed_build_resumes_to_the_same_bytes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let reference = tmp.path().join("reference");
+    run_ok("rh-pipeline", &build_args("120", "5", &reference));
+
+    let killed = tmp.path().join("killed");
+    let records = killed.join(".rh-build/groups");
+    let mut args = build_args("120", "5", &killed);
+    args.extend(["--jobs", "1"]);
+    let mut child = Command::new(bin("rh-pipeline"))
+        .args(&args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Kill it (SIGKILL) once a few of its 30 groups are finished.
+    let deadline = Instant::now() + Duration::from_secs(60);
+    loop {
+        let done = fs::read_dir(&records)
+            .map(|d| {
+                d.flatten()
+                    .filter(|e| e.file_name().to_string_lossy().ends_with(".parquet"))
+                    .count()
+            })
+            .unwrap_or(0);
+        if done >= 3 || Instant::now() > deadline {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        killed.join(".rh-build").exists(),
+        "the build finished before it could be killed"
+    );
+    assert!(!killed.join("README.md").exists());
+
+    // Another build into the same directory with other arguments is refused.
+    assert_exit2(&build_args("120", "6", &killed), "holds a different build");
+
+    let summary = run_ok("rh-pipeline", &[&args[..], &["--json"]].concat());
+    let summary: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    let resumed = summary["resumed_groups"].as_u64().unwrap();
+    let computed = summary["computed_groups"].as_u64().unwrap();
+    assert!(resumed >= 3, "{summary}");
+    assert_eq!(resumed + computed, 30, "{summary}");
+    assert_same_tree(&reference, &killed);
+
+    // Once complete, the same command does nothing and changes nothing.
+    let again = run_ok("rh-pipeline", &[&args[..], &["--json"]].concat());
+    let again: serde_json::Value = serde_json::from_str(&again).unwrap();
+    assert_eq!(again["computed_groups"], 0);
+    assert_same_tree(&reference, &killed);
+}
+
+#[test]
+fn dataset_loads_with_pyarrow_and_datasets_through_the_card() {
+    let (_, dir) = single();
+    let hf_home = tempfile::tempdir().unwrap();
+    let script = format!(
+        r#"
+import os, json
+os.environ["HF_HOME"] = {home:?}
+os.environ["HF_DATASETS_OFFLINE"] = "1"
+os.environ["HF_HUB_OFFLINE"] = "1"
+import pyarrow.parquet as pq
+import datasets
+d = {dir:?}
+t = pq.read_table(d + "/data/test-00000-of-00001.parquet")
+e = pq.read_table(d + "/eval/test-00000-of-00001.parquet")
+hf = json.loads(pq.read_schema(d + "/data/test-00000-of-00001.parquet").metadata[b"huggingface"])
+pf = pq.ParquetFile(d + "/data/test-00000-of-00001.parquet")
+default = datasets.load_dataset(d, "default", split="test")
+ev = datasets.load_dataset(d, "eval", split="test")
+print(json.dumps({{
+  "rows": t.num_rows, "eval_rows": e.num_rows,
+  "columns": t.column_names,
+  "hf_columns": list(hf["info"]["features"].keys()),
+  "ds_rows": default.num_rows, "ds_columns": default.column_names,
+  "ds_eval_rows": ev.num_rows,
+  "impact_point": str(default.features["impact_point"]),
+  "trajectory": str(default.features["trajectory"]),
+  "valid": str(default.features["valid"]),
+  "row_group_rows": pf.metadata.row_group(0).num_rows,
+  "eval_all_valid": all(ev["valid"]),
+  "first": default[0]["scene_id"] == t.column("scene_id")[0].as_py(),
+}}))
+"#,
+        home = hf_home.path().to_str().unwrap(),
+        dir = dir.to_str().unwrap()
+    );
+    let out: serde_json::Value = serde_json::from_str(python(&script).trim()).unwrap();
+    assert_eq!(out["rows"], 40, "{out}");
+    assert_eq!(out["ds_rows"], 40, "{out}");
+    assert_eq!(out["columns"], out["hf_columns"], "{out}");
+    assert_eq!(out["columns"], out["ds_columns"], "{out}");
+    assert!(out["eval_rows"].as_u64().unwrap() > 0, "{out}");
+    assert_eq!(out["ds_eval_rows"], out["eval_rows"], "{out}");
+    assert_eq!(out["eval_all_valid"], true, "{out}");
+    assert_eq!(out["first"], true, "{out}");
+    assert_eq!(out["row_group_rows"], 40, "{out}");
+    assert!(
+        out["impact_point"].as_str().unwrap().contains("length=3"),
+        "{out}"
+    );
+    assert!(
+        out["trajectory"].as_str().unwrap().contains("float32"),
+        "{out}"
+    );
+    assert!(out["valid"].as_str().unwrap().contains("bool"), "{out}");
+}
