@@ -100,6 +100,22 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Label balance: build K scenes per family in memory and count CATCH / DODGE /
+    /// NO_ACTION per family (the paper's 17 × 18 subset by default).
+    Balance {
+        /// Build seed; defaults to the configuration's build.seed.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Scenes per family.
+        #[arg(long, default_value_t = 18)]
+        per_family: usize,
+        /// Comma-separated families (default: all implemented).
+        #[arg(long, value_delimiter = ',')]
+        families: Option<Vec<String>>,
+        /// Print the counts as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 /// A failure with its exit code.
@@ -267,6 +283,42 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                         summary.invalid_scene_ids.join(", ")
                     );
                 }
+            }
+            Ok(())
+        }
+        Command::Balance {
+            seed,
+            per_family,
+            families,
+            json,
+        } => {
+            if per_family == 0 {
+                return Err(input("--per-family must be at least 1"));
+            }
+            let families = families.unwrap_or_default();
+            for f in &families {
+                if crate::families::get(f).is_none() {
+                    return Err(input(format!(
+                        "unknown or unimplemented family '{f}' (implemented: {})",
+                        crate::randomize::implemented_families()
+                    )));
+                }
+            }
+            let rows = crate::balance::label_balance(
+                &catalog,
+                &config,
+                seed.unwrap_or(config.build.seed),
+                &families,
+                per_family,
+            )
+            .map_err(|e| Failure {
+                code: 1,
+                message: format!("{e:#}"),
+            })?;
+            if json {
+                print_json(&rows);
+            } else {
+                print!("{}", crate::balance::format_table(&rows));
             }
             Ok(())
         }

@@ -95,6 +95,46 @@ pub struct RenderConfig {
     pub width: u32,
     pub height: u32,
     pub fps: u32,
+    /// Size and frame rate of the full-event video (for people, not model input).
+    #[serde(default = "default_full_width")]
+    pub full_width: u32,
+    #[serde(default = "default_full_height")]
+    pub full_height: u32,
+    #[serde(default = "default_full_fps")]
+    pub full_fps: u32,
+    /// libx264 preset and constant rate factor.
+    #[serde(default = "default_preset")]
+    pub preset: String,
+    #[serde(default = "default_crf")]
+    pub crf: u32,
+    /// libx264 threads per video (0 = automatic).
+    #[serde(default = "default_encoder_threads")]
+    pub encoder_threads: u32,
+    /// MSAA samples (4 or 1).
+    #[serde(default = "default_msaa")]
+    pub msaa: u32,
+}
+
+fn default_full_width() -> u32 {
+    640
+}
+fn default_full_height() -> u32 {
+    360
+}
+fn default_full_fps() -> u32 {
+    30
+}
+fn default_preset() -> String {
+    "veryfast".into()
+}
+fn default_crf() -> u32 {
+    20
+}
+fn default_encoder_threads() -> u32 {
+    1
+}
+fn default_msaa() -> u32 {
+    4
 }
 
 #[derive(Debug, Deserialize)]

@@ -19,6 +19,7 @@ pub mod manifest;
 pub mod merge;
 pub mod plan;
 pub mod randomize;
+pub mod render;
 pub mod scene;
 pub mod seeds;
 pub mod simulate;

@@ -364,3 +364,18 @@ fn all_seventeen_families_build_valid_and_replay() {
     let report: serde_json::Value = serde_json::from_str(&run_ok("rh-pipeline", &["verify", out.to_str().unwrap(), "--json"])).unwrap();
     assert_eq!(report["matched"], 340);
 }
+
+#[test]
+fn balance_reports_counts_per_action_per_family() {
+    let out = run_ok("rh-pipeline", &["balance", "--json", "--per-family", "8", "--families", FOUNDATION_FAMILIES]);
+    let rows: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let rows = rows.as_array().unwrap();
+    assert_eq!(rows.len(), 6);
+    for r in rows {
+        let total = ["catch", "dodge", "no_action", "invalid"].iter().map(|k| r[*k].as_u64().unwrap_or(0)).sum::<u64>();
+        assert_eq!(total, 8, "{r}");
+    }
+    let text = run_ok("rh-pipeline", &["balance", "--per-family", "4", "--families", "object_drop"]);
+    assert!(text.contains("object_drop") && text.contains("CATCH"), "{text}");
+    assert_eq!(run("rh-pipeline", &["balance", "--families", "nope"]).status.code(), Some(2));
+}

@@ -1,0 +1,269 @@
+//! H.264 (libx264) yuv420p MP4 writing with ffmpeg-next: RGBA frames in, a
+//! browser-playable file (`+faststart`) out, written to a temporary sibling and renamed.
+
+use ffmpeg_next as ff;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{sync_channel, SyncSender};
+use std::sync::Once;
+use std::thread::JoinHandle;
+
+/// Encoder settings (from `[render]`).
+#[derive(Debug, Clone)]
+pub struct EncodeSettings {
+    pub preset: String,
+    pub crf: u32,
+    /// libx264 threads per video (0 = libx264's automatic choice).
+    pub threads: u32,
+}
+
+static INIT: Once = Once::new();
+
+pub fn init() -> Result<(), String> {
+    let mut err = None;
+    INIT.call_once(|| {
+        if let Err(e) = ff::init() {
+            err = Some(e.to_string());
+        }
+        ff::util::log::set_level(ff::util::log::Level::Error);
+    });
+    match err {
+        Some(e) => Err(format!("ffmpeg init: {e}")),
+        None => Ok(()),
+    }
+}
+
+/// One MP4 being written.
+pub struct Mp4Writer {
+    octx: ff::format::context::Output,
+    encoder: ff::encoder::Video,
+    scaler: ff::software::scaling::Context,
+    rgba: ff::frame::Video,
+    yuv: ff::frame::Video,
+    enc_tb: ff::Rational,
+    width: u32,
+    height: u32,
+    frames: i64,
+    /// Set by `finish`: the temporary file is now the caller's to rename.
+    done: bool,
+    tmp: PathBuf,
+    path: PathBuf,
+}
+
+fn fferr(what: &str, e: ff::Error) -> String {
+    format!("{what}: {e}")
+}
+
+impl Mp4Writer {
+    pub fn create(
+        path: &Path,
+        width: u32,
+        height: u32,
+        fps: u32,
+        settings: &EncodeSettings,
+    ) -> Result<Mp4Writer, String> {
+        init()?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("video");
+        static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let tmp = dir.join(format!(".{name}.{}.{n}.tmp.mp4", std::process::id()));
+        let mut octx = ff::format::output_as(&tmp, "mp4")
+            .map_err(|e| fferr(&format!("open {}", tmp.display()), e))?;
+        let codec = ff::encoder::find_by_name("libx264")
+            .or_else(|| ff::encoder::find(ff::codec::Id::H264))
+            .ok_or("no H.264 encoder in this FFmpeg build (install libavcodec with libx264)")?;
+        let global_header = octx
+            .format()
+            .flags()
+            .contains(ff::format::Flags::GLOBAL_HEADER);
+        let mut enc = ff::codec::context::Context::new_with_codec(codec)
+            .encoder()
+            .video()
+            .map_err(|e| fferr("video encoder", e))?;
+        let enc_tb = ff::Rational::new(1, fps as i32);
+        enc.set_width(width);
+        enc.set_height(height);
+        enc.set_format(ff::format::Pixel::YUV420P);
+        enc.set_time_base(enc_tb);
+        enc.set_frame_rate(Some(ff::Rational::new(fps as i32, 1)));
+        enc.set_gop(fps.max(1) * 2);
+        if global_header {
+            enc.set_flags(ff::codec::Flags::GLOBAL_HEADER);
+        }
+        let mut opts = ff::Dictionary::new();
+        opts.set("preset", &settings.preset);
+        opts.set("crf", &settings.crf.to_string());
+        opts.set("profile", "high");
+        if settings.threads > 0 {
+            opts.set("threads", &settings.threads.to_string());
+        }
+        let encoder = enc.open_with(opts).map_err(|e| fferr("open libx264", e))?;
+        {
+            let mut st = octx.add_stream(codec).map_err(|e| fferr("add stream", e))?;
+            st.set_parameters(&encoder);
+            st.set_time_base(enc_tb);
+            st.set_rate(ff::Rational::new(fps as i32, 1));
+            st.set_avg_frame_rate(ff::Rational::new(fps as i32, 1));
+        }
+        let mut mopts = ff::Dictionary::new();
+        mopts.set("movflags", "+faststart");
+        octx.write_header_with(mopts)
+            .map_err(|e| fferr("write mp4 header", e))?;
+        let scaler = ff::software::scaling::Context::get(
+            ff::format::Pixel::RGBA,
+            width,
+            height,
+            ff::format::Pixel::YUV420P,
+            width,
+            height,
+            ff::software::scaling::Flags::BILINEAR,
+        )
+        .map_err(|e| fferr("swscale", e))?;
+        Ok(Mp4Writer {
+            octx,
+            encoder,
+            scaler,
+            rgba: ff::frame::Video::new(ff::format::Pixel::RGBA, width, height),
+            yuv: ff::frame::Video::new(ff::format::Pixel::YUV420P, width, height),
+            enc_tb,
+            width,
+            height,
+            frames: 0,
+            done: false,
+            tmp,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Appends one tightly packed RGBA frame.
+    pub fn push(&mut self, rgba: &[u8]) -> Result<(), String> {
+        let row = self.width as usize * 4;
+        if rgba.len() != row * self.height as usize {
+            return Err(format!(
+                "frame of {} bytes, expected {}",
+                rgba.len(),
+                row * self.height as usize
+            ));
+        }
+        let stride = self.rgba.stride(0);
+        let data = self.rgba.data_mut(0);
+        for y in 0..self.height as usize {
+            data[y * stride..y * stride + row].copy_from_slice(&rgba[y * row..(y + 1) * row]);
+        }
+        self.scaler
+            .run(&self.rgba, &mut self.yuv)
+            .map_err(|e| fferr("swscale", e))?;
+        self.yuv.set_pts(Some(self.frames));
+        self.frames += 1;
+        self.encoder
+            .send_frame(&self.yuv)
+            .map_err(|e| fferr("encode", e))?;
+        self.drain()
+    }
+
+    fn drain(&mut self) -> Result<(), String> {
+        let st_tb = self
+            .octx
+            .stream(0)
+            .map(|s| s.time_base())
+            .unwrap_or(self.enc_tb);
+        let mut packet = ff::Packet::empty();
+        while self.encoder.receive_packet(&mut packet).is_ok() {
+            packet.set_stream(0);
+            // The duration must be set before rescaling, or the file ends a frame short.
+            packet.set_duration(1);
+            packet.rescale_ts(self.enc_tb, st_tb);
+            packet
+                .write_interleaved(&mut self.octx)
+                .map_err(|e| fferr("write packet", e))?;
+        }
+        Ok(())
+    }
+
+    /// Flushes the encoder, writes the trailer, syncs and renames into place.
+    pub fn finish(mut self) -> Result<u32, String> {
+        self.encoder.send_eof().map_err(|e| fferr("flush", e))?;
+        self.drain()?;
+        self.octx
+            .write_trailer()
+            .map_err(|e| fferr("write mp4 trailer", e))?;
+        let frames = self.frames as u32;
+        let (tmp, path) = (self.tmp.clone(), self.path.clone());
+        self.done = true;
+        drop(self);
+        let result = std::fs::File::open(&tmp)
+            .and_then(|f| f.sync_all())
+            .and_then(|_| std::fs::rename(&tmp, &path));
+        if let Err(e) = result {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(format!("{}: {e}", path.display()));
+        }
+        Ok(frames)
+    }
+}
+
+impl Drop for Mp4Writer {
+    fn drop(&mut self) {
+        // A writer dropped without `finish` leaves no partial file behind.
+        if !self.done {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// A video encoded on its own thread: frames are sent through a bounded channel, so
+/// rendering (this thread) overlaps with encoding (that one).
+pub struct VideoJob {
+    tx: Option<SyncSender<Vec<u8>>>,
+    handle: Option<JoinHandle<Result<u32, String>>>,
+}
+
+impl VideoJob {
+    pub fn spawn(
+        path: PathBuf,
+        width: u32,
+        height: u32,
+        fps: u32,
+        settings: EncodeSettings,
+    ) -> VideoJob {
+        let (tx, rx) = sync_channel::<Vec<u8>>(8);
+        let handle = std::thread::Builder::new()
+            .name("rh-encode".into())
+            .spawn(move || {
+                let mut writer = Mp4Writer::create(&path, width, height, fps, &settings)?;
+                for frame in rx {
+                    writer.push(&frame)?;
+                }
+                writer.finish()
+            })
+            .expect("spawn encoder thread");
+        VideoJob {
+            tx: Some(tx),
+            handle: Some(handle),
+        }
+    }
+
+    /// Queues a frame; false when the encoder has stopped (its error comes from `finish`).
+    pub fn send(&self, frame: Vec<u8>) -> bool {
+        self.tx.as_ref().is_some_and(|tx| tx.send(frame).is_ok())
+    }
+
+    /// Waits for the file; returns the number of frames written.
+    pub fn finish(mut self) -> Result<u32, String> {
+        drop(self.tx.take());
+        match self.handle.take().map(|h| h.join()) {
+            Some(Ok(r)) => r,
+            _ => Err("encoder thread panicked".into()),
+        }
+    }
+}
+
+impl Drop for VideoJob {
+    fn drop(&mut self) {
+        drop(self.tx.take());
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}

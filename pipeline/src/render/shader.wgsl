@@ -1,0 +1,93 @@
+struct U {
+    view_proj: mat4x4<f32>,
+    light_vp: mat4x4<f32>,
+    cam_pos: vec4<f32>,
+    // Direction the sun light travels (unit), w unused.
+    sun_dir: vec4<f32>,
+    sun_color: vec4<f32>,
+    // rgb ambient; w > 0.5: unlit diagnostic colours.
+    ambient: vec4<f32>,
+};
+
+@group(0) @binding(0) var<uniform> u: U;
+@group(0) @binding(1) var shadow_tex: texture_depth_2d;
+@group(0) @binding(2) var shadow_smp: sampler_comparison;
+
+struct VIn {
+    @location(0) pos: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) color: vec4<f32>,
+};
+
+struct VOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) color: vec4<f32>,
+};
+
+@vertex
+fn vs_main(v: VIn) -> VOut {
+    var o: VOut;
+    o.clip = u.view_proj * vec4<f32>(v.pos, 1.0);
+    o.world = v.pos;
+    o.normal = v.normal;
+    o.color = v.color;
+    return o;
+}
+
+@vertex
+fn vs_shadow(v: VIn) -> @builtin(position) vec4<f32> {
+    return u.light_vp * vec4<f32>(v.pos, 1.0);
+}
+
+fn shadow_factor(world: vec3<f32>, n: vec3<f32>) -> f32 {
+    let lp = u.light_vp * vec4<f32>(world + n * 0.025, 1.0);
+    let ndc = lp.xyz / lp.w;
+    let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+    if (uv.x < 0.0 || uv.x > 1.0 || uv.y < 0.0 || uv.y > 1.0 || ndc.z > 1.0) {
+        return 1.0;
+    }
+    // One comparison tap; the linear comparison sampler filters 2×2 texels (cheap
+    // soft edges on a CPU rasterizer, where every extra tap costs).
+    return textureSampleCompareLevel(shadow_tex, shadow_smp, uv, ndc.z - 0.002);
+}
+
+@fragment
+fn fs_main(i: VOut) -> @location(0) vec4<f32> {
+    var base = i.color.rgb;
+    let m = i.color.a;
+    if (u.ambient.w > 0.5 || m > 2.5) {
+        return vec4<f32>(base, 1.0);
+    }
+    var n = normalize(i.normal);
+    let v = normalize(u.cam_pos.xyz - i.world);
+    if (dot(n, v) < 0.0) {
+        n = -n;
+    }
+    if (m > 0.5 && m < 1.5) {
+        // Floor: 0.5 m tiles with thin grout lines and a slight per-tile tint.
+        let g = i.world.xy * 2.0;
+        let cell = floor(g);
+        let f = fract(g);
+        let checker = (i32(cell.x) + i32(cell.y)) & 1;
+        var k = select(0.96, 1.04, checker == 1);
+        if (min(min(f.x, 1.0 - f.x), min(f.y, 1.0 - f.y)) < 0.012) {
+            k = 0.75;
+        }
+        base = base * k;
+    }
+    let l = -u.sun_dir.xyz;
+    let ndl = max(dot(n, l), 0.0);
+    var sh = 1.0;
+    if (ndl > 0.0) {
+        sh = shadow_factor(i.world, n);
+    }
+    let hemi = 0.8 + 0.2 * n.z;
+    var color = base * (u.ambient.rgb * hemi + u.sun_color.rgb * ndl * sh);
+    if (m > 1.5) {
+        let h = normalize(l + v);
+        color = color + u.sun_color.rgb * pow(max(dot(n, h), 0.0), 48.0) * 0.6 * sh;
+    }
+    return vec4<f32>(min(color, vec3<f32>(1.0)), 1.0);
+}
