@@ -4,7 +4,8 @@
 //! `cargo test --release` runs; a test binary lives in `target/<profile>/deps/`, so the
 //! programs sit one directory up.
 
-use std::path::PathBuf;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// Path of a workspace binary built in the same profile as the running test.
@@ -59,4 +60,28 @@ pub fn python(script: &str) -> String {
         String::from_utf8_lossy(&out.stderr)
     );
     String::from_utf8(out.stdout).expect("utf-8 stdout")
+}
+
+/// Every file below `dir` (following links), keyed by its path relative to `dir`, with
+/// its bytes: for comparing whole dataset trees.
+pub fn files_under(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            // `metadata` follows links (a Hub cache snapshot links into blobs/).
+            if std::fs::metadata(&path).unwrap().is_dir() {
+                stack.push(path);
+            } else {
+                let rel = path
+                    .strip_prefix(dir)
+                    .unwrap()
+                    .to_string_lossy()
+                    .to_string();
+                out.insert(rel, std::fs::read(&path).unwrap());
+            }
+        }
+    }
+    out
 }

@@ -3,8 +3,7 @@
 //! restarted equals an uninterrupted one, and pyarrow and `datasets` load the card's
 //! configs.
 
-use rh_e2e::{bin, python, run, run_ok};
-use std::collections::BTreeMap;
+use rh_e2e::{bin, files_under, python, run, run_ok};
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -39,27 +38,6 @@ fn single() -> &'static (tempfile::TempDir, PathBuf) {
         run_ok("rh-pipeline", &build_args("40", "11", &out));
         (dir, out)
     })
-}
-
-fn files_under(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in fs::read_dir(&d).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                stack.push(path);
-            } else {
-                let rel = path
-                    .strip_prefix(dir)
-                    .unwrap()
-                    .to_string_lossy()
-                    .to_string();
-                out.insert(rel, fs::read(&path).unwrap());
-            }
-        }
-    }
-    out
 }
 
 fn assert_same_tree(a: &Path, b: &Path) {

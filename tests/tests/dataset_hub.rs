@@ -7,7 +7,7 @@
 //! Network rules: loopback only, one server thread that stops when told to (or after two
 //! minutes by itself), bounded request sizes and loops.
 
-use rh_e2e::{bin, run_ok};
+use rh_e2e::{bin, files_under, run_ok};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::io::{Read, Write};
@@ -29,28 +29,6 @@ fn sha256_hex(bytes: &[u8]) -> String {
         .iter()
         .map(|b| format!("{b:02x}"))
         .collect()
-}
-
-fn files_under(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).unwrap() {
-            let path = entry.unwrap().path();
-            // `metadata` follows links (a cache snapshot links into blobs/).
-            if std::fs::metadata(&path).unwrap().is_dir() {
-                stack.push(path);
-            } else {
-                let rel = path
-                    .strip_prefix(dir)
-                    .unwrap()
-                    .to_string_lossy()
-                    .to_string();
-                out.insert(rel, std::fs::read(&path).unwrap());
-            }
-        }
-    }
-    out
 }
 
 /// The stand-in Hub.

@@ -1,8 +1,7 @@
 //! End-to-end tests of the real `rh-pipeline` binary: reproducible builds, the dataset
 //! layout read back by pyarrow, replay verification, and clear errors on bad input.
 
-use rh_e2e::{python, run, run_ok};
-use std::collections::BTreeMap;
+use rh_e2e::{files_under, python, run, run_ok};
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -39,27 +38,6 @@ fn builds() -> &'static (tempfile::TempDir, PathBuf, PathBuf) {
         }
         (dir, a, b)
     })
-}
-
-fn files_under(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in fs::read_dir(&d).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                stack.push(path);
-            } else {
-                let rel = path
-                    .strip_prefix(dir)
-                    .unwrap()
-                    .to_string_lossy()
-                    .to_string();
-                out.insert(rel, fs::read(&path).unwrap());
-            }
-        }
-    }
-    out
 }
 
 #[test]
@@ -349,10 +327,26 @@ fn plan_maps_descriptions_and_rejects_nonsense() {
 fn all_seventeen_families_build_valid_and_replay() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("all");
-    let summary = run_ok("rh-pipeline", &["build", "--n", "340", "--no-render", "--quiet", "--json", "--out", out.to_str().unwrap()]);
+    let summary = run_ok(
+        "rh-pipeline",
+        &[
+            "build",
+            "--n",
+            "340",
+            "--no-render",
+            "--quiet",
+            "--json",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
     let summary: serde_json::Value = serde_json::from_str(&summary).unwrap();
     assert_eq!(summary["scenes"], 340);
-    assert_eq!(summary["valid"], 340, "invalid scenes: {}", summary["invalid_scene_ids"]);
+    assert_eq!(
+        summary["valid"], 340,
+        "invalid scenes: {}",
+        summary["invalid_scene_ids"]
+    );
     let per_family = summary["per_family"].as_object().unwrap();
     assert_eq!(per_family.len(), 17);
     assert!(per_family.values().all(|c| c == 20), "{per_family:?}");
@@ -361,21 +355,49 @@ fn all_seventeen_families_build_valid_and_replay() {
         out.display()
     );
     assert_eq!(python(&script).trim(), "68 5", "every family × band pair");
-    let report: serde_json::Value = serde_json::from_str(&run_ok("rh-pipeline", &["verify", out.to_str().unwrap(), "--json"])).unwrap();
+    let report: serde_json::Value = serde_json::from_str(&run_ok(
+        "rh-pipeline",
+        &["verify", out.to_str().unwrap(), "--json"],
+    ))
+    .unwrap();
     assert_eq!(report["matched"], 340);
 }
 
 #[test]
 fn balance_reports_counts_per_action_per_family() {
-    let out = run_ok("rh-pipeline", &["balance", "--json", "--per-family", "8", "--families", FOUNDATION_FAMILIES]);
+    let out = run_ok(
+        "rh-pipeline",
+        &[
+            "balance",
+            "--json",
+            "--per-family",
+            "8",
+            "--families",
+            FOUNDATION_FAMILIES,
+        ],
+    );
     let rows: serde_json::Value = serde_json::from_str(&out).unwrap();
     let rows = rows.as_array().unwrap();
     assert_eq!(rows.len(), 6);
     for r in rows {
-        let total = ["catch", "dodge", "no_action", "invalid"].iter().map(|k| r[*k].as_u64().unwrap_or(0)).sum::<u64>();
+        let total = ["catch", "dodge", "no_action", "invalid"]
+            .iter()
+            .map(|k| r[*k].as_u64().unwrap_or(0))
+            .sum::<u64>();
         assert_eq!(total, 8, "{r}");
     }
-    let text = run_ok("rh-pipeline", &["balance", "--per-family", "4", "--families", "object_drop"]);
-    assert!(text.contains("object_drop") && text.contains("CATCH"), "{text}");
-    assert_eq!(run("rh-pipeline", &["balance", "--families", "nope"]).status.code(), Some(2));
+    let text = run_ok(
+        "rh-pipeline",
+        &["balance", "--per-family", "4", "--families", "object_drop"],
+    );
+    assert!(
+        text.contains("object_drop") && text.contains("CATCH"),
+        "{text}"
+    );
+    assert_eq!(
+        run("rh-pipeline", &["balance", "--families", "nope"])
+            .status
+            .code(),
+        Some(2)
+    );
 }
