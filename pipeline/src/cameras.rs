@@ -3,7 +3,7 @@
 //! observation window. Cameras never touch physics, so framing after the simulation
 //! changes no state hash; the chosen poses are stored in the spec.
 
-use crate::simulate::Simulation;
+use crate::simulate::{Obstacles, Simulation};
 use crate::spec::{CameraSpec, SceneSpec, Vec3};
 use rand::RngExt;
 
@@ -98,8 +98,9 @@ fn window_steps(spec: &SceneSpec, sim: &Simulation, until_within: f64) -> Vec<u3
         .collect()
 }
 
-/// Whether the hazard's centre stays inside every camera's frame (with `margin`) during
-/// the observation window (see `window_steps`).
+/// Whether the hazard's centre stays inside every camera's frame (with `margin`) and in
+/// its line of sight — no fixed body (table, shelf, wall, stairs) between the camera and
+/// the hazard — during the observation window (see `window_steps`).
 pub fn hazard_in_frame(
     spec: &SceneSpec,
     sim: &Simulation,
@@ -108,13 +109,16 @@ pub fn hazard_in_frame(
 ) -> bool {
     let limit = 1.0 - rules.margin;
     let steps = window_steps(spec, sim, rules.until_within);
+    let obstacles = Obstacles::of(spec);
     cameras.iter().all(|camera| {
         let Some(view) = View::new(camera) else {
             return false;
         };
         steps.iter().all(|&k| {
-            view.project(sim.hazard_position(k))
+            let p = sim.hazard_position(k);
+            view.project(p)
                 .is_some_and(|[x, y]| x.abs() <= limit && y.abs() <= limit)
+                && !obstacles.blocks(camera.position, p)
         })
     })
 }
@@ -272,4 +276,43 @@ pub fn draw(spec: &SceneSpec, k: u32, path: &[Vec3], margin: f64) -> Option<Vec<
     }
     let overhead = overhead?;
     Some(vec![ego, closeup, overhead])
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::config::Config;
+    use crate::randomize::{randomize, SceneKey};
+    use crate::simulate::Obstacles;
+    use crate::spec::{Selection, ShapeSpec};
+    use rh_catalog::Catalog;
+
+    #[test]
+    fn furniture_blocks_the_line_of_sight() {
+        let catalog = Catalog::embedded().unwrap();
+        let config = Config::embedded().unwrap();
+        let selection = Selection {
+            family: "object_drop".into(),
+            object_id: "apple".into(),
+            room_id: "kitchen".into(),
+            description: None,
+        };
+        let spec = randomize(&selection, &SceneKey::new(0, 0, 0), &catalog, &config).unwrap();
+        let table = &spec.bodies[spec.source_support.unwrap()];
+        let ShapeSpec::Box { half_extents } = table.parts[0].shape else {
+            panic!("the table is a box")
+        };
+        let [x, y, _] = table.position;
+        let top = table.position[2] + half_extents[2];
+        let obstacles = Obstacles::of(&spec);
+        // Straight through the table's middle, under its top: blocked.
+        let low = top / 2.0;
+        assert!(obstacles.blocks([x - 3.0, y, low], [x + 3.0, y, low]));
+        assert!(obstacles.blocks([x, y - 3.0, low], [x, y + 3.0, low]));
+        // Over the top, or beside it: clear.
+        assert!(!obstacles.blocks([x - 3.0, y, top + 0.2], [x + 3.0, y, top + 0.2]));
+        assert!(!obstacles.blocks([x + 3.0, y + 3.0, low], [x + 3.0, y - 3.0, low]));
+        // The hazard itself (a dynamic body) never blocks.
+        let h = spec.hazard_body().position;
+        assert!(!obstacles.blocks([h[0], h[1], h[2] + 1.0], h));
+    }
 }

@@ -141,19 +141,60 @@ fn axis_fix(shape: &ShapeSpec) -> Rotation {
     }
 }
 
-fn collider_for(parts: &[PartSpec]) -> ColliderBuilder {
-    let posed: Vec<(Pose, SharedShape)> = parts
+/// A body's parts as (pose in the body frame, shape) pairs.
+fn posed_parts(parts: &[PartSpec]) -> Vec<(Pose, SharedShape)> {
+    parts
         .iter()
         .map(|p| {
             let pose = Pose::from_parts(v3(p.offset), rot(p.rotation) * axis_fix(&p.shape));
             (pose, shared_shape(&p.shape))
         })
-        .collect();
+        .collect()
+}
+
+fn collider_for(parts: &[PartSpec]) -> ColliderBuilder {
+    let posed = posed_parts(parts);
     if posed.len() == 1 {
         let (pose, shape) = posed.into_iter().next().expect("one part");
         ColliderBuilder::new(shape).position(pose)
     } else {
         ColliderBuilder::compound(posed)
+    }
+}
+
+/// The spec's fixed bodies (furniture, walls, stairs) as world-posed shapes, for line-of-
+/// sight queries: `Obstacles::blocks` says whether a segment passes through any of them.
+pub struct Obstacles {
+    parts: Vec<(Pose, SharedShape)>,
+}
+
+impl Obstacles {
+    pub fn of(spec: &SceneSpec) -> Obstacles {
+        let parts = spec
+            .bodies
+            .iter()
+            .filter(|b| b.kind == BodyKind::Fixed)
+            .flat_map(|b| {
+                let body_pose = Pose::from_parts(v3(b.position), rot(b.rotation));
+                posed_parts(&b.parts)
+                    .into_iter()
+                    .map(move |(pose, shape)| (body_pose * pose, shape))
+            })
+            .collect();
+        Obstacles { parts }
+    }
+
+    /// Whether the straight segment from `a` to `b` passes through a fixed body.
+    pub fn blocks(&self, a: [f64; 3], b: [f64; 3]) -> bool {
+        let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        if length < 1e-9 {
+            return false;
+        }
+        let ray = rapier3d::parry::query::Ray::new(v3(a), v3(d.map(|c| c / length)));
+        self.parts
+            .iter()
+            .any(|(pose, shape)| shape.cast_ray(pose, &ray, length as Real, true).is_some())
     }
 }
 
