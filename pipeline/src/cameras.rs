@@ -4,6 +4,7 @@
 //! changes no state hash; the chosen poses are stored in the spec.
 
 use crate::simulate::{Obstacles, Simulation};
+use crate::spec::vec3::{cross, dot, norm, scale, sub};
 use crate::spec::{CameraSpec, SceneSpec, Vec3};
 use rand::RngExt;
 
@@ -27,26 +28,6 @@ pub struct View {
     forward: Vec3,
     tan_half_y: f64,
     tan_half_x: f64,
-}
-
-fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn norm(a: Vec3) -> f64 {
-    dot(a, a).sqrt()
-}
-fn scale(a: Vec3, s: f64) -> Vec3 {
-    [a[0] * s, a[1] * s, a[2] * s]
 }
 
 impl View {

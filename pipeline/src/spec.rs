@@ -329,8 +329,37 @@ impl SceneSpec {
     }
 }
 
+/// Vector helpers for the spec's plain `[f64; 3]` arrays.
+pub mod vec3 {
+    use super::Vec3;
+
+    pub fn add(a: Vec3, b: Vec3) -> Vec3 {
+        [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+    }
+    pub fn sub(a: Vec3, b: Vec3) -> Vec3 {
+        [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+    }
+    pub fn dot(a: Vec3, b: Vec3) -> f64 {
+        a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    }
+    pub fn cross(a: Vec3, b: Vec3) -> Vec3 {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    }
+    pub fn norm(a: Vec3) -> f64 {
+        dot(a, a).sqrt()
+    }
+    pub fn scale(a: Vec3, s: f64) -> Vec3 {
+        [a[0] * s, a[1] * s, a[2] * s]
+    }
+}
+
 /// Quaternion helpers (the spec keeps rotations as plain arrays).
 pub mod quat {
+    use super::vec3::cross;
     use super::{Quat, Vec3};
 
     /// Rotation of `angle` radians about a unit `axis`.
@@ -360,14 +389,6 @@ pub mod quat {
             v[0] + 2.0 * (w * uv[0] + uuv[0]),
             v[1] + 2.0 * (w * uv[1] + uuv[1]),
             v[2] + 2.0 * (w * uv[2] + uuv[2]),
-        ]
-    }
-
-    fn cross(a: Vec3, b: Vec3) -> Vec3 {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
         ]
     }
 }

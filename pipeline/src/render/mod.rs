@@ -22,6 +22,7 @@ pub mod recipes;
 
 use crate::config::RenderConfig;
 use crate::simulate::Simulation;
+use crate::spec::vec3::{add, cross, dot, norm, scale, sub};
 use crate::spec::{BodyKind, CameraSpec, JointKind, SceneSpec, Vec3};
 use encode::{EncodeSettings, VideoJob};
 use gpu::{Gpu, Uniforms, ViewJob};
@@ -558,29 +559,6 @@ pub fn full_event_camera(
         width,
         height,
     })
-}
-
-fn add(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn norm(a: Vec3) -> f64 {
-    dot(a, a).sqrt()
-}
-fn scale(a: Vec3, s: f64) -> Vec3 {
-    [a[0] * s, a[1] * s, a[2] * s]
 }
 
 // ---------------------------------------------------------------------------------------
