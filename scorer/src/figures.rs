@@ -206,14 +206,7 @@ fn per_family<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> 
     chart
         .configure_mesh()
         .y_labels(n + 1)
-        .y_label_formatter(&|y| {
-            let i = y.round();
-            if (y - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
-                names[names.len() - 1 - i as usize].to_string()
-            } else {
-                String::new()
-            }
-        })
+        .y_label_formatter(&|y| category_label(&names, *y))
         .disable_y_mesh()
         .x_desc("SAA (%)")
         .label_style((FONT, 12))
@@ -271,14 +264,7 @@ fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -
     chart
         .configure_mesh()
         .y_labels(n + 1)
-        .y_label_formatter(&|y| {
-            let i = y.round();
-            if (y - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
-                names[names.len() - 1 - i as usize].clone()
-            } else {
-                String::new()
-            }
-        })
+        .y_label_formatter(&|y| category_label(&names, *y))
         .disable_y_mesh()
         .x_desc("decisions (%)")
         .label_style((FONT, 12))
@@ -342,4 +328,15 @@ pub fn write_figures(r: &Report, dir: &Path) -> Result<Vec<std::path::PathBuf>> 
     both!(dir, "per_family", (1080, fam_h), per_family, r, out);
     both!(dir, "safety_rules", (1180, safety_h), safety_rules, r, out);
     Ok(out)
+}
+
+/// Label of a horizontal bar chart's category axis: bar `i` (counted from the bottom) shows
+/// `names[len − 1 − i]`, so the first name is at the top; off-integer ticks stay blank.
+fn category_label<S: AsRef<str>>(names: &[S], y: f64) -> String {
+    let i = y.round();
+    if (y - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
+        names[names.len() - 1 - i as usize].as_ref().to_string()
+    } else {
+        String::new()
+    }
 }
