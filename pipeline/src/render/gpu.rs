@@ -19,6 +19,10 @@ pub struct Uniforms {
     pub sun_dir: [f32; 4],
     pub sun_color: [f32; 4],
     pub ambient: [f32; 4],
+    /// Clear colour (rgb), for the fill pass that re-clears a scissored region.
+    pub background: [f32; 4],
+    /// Set by `Gpu`: the fill pass's rectangles (NDC x0, y0, x1, y1), one per instance.
+    pub fill_rects: [[f32; 4]; MAX_REDRAW_RECTS],
 }
 
 /// One view to draw: the output slot (its own target), uniforms and vertex ranges.
@@ -30,13 +34,33 @@ pub struct ViewJob {
     pub ranges: Vec<Range<u32>>,
 }
 
+/// Most rectangles one overlay view redraws (more are merged by the caller).
+pub const MAX_REDRAW_RECTS: usize = 8;
+
+/// One view drawn over its cached static image (see [`Gpu::cache_static`]): each
+/// `redraw` rectangle (x, y, width, height in pixels: where moving bodies may cast
+/// shadows; at most `MAX_REDRAW_RECTS`) is re-cleared and its static ranges drawn
+/// again, then the moving bodies are drawn everywhere.
+pub struct OverlayJob {
+    pub slot: usize,
+    pub uniforms: Uniforms,
+    pub redraw: Vec<([u32; 4], Vec<Range<u32>>)>,
+    pub dynamic: Range<u32>,
+}
+
 struct Target {
     width: u32,
     height: u32,
-    msaa: Option<wgpu::TextureView>,
+    /// The multisampled colour attachment (`None` without MSAA: `resolve` is drawn into).
+    msaa: Option<(wgpu::Texture, wgpu::TextureView)>,
     resolve: wgpu::Texture,
     resolve_view: wgpu::TextureView,
-    depth: wgpu::TextureView,
+    depth: wgpu::Texture,
+    depth_view: wgpu::TextureView,
+    /// The static scene's colour and depth (same sample count as the attachments),
+    /// copied in before each overlay frame.
+    cache_color: wgpu::Texture,
+    cache_depth: wgpu::Texture,
     readback: wgpu::Buffer,
     padded_row: u32,
     uniform: wgpu::Buffer,
@@ -49,9 +73,13 @@ pub struct Gpu {
     pub adapter_name: String,
     samples: u32,
     main: wgpu::RenderPipeline,
+    fill: wgpu::RenderPipeline,
     shadow: wgpu::RenderPipeline,
     main_bgl: wgpu::BindGroupLayout,
+    shadow_tex: wgpu::Texture,
     shadow_view: wgpu::TextureView,
+    /// Shadow map of the fixed casters only (see [`Gpu::cache_static`]).
+    static_shadow: wgpu::Texture,
     shadow_sampler: wgpu::Sampler,
     shadow_uniform: wgpu::Buffer,
     shadow_bind: wgpu::BindGroup,
@@ -59,6 +87,28 @@ pub struct Gpu {
     vcap: u64,
     static_len: u32,
     targets: Vec<Option<Target>>,
+}
+
+/// What a lit pass draws of the static scene.
+#[derive(Debug, Clone, Copy)]
+enum Redraw<'a> {
+    /// Everything, from a cleared target: these ranges.
+    Whole(&'a [Range<u32>]),
+    /// Over the copied-in static image, per pixel rectangle (x, y, width, height; none
+    /// empty) these ranges; `[]` redraws nothing.
+    Regions(&'a [([u32; 4], &'a [Range<u32>])]),
+}
+
+/// What differs between the render pipelines.
+struct PipelineDesc<'a> {
+    label: &'static str,
+    layout: &'a wgpu::PipelineLayout,
+    vertex: &'static str,
+    vertex_buffer: bool,
+    fragment: Option<&'static str>,
+    depth_compare: wgpu::CompareFunction,
+    depth_bias: wgpu::DepthBiasState,
+    samples: u32,
 }
 
 const VERTEX_ATTRS: [wgpu::VertexAttribute; 3] =
@@ -150,87 +200,102 @@ impl Gpu {
             attributes: &VERTEX_ATTRS,
         })];
         let main_layout = layout(&main_bgl);
-        let main = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("main"),
-            layout: Some(&main_layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &vlayout,
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: wgpu::MultisampleState {
-                count: samples,
-                ..Default::default()
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: COLOR_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
         let shadow_layout = layout(&shadow_bgl);
-        let shadow = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("shadow"),
-            layout: Some(&shadow_layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_shadow"),
-                compilation_options: Default::default(),
-                buffers: &vlayout,
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: wgpu::DepthBiasState {
-                    constant: 2,
-                    slope_scale: 2.0,
-                    clamp: 0.0,
+        let pipeline = |p: PipelineDesc| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(p.label),
+                layout: Some(p.layout),
+                vertex: wgpu::VertexState {
+                    module: &shader,
+                    entry_point: Some(p.vertex),
+                    compilation_options: Default::default(),
+                    buffers: if p.vertex_buffer { &vlayout } else { &[] },
                 },
-            }),
-            multisample: Default::default(),
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(p.depth_compare),
+                    stencil: Default::default(),
+                    bias: p.depth_bias,
+                }),
+                multisample: wgpu::MultisampleState {
+                    count: p.samples,
+                    ..Default::default()
+                },
+                fragment: p.fragment.map(|entry| wgpu::FragmentState {
+                    module: &shader,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: COLOR_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let main = pipeline(PipelineDesc {
+            label: "main",
+            layout: &main_layout,
+            vertex: "vs_main",
+            vertex_buffer: true,
+            fragment: Some("fs_main"),
+            depth_compare: wgpu::CompareFunction::Less,
+            depth_bias: Default::default(),
+            samples,
+        });
+        // Re-clears a scissored region (depth 1, background colour) before it is redrawn.
+        let fill = pipeline(PipelineDesc {
+            label: "fill",
+            layout: &main_layout,
+            vertex: "vs_fill",
+            vertex_buffer: false,
+            fragment: Some("fs_fill"),
+            depth_compare: wgpu::CompareFunction::Always,
+            depth_bias: Default::default(),
+            samples,
+        });
+        let shadow = pipeline(PipelineDesc {
+            label: "shadow",
+            layout: &shadow_layout,
+            vertex: "vs_shadow",
+            vertex_buffer: true,
             fragment: None,
-            multiview_mask: None,
-            cache: None,
-        });
-        let shadow_tex = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("shadow-map"),
-            size: wgpu::Extent3d {
-                width: SHADOW_SIZE,
-                height: SHADOW_SIZE,
-                depth_or_array_layers: 1,
+            depth_compare: wgpu::CompareFunction::Less,
+            depth_bias: wgpu::DepthBiasState {
+                constant: 2,
+                slope_scale: 2.0,
+                clamp: 0.0,
             },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
+            samples: 1,
         });
+        let shadow_map = |label| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: SHADOW_SIZE,
+                    height: SHADOW_SIZE,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: DEPTH_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC
+                    | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            })
+        };
+        let shadow_tex = shadow_map("shadow-map");
+        let static_shadow = shadow_map("static-shadow-map");
         let shadow_view = shadow_tex.create_view(&Default::default());
         let shadow_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("shadow-sampler"),
@@ -256,9 +321,12 @@ impl Gpu {
             adapter_name,
             samples,
             main,
+            fill,
             shadow,
             main_bgl,
+            shadow_tex,
             shadow_view,
+            static_shadow,
             shadow_sampler,
             shadow_uniform,
             shadow_bind,
@@ -341,26 +409,27 @@ impl Gpu {
                 view_formats: &[],
             })
         };
+        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::COPY_DST;
+        let copy_only = wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST;
         let msaa = (self.samples > 1).then(|| {
-            tex(
-                self.samples,
-                COLOR_FORMAT,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-            )
-            .create_view(&Default::default())
+            let t = tex(self.samples, COLOR_FORMAT, attachment);
+            let v = t.create_view(&Default::default());
+            (t, v)
         });
-        let resolve = tex(
-            1,
-            COLOR_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        );
+        let resolve = tex(1, COLOR_FORMAT, attachment);
         let resolve_view = resolve.create_view(&Default::default());
-        let depth = tex(
-            self.samples,
-            DEPTH_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT,
-        )
-        .create_view(&Default::default());
+        let depth = tex(self.samples, DEPTH_FORMAT, attachment);
+        let depth_view = depth.create_view(&Default::default());
+        // Copies need no render usage, but a multisampled texture must be renderable.
+        let cache_usage = if self.samples > 1 {
+            attachment
+        } else {
+            copy_only
+        };
+        let cache_color = tex(self.samples, COLOR_FORMAT, cache_usage);
+        let cache_depth = tex(self.samples, DEPTH_FORMAT, attachment);
         let padded_row = (width * 4).div_ceil(256) * 256;
         let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: None,
@@ -394,6 +463,9 @@ impl Gpu {
             resolve,
             resolve_view,
             depth,
+            depth_view,
+            cache_color,
+            cache_depth,
             readback,
             padded_row,
             uniform,
@@ -408,131 +480,298 @@ impl Gpu {
         light_vp: [[f32; 4]; 4],
         casters: &[Range<u32>],
         views: &[ViewJob],
-        background: [f64; 3],
     ) -> Result<Vec<Vec<u8>>, RenderError> {
         for v in views {
             self.target(v.slot, v.width, v.height);
+            self.write_uniforms(v.slot, &v.uniforms, Redraw::Whole(&[]));
         }
+        self.write_shadow_uniforms(light_vp);
+        let mut enc = self.encoder();
+        self.shadow_pass(&mut enc, casters, true);
+        for v in views {
+            let t = self.targets[v.slot].as_ref().unwrap();
+            self.main_pass(&mut enc, t, Redraw::Whole(&v.ranges), &[]);
+            Self::copy_to_readback(&mut enc, t);
+        }
+        self.queue.submit([enc.finish()]);
+        self.read_back(views.iter().map(|v| v.slot))
+    }
+
+    /// Renders the fixed casters' shadow map and each view's static geometry once, and
+    /// keeps them: [`Gpu::draw_overlay`] then starts every frame from these images
+    /// instead of drawing the room, furniture and observer again (the cameras do not
+    /// move within a scene).
+    pub fn cache_static(
+        &mut self,
+        light_vp: [[f32; 4]; 4],
+        casters: &[Range<u32>],
+        views: &[ViewJob],
+    ) -> Result<(), RenderError> {
+        for v in views {
+            self.target(v.slot, v.width, v.height);
+            self.write_uniforms(v.slot, &v.uniforms, Redraw::Whole(&[]));
+        }
+        self.write_shadow_uniforms(light_vp);
+        let mut enc = self.encoder();
+        self.shadow_pass(&mut enc, casters, true);
+        copy_whole(
+            &mut enc,
+            &self.shadow_tex,
+            &self.static_shadow,
+            SHADOW_SIZE,
+            SHADOW_SIZE,
+        );
+        for v in views {
+            let t = self.targets[v.slot].as_ref().unwrap();
+            self.main_pass(&mut enc, t, Redraw::Whole(&v.ranges), &[]);
+            copy_whole(&mut enc, t.color(), &t.cache_color, t.width, t.height);
+            copy_whole(&mut enc, &t.depth, &t.cache_depth, t.width, t.height);
+        }
+        self.queue.submit([enc.finish()]);
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| RenderError::Gpu(format!("poll: {e}")))?;
+        Ok(())
+    }
+
+    /// One frame over the cached static images (same pixels as [`Gpu::draw`] of the
+    /// whole scene when each job's `redraw` covers every static pixel a moving caster
+    /// can shade): adds `casters` to the cached shadow map, re-clears and redraws the
+    /// static geometry inside `redraw`, then draws the moving bodies.
+    pub fn draw_overlay(
+        &mut self,
+        light_vp: [[f32; 4]; 4],
+        casters: &[Range<u32>],
+        views: &[OverlayJob],
+    ) -> Result<Vec<Vec<u8>>, RenderError> {
+        let mut redraws = Vec::with_capacity(views.len());
+        for v in views {
+            if self.targets.get(v.slot).is_none_or(Option::is_none) {
+                return Err(RenderError::Gpu(format!(
+                    "view slot {} has no cached static image",
+                    v.slot
+                )));
+            }
+            if v.redraw.len() > MAX_REDRAW_RECTS {
+                return Err(RenderError::Gpu(format!(
+                    "{} redraw rectangles (at most {MAX_REDRAW_RECTS})",
+                    v.redraw.len()
+                )));
+            }
+            let rects: Vec<([u32; 4], &[Range<u32>])> = v
+                .redraw
+                .iter()
+                .filter(|(r, _)| r[2] > 0 && r[3] > 0)
+                .map(|(r, ranges)| (*r, &ranges[..]))
+                .collect();
+            self.write_uniforms(v.slot, &v.uniforms, Redraw::Regions(&rects));
+            redraws.push(rects);
+        }
+        self.write_shadow_uniforms(light_vp);
+        let mut enc = self.encoder();
+        copy_whole(
+            &mut enc,
+            &self.static_shadow,
+            &self.shadow_tex,
+            SHADOW_SIZE,
+            SHADOW_SIZE,
+        );
+        self.shadow_pass(&mut enc, casters, false);
+        for (v, rects) in views.iter().zip(&redraws) {
+            let t = self.targets[v.slot].as_ref().unwrap();
+            copy_whole(&mut enc, &t.cache_color, t.color(), t.width, t.height);
+            copy_whole(&mut enc, &t.cache_depth, &t.depth, t.width, t.height);
+            let redraw = Redraw::Regions(rects);
+            self.main_pass(&mut enc, t, redraw, std::slice::from_ref(&v.dynamic));
+            Self::copy_to_readback(&mut enc, t);
+        }
+        self.queue.submit([enc.finish()]);
+        self.read_back(views.iter().map(|v| v.slot))
+    }
+
+    fn encoder(&self) -> wgpu::CommandEncoder {
+        self.device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None })
+    }
+
+    /// Writes a view's uniforms, with the fill rectangles of `redraw`.
+    fn write_uniforms(&self, slot: usize, u: &Uniforms, redraw: Redraw) {
+        let t = self.targets[slot].as_ref().unwrap();
+        let mut u = *u;
+        let (fw, fh) = (t.width as f32, t.height as f32);
+        u.fill_rects = [[-1.0, -1.0, 1.0, 1.0]; MAX_REDRAW_RECTS];
+        if let Redraw::Regions(rects) = redraw {
+            for (ndc, &([x, y, w, h], _)) in u.fill_rects.iter_mut().zip(rects) {
+                *ndc = [
+                    x as f32 / fw * 2.0 - 1.0,
+                    1.0 - (y + h) as f32 / fh * 2.0,
+                    (x + w) as f32 / fw * 2.0 - 1.0,
+                    1.0 - y as f32 / fh * 2.0,
+                ];
+            }
+        }
+        self.queue
+            .write_buffer(&t.uniform, 0, bytemuck::bytes_of(&u));
+    }
+
+    fn write_shadow_uniforms(&self, light_vp: [[f32; 4]; 4]) {
         let mut su: Uniforms = bytemuck::Zeroable::zeroed();
         su.light_vp = light_vp;
         su.view_proj = light_vp;
         self.queue
             .write_buffer(&self.shadow_uniform, 0, bytemuck::bytes_of(&su));
-        for v in views {
-            let t = self.targets[v.slot].as_ref().unwrap();
-            self.queue
-                .write_buffer(&t.uniform, 0, bytemuck::bytes_of(&v.uniforms));
-        }
-        let mut enc = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-        {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shadow"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &self.shadow_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
+    }
+
+    /// Depth of `casters` into the shadow map, cleared first or added to what is there.
+    fn shadow_pass(&self, enc: &mut wgpu::CommandEncoder, casters: &[Range<u32>], clear: bool) {
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("shadow"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.shadow_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: if clear {
+                        wgpu::LoadOp::Clear(1.0)
+                    } else {
+                        wgpu::LoadOp::Load
+                    },
+                    store: wgpu::StoreOp::Store,
                 }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.shadow);
-            pass.set_bind_group(0, &self.shadow_bind, &[]);
-            pass.set_vertex_buffer(0, self.vbuf.slice(..));
-            for r in casters {
-                if !r.is_empty() {
-                    pass.draw(r.clone(), 0..1);
-                }
-            }
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.shadow);
+        pass.set_bind_group(0, &self.shadow_bind, &[]);
+        pass.set_vertex_buffer(0, self.vbuf.slice(..));
+        for r in casters.iter().filter(|r| !r.is_empty()) {
+            pass.draw(r.clone(), 0..1);
         }
-        let [br, bg, bb] = background;
-        for v in views {
-            let t = self.targets[v.slot].as_ref().unwrap();
-            {
-                let (view, resolve) = match &t.msaa {
-                    Some(m) => (m, Some(&t.resolve_view)),
-                    None => (&t.resolve_view, None),
-                };
-                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("main"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view,
-                        depth_slice: None,
-                        resolve_target: resolve,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color {
-                                r: br,
-                                g: bg,
-                                b: bb,
-                                a: 1.0,
-                            }),
-                            store: if resolve.is_some() {
-                                wgpu::StoreOp::Discard
-                            } else {
-                                wgpu::StoreOp::Store
-                            },
-                        },
-                    })],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &t.depth,
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
-                            store: wgpu::StoreOp::Discard,
-                        }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&self.main);
-                pass.set_bind_group(0, &t.bind, &[]);
-                pass.set_vertex_buffer(0, self.vbuf.slice(..));
-                for r in &v.ranges {
-                    if !r.is_empty() {
-                        pass.draw(r.clone(), 0..1);
-                    }
-                }
-            }
-            enc.copy_texture_to_buffer(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &t.resolve,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::TexelCopyBufferInfo {
-                    buffer: &t.readback,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(t.padded_row),
-                        rows_per_image: Some(t.height),
+    }
+
+    /// One lit pass into a target. `Redraw::Whole` clears it and draws its ranges;
+    /// `Redraw::Regions` continues from the copied-in static image and re-clears and
+    /// redraws each rectangle (scissored). `dynamic` is then drawn over the whole target.
+    /// The colour is resolved (MSAA) at the end.
+    fn main_pass(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        t: &Target,
+        redraw: Redraw,
+        dynamic: &[Range<u32>],
+    ) {
+        let (view, resolve) = match &t.msaa {
+            Some((_, m)) => (m, Some(&t.resolve_view)),
+            None => (&t.resolve_view, None),
+        };
+        let whole = matches!(redraw, Redraw::Whole(_));
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("main"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: resolve,
+                ops: wgpu::Operations {
+                    // A whole frame is cleared by the fill draw below.
+                    load: if whole {
+                        wgpu::LoadOp::Clear(wgpu::Color::BLACK)
+                    } else {
+                        wgpu::LoadOp::Load
+                    },
+                    // Whole frames may become the static cache; overlays need only the
+                    // resolved image.
+                    store: if whole || resolve.is_none() {
+                        wgpu::StoreOp::Store
+                    } else {
+                        wgpu::StoreOp::Discard
                     },
                 },
-                wgpu::Extent3d {
-                    width: t.width,
-                    height: t.height,
-                    depth_or_array_layers: 1,
-                },
-            );
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &t.depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: if whole {
+                        wgpu::LoadOp::Clear(1.0)
+                    } else {
+                        wgpu::LoadOp::Load
+                    },
+                    store: if whole {
+                        wgpu::StoreOp::Store
+                    } else {
+                        wgpu::StoreOp::Discard
+                    },
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, &t.bind, &[]);
+        pass.set_vertex_buffer(0, self.vbuf.slice(..));
+        let full;
+        let rects = match redraw {
+            Redraw::Whole(ranges) => {
+                full = [([0, 0, t.width, t.height], ranges)];
+                &full[..]
+            }
+            Redraw::Regions(r) => r,
+        };
+        for (i, &([x, y, w, h], statics)) in rects.iter().enumerate() {
+            pass.set_scissor_rect(x, y, w, h);
+            // Clearing by drawing (not LoadOp::Clear's colour) keeps the background
+            // bit-identical between whole frames and redrawn regions.
+            pass.set_pipeline(&self.fill);
+            pass.draw(0..6, i as u32..i as u32 + 1);
+            pass.set_pipeline(&self.main);
+            for r in statics.iter().filter(|r| !r.is_empty()) {
+                pass.draw(r.clone(), 0..1);
+            }
         }
-        self.queue.submit([enc.finish()]);
-        for v in views {
-            let t = self.targets[v.slot].as_ref().unwrap();
+        pass.set_scissor_rect(0, 0, t.width, t.height);
+        pass.set_pipeline(&self.main);
+        for r in dynamic.iter().filter(|r| !r.is_empty()) {
+            pass.draw(r.clone(), 0..1);
+        }
+    }
+
+    fn copy_to_readback(enc: &mut wgpu::CommandEncoder, t: &Target) {
+        enc.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: &t.resolve,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &t.readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(t.padded_row),
+                    rows_per_image: Some(t.height),
+                },
+            },
+            extent(t.width, t.height),
+        );
+    }
+
+    /// Waits for the submitted work and returns the slots' images, tightly packed.
+    fn read_back(
+        &self,
+        slots: impl Iterator<Item = usize> + Clone,
+    ) -> Result<Vec<Vec<u8>>, RenderError> {
+        for slot in slots.clone() {
+            let t = self.targets[slot].as_ref().unwrap();
             t.readback.slice(..).map_async(wgpu::MapMode::Read, |_| {});
         }
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| RenderError::Gpu(format!("poll: {e}")))?;
-        let mut out = Vec::with_capacity(views.len());
-        for v in views {
-            let t = self.targets[v.slot].as_ref().unwrap();
+        let mut out = Vec::new();
+        for slot in slots {
+            let t = self.targets[slot].as_ref().unwrap();
             let row = t.width as usize * 4;
             let mut img = vec![0u8; row * t.height as usize];
             {
@@ -551,6 +790,41 @@ impl Gpu {
         }
         Ok(out)
     }
+}
+
+impl Target {
+    /// The colour attachment drawn into (multisampled when MSAA is on).
+    fn color(&self) -> &wgpu::Texture {
+        match &self.msaa {
+            Some((t, _)) => t,
+            None => &self.resolve,
+        }
+    }
+}
+
+fn extent(width: u32, height: u32) -> wgpu::Extent3d {
+    wgpu::Extent3d {
+        width,
+        height,
+        depth_or_array_layers: 1,
+    }
+}
+
+/// Copies a whole single-level texture (colour or depth, any sample count).
+fn copy_whole(
+    enc: &mut wgpu::CommandEncoder,
+    from: &wgpu::Texture,
+    to: &wgpu::Texture,
+    width: u32,
+    height: u32,
+) {
+    let info = |texture| wgpu::TexelCopyTextureInfo {
+        texture,
+        mip_level: 0,
+        origin: wgpu::Origin3d::ZERO,
+        aspect: wgpu::TextureAspect::All,
+    };
+    enc.copy_texture_to_texture(info(from), info(to), extent(width, height));
 }
 
 fn uniform_buffer(device: &wgpu::Device) -> wgpu::Buffer {

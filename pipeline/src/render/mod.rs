@@ -25,7 +25,7 @@ use crate::simulate::Simulation;
 use crate::spec::vec3::{add, cross, dot, norm, scale, sub};
 use crate::spec::{BodyKind, CameraSpec, JointKind, SceneSpec, Vec3};
 use encode::{EncodeSettings, VideoJob};
-use gpu::{Gpu, Uniforms, ViewJob};
+use gpu::{Gpu, OverlayJob, Uniforms, ViewJob};
 use mesh::*;
 use rh_catalog::Catalog;
 use std::cell::RefCell;
@@ -200,6 +200,18 @@ impl Renderer {
         self.gpu
             .reserve(scene.statics.len() + scene.max_dynamic + 1024);
         self.gpu.set_static(&scene.statics);
+        // The cameras stand still within a scene: the room, furniture and observer are
+        // drawn once per view and every frame starts from that image.
+        let full_cam = full_event_camera(spec, sim, self.opts.full_width, self.opts.full_height);
+        let mut all_cams = cams.clone();
+        all_cams.push(&full_cam);
+        let static_views: Vec<ViewJob> = all_cams
+            .iter()
+            .enumerate()
+            .map(|(slot, cam)| scene.view_job(slot, cam, Shading::Lit, scene.ranges_for(cam)))
+            .collect();
+        self.gpu
+            .cache_static(scene.light_vp, &scene.static_casters(), &static_views)?;
 
         let fps = spec.video.fps;
         let frames = (spec.observation_window_s * fps as f64).round() as u32;
@@ -239,7 +251,7 @@ impl Renderer {
         let mut result = Ok(());
         for (k, &step) in frame_steps.iter().enumerate() {
             let t = std::time::Instant::now();
-            let images = self.draw_step(&scene, sim, step, &cams, Shading::Lit)?;
+            let images = self.draw_overlay_step(&scene, sim, step, &cams, 0)?;
             t_draw += t.elapsed().as_secs_f64();
             for (ci, (img, job)) in images.into_iter().zip(&jobs).enumerate() {
                 for (ti, &(pk, t)) in png_frames.iter().enumerate() {
@@ -265,7 +277,6 @@ impl Renderer {
 
         // Full-event video: the whole simulation from outside.
         let full_fps = self.opts.full_fps.max(1);
-        let full_cam = full_event_camera(spec, sim, self.opts.full_width, self.opts.full_height);
         let duration = sim.steps() as f64 * sim.dt;
         let full_frames = (duration * full_fps as f64 + 1e-9).floor() as u32;
         let full_event_steps: Vec<u32> = (0..=full_frames)
@@ -281,7 +292,8 @@ impl Renderer {
         );
         if result.is_ok() {
             for &step in &full_event_steps {
-                let mut images = self.draw_step(&scene, sim, step, &[&full_cam], Shading::Lit)?;
+                let mut images =
+                    self.draw_overlay_step(&scene, sim, step, &[&full_cam], cams.len())?;
                 if !full_job.send(images.pop().unwrap()) {
                     break;
                 }
@@ -381,6 +393,7 @@ impl Renderer {
             .collect())
     }
 
+    /// The whole scene at one step, drawn from scratch (diagnostics and single frames).
     fn draw_step(
         &mut self,
         scene: &SceneGeometry,
@@ -395,23 +408,247 @@ impl Renderer {
             .iter()
             .enumerate()
             .map(|(slot, cam)| {
-                // Front to back, roughly (moving objects, furniture, then the room
-                // shell): early depth rejection saves fragment work on a CPU rasterizer.
-                let mut ranges = vec![dyn_range.clone()];
-                ranges.extend(scene.ranges_for(cam));
-                ViewJob {
-                    slot,
-                    width: cam.width,
-                    height: cam.height,
-                    uniforms: scene.uniforms(cam, shading),
-                    ranges,
-                }
+                let mut ranges = scene.ranges_for(cam);
+                ranges.push(dyn_range.clone());
+                scene.view_job(slot, cam, shading, ranges)
             })
             .collect();
-        let casters = [scene.fixed.clone(), scene.observer.clone(), dyn_range];
-        self.gpu
-            .draw(scene.light_vp, &casters, &views, scene.background)
+        let mut casters = scene.static_casters();
+        casters.push(dyn_range);
+        self.gpu.draw(scene.light_vp, &casters, &views)
     }
+
+    /// The same pixels as `draw_step` with `Shading::Lit`, drawn over the views cached
+    /// in `render_scene` (slots `first_slot..`): only the moving bodies and the static
+    /// surfaces their shadows can reach are drawn.
+    fn draw_overlay_step(
+        &mut self,
+        scene: &SceneGeometry,
+        sim: &Simulation,
+        step: u32,
+        cams: &[&CameraSpec],
+        first_slot: usize,
+    ) -> Result<Vec<Vec<u8>>, RenderError> {
+        let dynamic = scene.dynamic_at(sim, step, false);
+        let dyn_range = self.gpu.set_dynamic(&dynamic)?;
+        let moving = bounds(&dynamic);
+        let jobs: Vec<OverlayJob> = cams
+            .iter()
+            .enumerate()
+            .map(|(i, cam)| OverlayJob {
+                slot: first_slot + i,
+                uniforms: scene.uniforms(cam, Shading::Lit),
+                redraw: moving
+                    .map(|m| scene.shadow_redraws(cam, m))
+                    .unwrap_or_default(),
+                dynamic: dyn_range.clone(),
+            })
+            .collect();
+        self.gpu
+            .draw_overlay(scene.light_vp, std::slice::from_ref(&dyn_range), &jobs)
+    }
+}
+
+/// Axis-aligned bounds of some vertices (`None` when there are none).
+fn bounds(verts: &[Vertex]) -> Option<[Vec3; 2]> {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for v in verts {
+        for i in 0..3 {
+            lo[i] = lo[i].min(v.pos[i] as f64);
+            hi[i] = hi[i].max(v.pos[i] as f64);
+        }
+    }
+    (!verts.is_empty()).then_some([lo, hi])
+}
+
+/// Screen bounds (x, y, width, height; clamped, padded by 2 pixels) of the box
+/// `[lo, hi]` in `cam` with view-projection `m`: `None` when off screen, the whole
+/// frame when the box reaches behind the camera.
+fn screen_rect(cam: &CameraSpec, m: &[[f32; 4]; 4], [lo, hi]: [Vec3; 2]) -> Option<[u32; 4]> {
+    let (mut x0, mut y0) = (f64::INFINITY, f64::INFINITY);
+    let (mut x1, mut y1) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+    for corner in 0..8 {
+        let p = [0, 1, 2].map(|i| if corner >> i & 1 == 1 { hi[i] } else { lo[i] });
+        let [cx, cy, cw] = [0, 1, 3].map(|row| {
+            (0..4)
+                .map(|col| m[col][row] as f64 * if col < 3 { p[col] } else { 1.0 })
+                .sum::<f64>()
+        });
+        if cw < 0.05 {
+            return Some([0, 0, cam.width, cam.height]);
+        }
+        let px = (cx / cw * 0.5 + 0.5) * cam.width as f64;
+        let py = (0.5 - cy / cw * 0.5) * cam.height as f64;
+        x0 = x0.min(px);
+        y0 = y0.min(py);
+        x1 = x1.max(px);
+        y1 = y1.max(py);
+    }
+    let clamp_x = |v: f64| v.clamp(0.0, cam.width as f64) as u32;
+    let clamp_y = |v: f64| v.clamp(0.0, cam.height as f64) as u32;
+    let (x0, y0) = (clamp_x(x0.floor() - 2.0), clamp_y(y0.floor() - 2.0));
+    let (x1, y1) = (clamp_x(x1.ceil() + 2.0), clamp_y(y1.ceil() + 2.0));
+    (x1 > x0 && y1 > y0).then_some([x0, y0, x1 - x0, y1 - y0])
+}
+
+/// Merges rectangles pairwise, cheapest first (least area added), while a merge adds
+/// no area or more than `max` remain.
+fn merge_rects(rects: &mut Vec<[u32; 4]>, max: usize) {
+    loop {
+        let mut best: Option<(i64, usize, usize)> = None;
+        for i in 0..rects.len() {
+            for j in i + 1..rects.len() {
+                let added = rect_area(rect_union(rects[i], rects[j])) as i64
+                    - rect_area(rects[i]) as i64
+                    - rect_area(rects[j]) as i64;
+                if best.is_none_or(|(b, _, _)| added < b) {
+                    best = Some((added, i, j));
+                }
+            }
+        }
+        match best {
+            Some((added, i, j)) if added <= 0 || rects.len() > max => {
+                rects[i] = rect_union(rects[i], rects[j]);
+                rects.swap_remove(j);
+            }
+            _ => return,
+        }
+    }
+}
+
+fn rect_area(r: [u32; 4]) -> u64 {
+    r[2] as u64 * r[3] as u64
+}
+
+fn rect_union(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
+    let (x0, y0) = (a[0].min(b[0]), a[1].min(b[1]));
+    let (x1, y1) = (
+        (a[0] + a[2]).max(b[0] + b[2]),
+        (a[1] + a[3]).max(b[1] + b[3]),
+    );
+    [x0, y0, x1 - x0, y1 - y0]
+}
+
+fn rects_meet(a: [u32; 4], b: [u32; 4]) -> bool {
+    a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3]
+}
+
+/// Pixel rectangles (x, y, width, height) where moving geometry with bounds `[lo, hi]`
+/// may shade static surfaces, i.e. where its shadow can fall. The shadow of a box B
+/// lies in the translates B + d·t (t ≥ 0, `d` the sun's direction); those that meet a
+/// receiver box R have t in an interval [t0, t1], and their union lies in the box
+/// spanned by B + d·t0 and B + d·t1. Each receiver gives the screen bounds of that box
+/// intersected with R. Rectangles are then merged, cheapest first, while a merge adds
+/// no area or more than `MAX_REDRAW_RECTS` remain.
+fn shadow_regions(
+    cam: &CameraSpec,
+    [lo, hi]: [Vec3; 2],
+    reach: f64,
+    sun_dir: [f32; 4],
+    receivers: &[[Vec3; 2]],
+) -> Vec<[u32; 4]> {
+    // A shaded point is on its triangle (centroid interpolation), so inside its
+    // receiver box; the box only needs rounding slack.
+    const PAD: f64 = 0.001;
+    let (lo, hi) = (lo.map(|v| v - reach), hi.map(|v| v + reach));
+    let d = [sun_dir[0] as f64, sun_dir[1] as f64, sun_dir[2] as f64];
+    let m = view_proj(cam);
+    let mut rects: Vec<[u32; 4]> = Vec::new();
+    for [rlo, rhi] in receivers {
+        // The translates B + d·t that overlap R: t in [t0, t1], per axis.
+        let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+        for i in 0..3 {
+            let (rlo, rhi) = (rlo[i] - PAD, rhi[i] + PAD);
+            if d[i].abs() < 1e-9 {
+                if hi[i] < rlo || lo[i] > rhi {
+                    t1 = -1.0;
+                }
+                continue;
+            }
+            let (a, b) = ((rlo - hi[i]) / d[i], (rhi - lo[i]) / d[i]);
+            t0 = t0.max(a.min(b));
+            t1 = t1.min(a.max(b));
+        }
+        if t1 < t0 {
+            continue;
+        }
+        let mut box_lo = [0.0; 3];
+        let mut box_hi = [0.0; 3];
+        for i in 0..3 {
+            box_lo[i] = (lo[i] + d[i] * t0).min(lo[i] + d[i] * t1).max(rlo[i] - PAD);
+            box_hi[i] = (hi[i] + d[i] * t0).max(hi[i] + d[i] * t1).min(rhi[i] + PAD);
+        }
+        if (0..3).any(|i| box_lo[i] > box_hi[i]) {
+            continue;
+        }
+        if let Some(r) = screen_rect(cam, &m, [box_lo, box_hi]) {
+            rects.push(r);
+        }
+    }
+    let mut rects = cover_with_tiles(&rects, cam.width, cam.height);
+    merge_rects(&mut rects, gpu::MAX_REDRAW_RECTS);
+    rects
+}
+
+/// Side of the screen tiles `cover_with_tiles` snaps to (pixels).
+const REDRAW_TILE: u32 = 16;
+
+/// Few rectangles covering the union of many: mark the `REDRAW_TILE` tiles any
+/// rectangle touches, take each tile row's runs, and stack runs with the same span in
+/// consecutive rows into one rectangle.
+fn cover_with_tiles(rects: &[[u32; 4]], width: u32, height: u32) -> Vec<[u32; 4]> {
+    let (cols, rows) = (width.div_ceil(REDRAW_TILE), height.div_ceil(REDRAW_TILE));
+    let mut marked = vec![false; (cols * rows) as usize];
+    for &[x, y, w, h] in rects {
+        for ty in y / REDRAW_TILE..(y + h).div_ceil(REDRAW_TILE).min(rows) {
+            for tx in x / REDRAW_TILE..(x + w).div_ceil(REDRAW_TILE).min(cols) {
+                marked[(ty * cols + tx) as usize] = true;
+            }
+        }
+    }
+    // Open rectangles in tile units: (first column, end column, first row, end row).
+    let mut done: Vec<[u32; 4]> = Vec::new();
+    let mut open: Vec<[u32; 4]> = Vec::new();
+    for ty in 0..rows {
+        let mut runs = Vec::new();
+        let mut tx = 0;
+        while tx < cols {
+            if marked[(ty * cols + tx) as usize] {
+                let start = tx;
+                while tx < cols && marked[(ty * cols + tx) as usize] {
+                    tx += 1;
+                }
+                runs.push((start, tx));
+            } else {
+                tx += 1;
+            }
+        }
+        let mut next = Vec::new();
+        for (c0, c1) in runs {
+            match open.iter().position(|o| o[0] == c0 && o[1] == c1) {
+                Some(i) => {
+                    let mut o = open.swap_remove(i);
+                    o[3] = ty + 1;
+                    next.push(o);
+                }
+                None => next.push([c0, c1, ty, ty + 1]),
+            }
+        }
+        done.append(&mut open);
+        open = next;
+    }
+    done.append(&mut open);
+    done.into_iter()
+        .map(|[c0, c1, r0, r1]| {
+            let (x0, y0) = (c0 * REDRAW_TILE, r0 * REDRAW_TILE);
+            let (x1, y1) = (
+                (c1 * REDRAW_TILE).min(width),
+                (r1 * REDRAW_TILE).min(height),
+            );
+            [x0, y0, x1 - x0, y1 - y0]
+        })
+        .collect()
 }
 
 /// `<cam>_t0.150.png`
@@ -564,6 +801,31 @@ pub fn full_event_camera(
 // ---------------------------------------------------------------------------------------
 // Scene geometry
 
+/// One static mesh piece: its vertices in `statics`, its bounding box, and the
+/// bounding boxes of its triangle pairs (meshes are built face by face, so a pair is
+/// one quad: a table top apart from its legs), which bound where on it a shadow can
+/// fall much tighter than the whole box.
+struct Piece {
+    range: Range<u32>,
+    bounds: [Vec3; 2],
+    receivers: Vec<[Vec3; 2]>,
+}
+
+const RECEIVER_TRIANGLES: usize = 2;
+
+/// The piece made of `statics[from..]` (`None` when empty).
+fn piece(statics: &[Vertex], from: usize) -> Option<Piece> {
+    let verts = &statics[from..];
+    bounds(verts).map(|whole| Piece {
+        range: from as u32..statics.len() as u32,
+        bounds: whole,
+        receivers: verts
+            .chunks(3 * RECEIVER_TRIANGLES)
+            .filter_map(bounds)
+            .collect(),
+    })
+}
+
 struct Wall {
     range: Range<u32>,
     /// Visible from cameras with `axis` coordinate on this side: `sign * p[axis] < limit`.
@@ -601,7 +863,11 @@ struct SceneGeometry {
     sun_dir: [f32; 4],
     sun_color: [f32; 4],
     ambient: [f32; 4],
-    background: [f64; 3],
+    background: [f32; 4],
+    /// The static pieces (each fixed body, the observer, floor, each wall, ceiling).
+    pieces: Vec<Piece>,
+    /// Distance (m) from a shadow volume within which shading may depend on it.
+    shadow_reach: f64,
 }
 
 fn fixed_color(name: &str, wall: Rgba) -> Rgba {
@@ -732,6 +998,9 @@ fn color_temperature(k: f64) -> [f32; 3] {
 impl SceneGeometry {
     fn build(spec: &SceneSpec, sim: &Simulation, catalog: &Catalog) -> SceneGeometry {
         let mut statics: Vec<Vertex> = Vec::new();
+        // Each static piece's vertices and bounds: what a moving body's shadow can fall on
+        // and what must be redrawn where it does (see `shadow_regions`).
+        let mut pieces: Vec<Piece> = Vec::new();
         let room = &spec.room;
         let wall_c = hex(&room.wall_color);
         let floor_c = mat(hex(&room.floor_color), MAT_FLOOR);
@@ -751,7 +1020,9 @@ impl SceneGeometry {
                     m
                 }
             };
+            let from = statics.len();
             mesh.transformed_into(&Xf::from_quat(body.rotation, body.position), &mut statics);
+            pieces.extend(piece(&statics, from));
         }
         let fixed = 0..statics.len() as u32;
         let o = &spec.observer;
@@ -760,6 +1031,7 @@ impl SceneGeometry {
         obody.transformed_into(&oxf, &mut statics);
         ohead.transformed_into(&oxf, &mut statics);
         let observer = fixed.end..statics.len() as u32;
+        pieces.extend(piece(&statics, observer.start as usize));
         let head_center = [o.x, o.y, o.height - 0.075];
 
         // Room shell.
@@ -778,6 +1050,7 @@ impl SceneGeometry {
         );
         floor.transformed_into(&Xf::ID, &mut statics);
         let floor_r = start..statics.len() as u32;
+        pieces.extend(piece(&statics, start as usize));
         let mut walls = Vec::new();
         let skirting = shade(wall_c, 0.55);
         let wall_paint = move |p: V3| if p[2] < 0.1 { skirting } else { wall_c };
@@ -799,6 +1072,7 @@ impl SceneGeometry {
             let paint = move |p: V3| wall_paint([p[0], p[1], p[2] + ch / 2.0]);
             m.boxy(&Xf::at(pos), half_len, 12, &paint);
             m.transformed_into(&Xf::ID, &mut statics);
+            pieces.extend(piece(&statics, s as usize));
             walls.push(Wall {
                 range: s..statics.len() as u32,
                 axis,
@@ -816,6 +1090,7 @@ impl SceneGeometry {
         );
         ceil.transformed_into(&Xf::ID, &mut statics);
         let ceiling = s..statics.len() as u32;
+        pieces.extend(piece(&statics, s as usize));
 
         // Moving bodies, meshed once in their body frames.
         let mut dynamic = Vec::new();
@@ -890,7 +1165,12 @@ impl SceneGeometry {
         let tint = color_temperature(l.color_temperature_k);
         let sun = (l.sun_intensity * 0.25) as f32;
         let amb = (l.ambient * 1.3) as f32;
-        let light_vp = light_matrix(dir, room.size, room.ceiling_height);
+        let (light_vp, light_radius) = light_matrix(dir, room.size, room.ceiling_height);
+        // How far from a moving body's shadow volume a static pixel's shading can still
+        // see it: the shader's normal offset, the comparison filter's 2×2 texels (with a
+        // texel to spare), and a centimetre of slack.
+        let texel = 2.0 * light_radius / gpu::SHADOW_SIZE as f64;
+        let shadow_reach = SHADOW_NORMAL_OFFSET + 3.0 * texel + 0.01;
         SceneGeometry {
             statics,
             fixed,
@@ -912,7 +1192,9 @@ impl SceneGeometry {
                 amb * (0.9 + 0.1 * tint[2]),
                 0.0,
             ],
-            background: [0.04, 0.045, 0.05],
+            background: [0.04, 0.045, 0.05, 1.0],
+            pieces,
+            shadow_reach,
         }
     }
 
@@ -971,6 +1253,63 @@ impl SceneGeometry {
         r
     }
 
+    /// Where moving geometry with bounds `moving` may shade static surfaces in `cam`
+    /// (`shadow_regions`), each rectangle with the static pieces it must redraw: those
+    /// the camera sees whose screen bounds meet it.
+    fn shadow_redraws(
+        &self,
+        cam: &CameraSpec,
+        moving: [Vec3; 2],
+    ) -> Vec<([u32; 4], Vec<Range<u32>>)> {
+        let seen = self.ranges_for(cam);
+        let m = view_proj(cam);
+        let visible: Vec<(&Piece, [u32; 4])> = self
+            .pieces
+            .iter()
+            .filter(|p| {
+                seen.iter()
+                    .any(|r| r.start <= p.range.start && p.range.end <= r.end)
+            })
+            .filter_map(|p| screen_rect(cam, &m, p.bounds).map(|r| (p, r)))
+            .collect();
+        let receivers: Vec<[Vec3; 2]> = visible
+            .iter()
+            .flat_map(|(p, _)| p.receivers.iter().copied())
+            .collect();
+        shadow_regions(cam, moving, self.shadow_reach, self.sun_dir, &receivers)
+            .into_iter()
+            .map(|rect| {
+                let ranges = visible
+                    .iter()
+                    .filter(|(_, r)| rects_meet(*r, rect))
+                    .map(|(p, _)| p.range.clone())
+                    .collect();
+                (rect, ranges)
+            })
+            .collect()
+    }
+
+    /// Fixed bodies and the observer: the shadow casters that never move.
+    fn static_casters(&self) -> Vec<Range<u32>> {
+        vec![self.fixed.clone(), self.observer.clone()]
+    }
+
+    fn view_job(
+        &self,
+        slot: usize,
+        cam: &CameraSpec,
+        shading: Shading,
+        ranges: Vec<Range<u32>>,
+    ) -> ViewJob {
+        ViewJob {
+            slot,
+            width: cam.width,
+            height: cam.height,
+            uniforms: self.uniforms(cam, shading),
+            ranges,
+        }
+    }
+
     fn uniforms(&self, cam: &CameraSpec, shading: Shading) -> Uniforms {
         Uniforms {
             view_proj: view_proj(cam),
@@ -993,6 +1332,8 @@ impl SceneGeometry {
                     0.0
                 },
             ],
+            background: self.background,
+            fill_rects: [[-1.0, -1.0, 1.0, 1.0]; gpu::MAX_REDRAW_RECTS],
         }
     }
 }
@@ -1012,7 +1353,8 @@ fn object_look_mesh(catalog: &Catalog, id: &str, parts: &[crate::spec::PartSpec]
 }
 
 /// Orthographic light matrix covering the room (and a margin) along the sun direction.
-fn light_matrix(dir: Vec3, size: [f64; 2], ceiling: f64) -> [[f32; 4]; 4] {
+/// The sun's orthographic view-projection over the room, and its half-width (m).
+fn light_matrix(dir: Vec3, size: [f64; 2], ceiling: f64) -> ([[f32; 4]; 4], f64) {
     let center = [0.0, 0.0, ceiling / 2.0];
     let radius = 0.5 * (size[0].hypot(size[1])).hypot(ceiling) + 0.5;
     let eye = sub(center, scale(dir, radius + 2.0));
@@ -1046,8 +1388,11 @@ fn light_matrix(dir: Vec3, size: [f64; 2], ceiling: f64) -> [[f32; 4]; 4] {
         ],
         [0.0, 0.0, 0.0, 1.0],
     ];
-    to_cols(rows)
+    (to_cols(rows), radius)
 }
+
+/// The shader's shadow lookup offset along the surface normal (m; `shadow_factor`).
+const SHADOW_NORMAL_OFFSET: f64 = 0.025;
 
 // ---------------------------------------------------------------------------------------
 // Contact sheet

@@ -7,6 +7,11 @@ struct U {
     sun_color: vec4<f32>,
     // rgb ambient; w > 0.5: unlit diagnostic colours.
     ambient: vec4<f32>,
+    // rgb: clear colour, drawn by the fill pass.
+    background: vec4<f32>,
+    // The fill pass's rectangles in normalised device coordinates (x0, y0, x1, y1),
+    // one per instance.
+    fill_rects: array<vec4<f32>, 8>,
 };
 
 @group(0) @binding(0) var<uniform> u: U;
@@ -19,10 +24,12 @@ struct VIn {
     @location(2) color: vec4<f32>,
 };
 
+// Centroid interpolation: a multisampled edge pixel is shaded at a point on its
+// triangle, never extrapolated past it (which would look up shadows elsewhere).
 struct VOut {
     @builtin(position) clip: vec4<f32>,
-    @location(0) world: vec3<f32>,
-    @location(1) normal: vec3<f32>,
+    @location(0) @interpolate(perspective, centroid) world: vec3<f32>,
+    @location(1) @interpolate(perspective, centroid) normal: vec3<f32>,
     @location(2) color: vec4<f32>,
 };
 
@@ -36,12 +43,36 @@ fn vs_main(v: VIn) -> VOut {
     return o;
 }
 
+// A rectangle (two triangles) at the far plane (depth 1): clears what it covers to the
+// background. Its own edges bound it, not only the scissor: a CPU rasterizer's
+// multisampled scissor test may let samples just outside the rectangle through.
+@vertex
+fn vs_fill(
+    @builtin(vertex_index) i: u32,
+    @builtin(instance_index) rect: u32,
+) -> @builtin(position) vec4<f32> {
+    let r = u.fill_rects[rect];
+    let corner = array<vec2<u32>, 6>(
+        vec2<u32>(0u, 0u), vec2<u32>(1u, 0u), vec2<u32>(0u, 1u),
+        vec2<u32>(0u, 1u), vec2<u32>(1u, 0u), vec2<u32>(1u, 1u),
+    )[i];
+    let x = select(r.x, r.z, corner.x == 1u);
+    let y = select(r.y, r.w, corner.y == 1u);
+    return vec4<f32>(x, y, 1.0, 1.0);
+}
+
+@fragment
+fn fs_fill() -> @location(0) vec4<f32> {
+    return vec4<f32>(u.background.rgb, 1.0);
+}
+
 @vertex
 fn vs_shadow(v: VIn) -> @builtin(position) vec4<f32> {
     return u.light_vp * vec4<f32>(v.pos, 1.0);
 }
 
 fn shadow_factor(world: vec3<f32>, n: vec3<f32>) -> f32 {
+    // Offset along the normal: SHADOW_NORMAL_OFFSET in mod.rs.
     let lp = u.light_vp * vec4<f32>(world + n * 0.025, 1.0);
     let ndc = lp.xyz / lp.w;
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
