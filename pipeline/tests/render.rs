@@ -375,3 +375,55 @@ fn preview() {
         println!("{family}: {} ({})", selection.object_id, spec.scene_id);
     }
 }
+
+/// `render_scene` draws each frame over a cached image of the static scene, redrawing
+/// static surfaces only where moving bodies can cast shadows. The observation frames
+/// it writes must be pixel-identical to drawing the whole scene from scratch, in every
+/// family (each has its own moving geometry, heights and shadow directions).
+#[test]
+fn cached_static_frames_equal_whole_scene_frames_in_every_family() {
+    let mut config = small_config();
+    config.render.width = 192;
+    config.render.height = 108;
+    let catalog = Catalog::embedded().unwrap();
+    let families = config.build.families.clone();
+    assert_eq!(families.len(), 17);
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-cache-test");
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut r = renderer().lock().unwrap();
+    let mut compared = 0;
+    for (fi, family) in families.iter().enumerate() {
+        let selection = plan_group(&catalog, std::slice::from_ref(family), 23, fi as u64).unwrap();
+        let results = produce_group(&selection, 23, fi as u64 * 4, 1, &catalog, &config).unwrap();
+        let spec = &results[0].spec;
+        if spec.cameras.is_empty() {
+            continue;
+        }
+        let sim = simulate(spec, SimOptions::default());
+        let rendered = r.render_scene(spec, &sim, &catalog, &dir).unwrap();
+        for (ti, &t) in FRAME_TIMES.iter().enumerate() {
+            let k = (t * spec.video.fps as f64).round() as usize;
+            let step = rendered.frame_steps[k];
+            let whole = r
+                .render_frame(spec, &sim, &catalog, &spec.cameras, step, Shading::Lit)
+                .unwrap();
+            for (ci, cam) in CAMERAS.iter().enumerate() {
+                let in_spec = spec.cameras.iter().position(|c| c.name == *cam).unwrap();
+                let rel = &rendered.frames[ci * FRAME_TIMES.len() + ti];
+                let png = image::open(dir.join(rel)).unwrap().to_rgb8();
+                let reference = image::DynamicImage::ImageRgba8(whole[in_spec].clone()).to_rgb8();
+                let differing = png
+                    .pixels()
+                    .zip(reference.pixels())
+                    .filter(|(a, b)| a != b)
+                    .count();
+                assert_eq!(
+                    differing, 0,
+                    "{family} {rel}: {differing} pixels differ from the whole-scene render at step {step}"
+                );
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared >= 15 * 15, "only {compared} frames compared");
+}
