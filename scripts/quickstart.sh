@@ -14,6 +14,7 @@ rm -rf "$dataset"
 mkdir -p "$out"
 ./target/release/rh-pipeline build --n 60 --out "$dataset"
 ./target/release/rh-pipeline verify "$dataset"
+./target/release/rh-pipeline sheet "$dataset" --out "$out/sheet.png"
 
 preds="$out/preds.jsonl"
 : > "$preds"
@@ -22,4 +23,4 @@ for baseline in oracle majority random always-catch freeze; do
 done
 ./target/release/rh-score "$preds" --dataset "$dataset" \
   --json "$out/report.json" --csv "$out/report.csv" --markdown "$out/report.md" --figures "$out/figures"
-echo "quickstart: dataset in $dataset, report in $out/report.md, figures in $out/figures"
+echo "quickstart: dataset in $dataset (videos/, frames/; contact sheet $out/sheet.png), report in $out/report.md, figures in $out/figures"

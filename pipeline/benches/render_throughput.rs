@@ -5,7 +5,8 @@
 //! `cargo bench -p rh-pipeline --bench render_throughput [-- N]` (N scenes, default 8,
 //! taken round-robin over the families). Environment overrides: `RH_BENCH_JOBS`
 //! (workers; default: all cores), `RH_BENCH_PRESET`, `RH_BENCH_THREADS` (x264 threads
-//! per video), `RH_BENCH_MSAA`.
+//! per video), `RH_BENCH_MSAA` (samples on any adapter; default: the
+//! configuration's `msaa`, or `msaa_cpu` on a CPU rasterizer).
 //!
 //! Prints each scene's own time and the figure that matters for a build: wall-clock
 //! seconds per scene with every worker busy.
@@ -38,6 +39,7 @@ fn main() {
     }
     if let Some(m) = env_parse("RH_BENCH_MSAA") {
         config.render.msaa = m;
+        config.render.msaa_cpu = m;
     }
     let jobs: usize = env_parse("RH_BENCH_JOBS").unwrap_or_else(|| {
         std::thread::available_parallelism()
@@ -66,8 +68,9 @@ fn main() {
         .unwrap();
     // Open each worker's device before timing (once per build, not per scene).
     let t = Instant::now();
-    let adapters: Vec<String> = pool.broadcast(|_| {
-        with_thread_renderer(&opts, |r| r.adapter_name().to_string()).expect("a Vulkan adapter")
+    let adapters: Vec<(String, u32)> = pool.broadcast(|_| {
+        with_thread_renderer(&opts, |r| (r.adapter_name().to_string(), r.samples()))
+            .expect("a Vulkan adapter")
     });
     let setup = t.elapsed().as_secs_f64();
     let t = Instant::now();
@@ -109,10 +112,10 @@ fn main() {
         wall / count,
         times.len(),
         times.iter().map(|(s, _)| s).sum::<f64>() / count,
-        adapters.first().map(String::as_str).unwrap_or("?"),
+        adapters[0].0,
         setup,
         opts.encode.preset,
-        opts.msaa,
+        adapters[0].1,
         opts.encode.threads
     );
 }

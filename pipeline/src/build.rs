@@ -24,7 +24,9 @@ use crate::dataset;
 use crate::families;
 use crate::manifest::{Manifest, MANIFEST_FILE};
 use crate::plan::plan_group;
-use crate::scene::produce_group;
+use crate::render::{with_thread_renderer, RenderOptions, Renderer};
+use crate::scene::{produce_group, SceneMedia, SceneResult};
+use crate::simulate::{simulate, SimOptions};
 use arrow::array::RecordBatch;
 use rayon::prelude::*;
 use rh_catalog::Catalog;
@@ -274,7 +276,32 @@ pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError
     Ok(!out.join(WORK_DIR).exists() && data.exists() && out.join("README.md").exists())
 }
 
-/// Reads group `g`'s record if it is there and whole (right rows, specs present).
+/// Renders a valid scene's videos and frames into `out` (stage 4). Invalid scenes are
+/// not rendered: their video columns stay null. The simulation is run again from the
+/// spec (milliseconds, and identical by construction) rather than kept per group.
+fn render_scene(
+    r: &SceneResult,
+    catalog: &Catalog,
+    opts: &RenderOptions,
+    out: &Path,
+) -> Result<Option<SceneMedia>, BuildError> {
+    if !r.verdicts.all() || r.spec.cameras.is_empty() {
+        return Ok(None);
+    }
+    let sim = simulate(&r.spec, SimOptions::default());
+    let rendered = with_thread_renderer(opts, |renderer| {
+        renderer.render_scene(&r.spec, &sim, catalog, out)
+    })
+    .and_then(|x| x)
+    .map_err(|e| BuildError::Internal(format!("render {}: {e}", r.spec.scene_id)))?;
+    Ok(Some(SceneMedia {
+        videos: rendered.videos,
+        full_event: rendered.full_event,
+    }))
+}
+
+/// Reads group `g`'s record if it is there and whole (right rows, every file it names
+/// present: specs, videos, frames).
 fn load_record(out: &Path, manifest: &Manifest, g: u64) -> Option<RecordBatch> {
     let path = record_path(out, g);
     if !path.exists() {
@@ -286,10 +313,10 @@ fn load_record(out: &Path, manifest: &Manifest, g: u64) -> Option<RecordBatch> {
     if indices != expected {
         return None;
     }
-    let specs_there = dataset::string_column(&batch, "spec_file")
+    let files_there = dataset::referenced_files(&batch)
         .iter()
         .all(|f| out.join(f).exists());
-    specs_there.then_some(batch)
+    files_there.then_some(batch)
 }
 
 /// Builds the dataset described by `opts`.
@@ -299,12 +326,19 @@ pub fn build(
     config: &Config,
 ) -> Result<BuildSummary, BuildError> {
     check_options(opts, catalog, config)?;
-    if opts.render && opts.progress {
-        // The render stage is not part of this build yet: scenes get specs, labels and
-        // Parquet rows, and their video columns stay null (as with --no-render).
-        eprintln!(
-            "note: this build has no render stage yet; building without videos (as --no-render)"
-        );
+    let render_opts = RenderOptions::from_config(&config.render);
+    if opts.render {
+        // Fail before any work when there is nothing to render with.
+        let renderer = Renderer::new(render_opts.clone()).map_err(|e| {
+            BuildError::Input(format!("render stage: {e} (or build with --no-render)"))
+        })?;
+        if opts.progress {
+            eprintln!(
+                "rendering on {} ({} MSAA samples)",
+                renderer.adapter_name(),
+                renderer.samples()
+            );
+        }
     }
     let manifest = Manifest::new(
         opts.seed,
@@ -366,8 +400,14 @@ pub fn build(
                 let selection = plan_group(catalog, &opts.families, opts.seed, g)
                     .map_err(|e| BuildError::Input(e.to_string()))?;
                 let count = manifest.group_size(g);
-                let results = produce_group(&selection, opts.seed, g * 4, count, catalog, config)
-                    .map_err(|e| BuildError::Input(e.to_string()))?;
+                let mut results =
+                    produce_group(&selection, opts.seed, g * 4, count, catalog, config)
+                        .map_err(|e| BuildError::Input(e.to_string()))?;
+                if opts.render {
+                    for r in results.iter_mut() {
+                        r.media = render_scene(r, catalog, &render_opts, out)?;
+                    }
+                }
                 for r in &results {
                     let path = out.join(dataset::spec_path(&r.spec.scene_id));
                     dataset::write_atomic(&path, r.spec.to_json().as_bytes())

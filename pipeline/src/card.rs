@@ -244,11 +244,15 @@ pub fn render(input: &CardInput) -> String {
     v.insert(
         "render_note",
         if rendered {
-            "Observation frames are under `frames/<scene_id>/`; videos under `videos/<cam>/`."
+            "Videos and frames exist for the valid scenes (invalid ones have null `*_file_name` \
+             columns). Video frame `k` of a camera video shows physics step \
+             `round(k / fps / dt)` of the spec (`video.fps`, `physics.dt`), clamped to the \
+             scene's last step; the PNG at time t is video frame `round(t · fps)` before \
+             compression. Full-event frame `j` shows step `round(j / full_fps / dt)`."
                 .into()
         } else {
             "This build has no rendered videos: the `*_file_name` columns are null and there is \
-             no `videos/` or `frames/` folder (`--no-render`, or a build without the render stage)."
+             no `videos/` or `frames/` folder (built with `--no-render`)."
                 .into()
         },
     );
@@ -360,7 +364,7 @@ speed is > {} m/s, or the impact kinetic energy is > {} J; else `CATCH`.",
             m.families.join(", "),
             m.shard[0],
             m.shard[1],
-            if m.render { "requested" } else { "no (--no-render)" },
+            if m.render { "yes (valid scenes)" } else { "no (--no-render)" },
             if default_config { "the default `configs/default.toml`" } else { "custom" },
             m.config_sha256,
             m.catalog_sha256,

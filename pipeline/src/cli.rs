@@ -100,6 +100,19 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Tile one observation frame per family of a rendered dataset (the close-up at
+    /// t = 0.30 s of each family's first scene) into one labelled PNG, to eyeball all
+    /// families at once.
+    Sheet {
+        /// Dataset directory built by `rh-pipeline build` (with rendering).
+        dir: PathBuf,
+        /// The PNG to write.
+        #[arg(long, value_name = "PNG")]
+        out: PathBuf,
+        /// Print the tiles (family, scene id) as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
     /// Label balance: build K scenes per family in memory and count CATCH / DODGE /
     /// NO_ACTION per family (the paper's 17 × 18 subset by default).
     Balance {
@@ -194,6 +207,43 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             }
             return Ok(());
         }
+        Command::Sheet { dir, out, json } => {
+            if !dir.join("specs").is_dir() {
+                return Err(input(format!(
+                    "{}: not a dataset directory (no specs/)",
+                    dir.display()
+                )));
+            }
+            let sheet = crate::render::contact_sheet(dir, out).map_err(|e| match e {
+                crate::render::RenderError::Io(m) => input(m),
+                other => Failure {
+                    code: 1,
+                    message: other.to_string(),
+                },
+            })?;
+            if *json {
+                let tiles: Vec<serde_json::Value> = sheet
+                    .tiles
+                    .iter()
+                    .map(|(family, id)| serde_json::json!({ "family": family, "scene_id": id }))
+                    .collect();
+                print_json(&serde_json::json!({
+                    "out": out.display().to_string(),
+                    "width": sheet.width,
+                    "height": sheet.height,
+                    "tiles": tiles,
+                }));
+            } else {
+                println!(
+                    "contact sheet of {} families ({}x{}) written to {}",
+                    sheet.tiles.len(),
+                    sheet.width,
+                    sheet.height,
+                    out.display()
+                );
+            }
+            return Ok(());
+        }
         Command::Download {
             repo,
             revision,
@@ -228,7 +278,9 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
     }
     let (catalog, config) = load(&cli)?;
     match cli.command {
-        Command::Merge { .. } | Command::Download { .. } => unreachable!("handled above"),
+        Command::Merge { .. } | Command::Download { .. } | Command::Sheet { .. } => {
+            unreachable!("handled above")
+        }
         Command::Build {
             n,
             out,

@@ -110,9 +110,17 @@ pub struct RenderConfig {
     /// libx264 threads per video (0 = automatic).
     #[serde(default = "default_encoder_threads")]
     pub encoder_threads: u32,
-    /// MSAA samples (4 or 1).
+    /// MSAA samples (4 or 1) on a hardware GPU.
     #[serde(default = "default_msaa")]
     pub msaa: u32,
+    /// MSAA samples (4 or 1) on a CPU rasterizer (Mesa's lavapipe), where 4 samples
+    /// cost about 2× the time.
+    #[serde(default = "default_msaa_cpu")]
+    pub msaa_cpu: u32,
+}
+
+fn default_msaa_cpu() -> u32 {
+    1
 }
 
 fn default_full_width() -> u32 {

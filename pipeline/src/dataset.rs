@@ -123,6 +123,11 @@ fn plain_schema() -> Schema {
     }
     fields.push(utf8("full_event_file_name", true));
     fields.push(Field::new(
+        "frame_steps",
+        DataType::List(Arc::new(Field::new("item", DataType::UInt32, true))),
+        false,
+    ));
+    fields.push(Field::new(
         "trajectory",
         DataType::List(Arc::new(Field::new(
             "item",
@@ -181,9 +186,9 @@ pub fn huggingface_features(schema: &Schema) -> String {
 pub fn column_description(name: &str) -> Option<String> {
     if let Some(cam) = name.strip_suffix("_file_name") {
         return Some(if cam == "full_event" {
-            "Relative path of the full-event MP4 from an outside view, for people (never model input); null until rendered".into()
+            "Relative path of the full-event MP4 from an outside view, for people (never model input): `videos/full/<scene_id>.mp4`; null when not rendered (`--no-render`, or an invalid scene)".into()
         } else {
-            format!("Relative path `videos/{cam}/<scene_id>.mp4` of the `{cam}` camera's observation-window video; null until rendered")
+            format!("Relative path `videos/{cam}/<scene_id>.mp4` of the `{cam}` camera's observation-window video; null when not rendered (`--no-render`, or an invalid scene)")
         });
     }
     let text = match name {
@@ -228,6 +233,7 @@ pub fn column_description(name: &str) -> Option<String> {
         "valid_in_frame" => "Validator: the hazard stays in all three cameras' frames during the observation window",
         "valid_intended_event" => "Validator: the family's intended event really happened",
         "spec_file" => "Relative path of the scene's full, replayable SceneSpec JSON",
+        "frame_steps" => "Physics step shown by each frame k of the camera videos (observation window, both ends included): round(k / video.fps / physics.dt), at most sim_steps",
         "trajectory" => "Hazard centre [t (s), x, y, z (m)] at each video frame (float32)",
         _ => return None,
     };
@@ -348,11 +354,25 @@ pub fn record_batch(results: &[SceneResult], catalog: &Catalog) -> RecordBatch {
     columns.push(strings!(|r: &SceneResult| Some(spec_path(
         &r.spec.scene_id
     ))));
-    for _ in CAMERA_NAMES {
-        // Rendering is a later stage; without it the video columns stay null.
-        columns.push(strings!(|_r: &SceneResult| None::<String>));
+    // Null when the scene was not rendered (`--no-render`, or an invalid scene).
+    for cam in CAMERA_NAMES {
+        columns.push(strings!(|r: &SceneResult| r
+            .media
+            .as_ref()
+            .and_then(|m| m.videos.get(cam).cloned())));
     }
-    columns.push(strings!(|_r: &SceneResult| None::<String>));
+    columns.push(strings!(|r: &SceneResult| r
+        .media
+        .as_ref()
+        .map(|m| m.full_event.clone())));
+    let mut frame_steps = ListBuilder::new(UInt32Builder::new());
+    for r in results {
+        frame_steps
+            .values()
+            .append_slice(&r.spec.observation_frame_steps(r.steps));
+        frame_steps.append(true);
+    }
+    columns.push(Arc::new(frame_steps.finish()));
     let mut trajectories = ListBuilder::new(
         FixedSizeListBuilder::new(Float32Builder::new(), 4).with_field(Field::new(
             "item",
@@ -369,6 +389,63 @@ pub fn record_batch(results: &[SceneResult], catalog: &Catalog) -> RecordBatch {
     }
     columns.push(Arc::new(trajectories.finish()));
     RecordBatch::try_new(Arc::new(schema()), columns).expect("columns match the schema")
+}
+
+/// Every file a row refers to, relative to the dataset root: its spec, its videos
+/// (`<cam>_file_name`, `full_event_file_name`) and, for a rendered scene, its observation
+/// frames (`frames/<scene_id>/<cam>_t….png`). Row order, then the order above.
+pub fn referenced_files(batch: &RecordBatch) -> Vec<String> {
+    let ids = string_column(batch, "scene_id");
+    let specs = string_column(batch, "spec_file");
+    let mut video_columns: Vec<Vec<Option<String>>> = CAMERA_NAMES
+        .iter()
+        .map(|cam| optional_string_column(batch, &format!("{cam}_file_name")))
+        .collect();
+    video_columns.push(optional_string_column(batch, "full_event_file_name"));
+    let mut files = Vec::new();
+    for (row, (id, spec)) in ids.iter().zip(specs).enumerate() {
+        files.push(spec);
+        let mut rendered = false;
+        for column in &video_columns {
+            if let Some(v) = &column[row] {
+                files.push(v.clone());
+                rendered = true;
+            }
+        }
+        if rendered {
+            files.extend(frame_files(id));
+        }
+    }
+    files
+}
+
+/// A rendered scene's observation frames, camera-major (`frames/<id>/<cam>_t0.150.png`).
+pub fn frame_files(scene_id: &str) -> Vec<String> {
+    CAMERA_NAMES
+        .iter()
+        .flat_map(|cam| {
+            crate::render::FRAME_TIMES.iter().map(move |&t| {
+                format!(
+                    "frames/{scene_id}/{}",
+                    crate::render::frame_file_name(cam, t)
+                )
+            })
+        })
+        .collect()
+}
+
+/// A nullable string column by name (all null when absent).
+pub fn optional_string_column(batch: &RecordBatch, name: &str) -> Vec<Option<String>> {
+    use arrow::array::Array;
+    match batch
+        .column_by_name(name)
+        .and_then(|c| c.as_any().downcast_ref::<arrow::array::StringArray>())
+    {
+        Some(a) => (0..a.len())
+            .map(|i| (!a.is_null(i)).then(|| a.value(i).to_string()))
+            .collect(),
+        None => vec![None; batch.num_rows()],
+    }
 }
 
 /// Reads a Parquet file of scene rows written by `parquet_bytes` back into one batch with

@@ -199,8 +199,12 @@ fn write_merged(staging: &Path, whole: &Manifest, shards: &[Shard]) -> Result<()
         .map_err(|e| internal(staging, e))?;
     let mut batches = Vec::new();
     for (dir, (_, rows)) in shards {
-        for spec in dataset::string_column(rows, "spec_file") {
-            let (from, to) = (dir.join(&spec), staging.join(&spec));
+        // Specs, videos and frames: every file a row names.
+        for file in dataset::referenced_files(rows) {
+            let (from, to) = (dir.join(&file), staging.join(&file));
+            if let Some(parent) = to.parent() {
+                std::fs::create_dir_all(parent).map_err(|e| internal(parent, e))?;
+            }
             std::fs::copy(&from, &to).map_err(|e| internal(&from, e))?;
         }
         batches.push(rows.clone());

@@ -21,6 +21,17 @@ pub struct SceneResult {
     /// The hazard's centre at each video frame: `[t, x, y, z]` until the scene ends.
     pub trajectory: Vec<[f32; 4]>,
     pub steps: u32,
+    /// What the render stage wrote (`None` until rendered, and for unrendered scenes).
+    pub media: Option<SceneMedia>,
+}
+
+/// A rendered scene's files, relative to the dataset root.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneMedia {
+    /// Camera name → `videos/<cam>/<scene_id>.mp4`.
+    pub videos: std::collections::BTreeMap<String, String>,
+    /// `videos/full/<scene_id>.mp4`.
+    pub full_event: String,
 }
 
 /// Simulates one spec (plain and counterfactual), frames its cameras, validates and labels.
@@ -51,6 +62,7 @@ pub fn run_scene(mut spec: SceneSpec, config: &Config) -> SceneResult {
         labels,
         verdicts,
         trajectory,
+        media: None,
     }
 }
 

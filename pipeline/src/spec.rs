@@ -327,6 +327,16 @@ impl SceneSpec {
     pub fn frame_step(&self, frame: u32) -> u32 {
         (frame as f64 / self.video.fps as f64 / self.physics.dt).round() as u32
     }
+
+    /// The physics step of every frame of the observation videos, `[0, Δ]` both ends
+    /// included, for a simulation of `steps` steps (a scene that ends early holds its
+    /// last state).
+    pub fn observation_frame_steps(&self, steps: u32) -> Vec<u32> {
+        let frames = (self.observation_window_s * self.video.fps as f64).round() as u32;
+        (0..=frames)
+            .map(|k| self.frame_step(k).min(steps))
+            .collect()
+    }
 }
 
 /// Vector helpers for the spec's plain `[f64; 3]` arrays.

@@ -385,12 +385,16 @@ fn cached_static_frames_equal_whole_scene_frames_in_every_family() {
     let mut config = small_config();
     config.render.width = 192;
     config.render.height = 108;
+    // Four samples: the harder case (multisampled scissor edges), on any adapter.
+    config.render.msaa = 4;
+    config.render.msaa_cpu = 4;
+    let mut r = Renderer::new(RenderOptions::from_config(&config.render)).unwrap();
+    assert_eq!(r.samples(), 4);
     let catalog = Catalog::embedded().unwrap();
     let families = config.build.families.clone();
     assert_eq!(families.len(), 17);
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-cache-test");
     let _ = std::fs::remove_dir_all(&dir);
-    let mut r = renderer().lock().unwrap();
     let mut compared = 0;
     for (fi, family) in families.iter().enumerate() {
         let selection = plan_group(&catalog, std::slice::from_ref(family), 23, fi as u64).unwrap();

@@ -115,7 +115,9 @@ const VERTEX_ATTRS: [wgpu::VertexAttribute; 3] =
     wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4];
 
 impl Gpu {
-    pub fn new(samples: u32) -> Result<Gpu, RenderError> {
+    /// Opens the adapter and builds the pipelines with `samples` MSAA samples on a
+    /// hardware GPU, `cpu_samples` on a CPU rasterizer (4 or 1 each).
+    pub fn new(samples: u32, cpu_samples: u32) -> Result<Gpu, RenderError> {
         if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
             // Silences a harmless probe error of the Vulkan loader on headless machines.
             // SAFETY: called before any other thread of ours reads the environment here.
@@ -137,7 +139,13 @@ impl Gpu {
                 "{e} (install a Vulkan driver: Mesa's lavapipe, package mesa-vulkan-drivers)"
             ))
         })?;
-        let adapter_name = adapter.get_info().name;
+        let info = adapter.get_info();
+        let adapter_name = info.name;
+        let samples = if info.device_type == wgpu::DeviceType::Cpu {
+            cpu_samples
+        } else {
+            samples
+        };
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("rh-render"),
             required_features: wgpu::Features::empty(),
@@ -335,6 +343,10 @@ impl Gpu {
             static_len: 0,
             targets: Vec::new(),
         })
+    }
+
+    pub fn samples(&self) -> u32 {
+        self.samples
     }
 
     /// Uploads the scene's static geometry (kept until the next call).

@@ -61,7 +61,9 @@ pub struct RenderOptions {
     pub full_height: u32,
     pub full_fps: u32,
     pub encode: EncodeSettings,
+    /// MSAA samples on a hardware GPU, and on a CPU rasterizer.
     pub msaa: u32,
+    pub msaa_cpu: u32,
 }
 
 impl RenderOptions {
@@ -76,6 +78,7 @@ impl RenderOptions {
                 threads: c.encoder_threads,
             },
             msaa: c.msaa,
+            msaa_cpu: c.msaa_cpu,
         }
     }
 }
@@ -92,6 +95,7 @@ impl Default for RenderOptions {
                 threads: 1,
             },
             msaa: 4,
+            msaa_cpu: 1,
         }
     }
 }
@@ -163,12 +167,17 @@ impl Renderer {
     /// that FFmpeg has an H.264 encoder.
     pub fn new(opts: RenderOptions) -> Result<Renderer, RenderError> {
         encode::init().map_err(RenderError::Encode)?;
-        let gpu = Gpu::new(opts.msaa)?;
+        let gpu = Gpu::new(opts.msaa, opts.msaa_cpu)?;
         Ok(Renderer { gpu, opts })
     }
 
     pub fn adapter_name(&self) -> &str {
         &self.gpu.adapter_name
+    }
+
+    /// MSAA samples per pixel in use.
+    pub fn samples(&self) -> u32 {
+        self.gpu.samples()
     }
 
     pub fn options(&self) -> &RenderOptions {
@@ -214,10 +223,8 @@ impl Renderer {
             .cache_static(scene.light_vp, &scene.static_casters(), &static_views)?;
 
         let fps = spec.video.fps;
-        let frames = (spec.observation_window_s * fps as f64).round() as u32;
-        let frame_steps: Vec<u32> = (0..=frames)
-            .map(|k| spec.frame_step(k).min(sim.steps()))
-            .collect();
+        let frame_steps = spec.observation_frame_steps(sim.steps());
+        let frames = frame_steps.len() as u32 - 1;
         let png_frames: Vec<(u32, f64)> = FRAME_TIMES
             .iter()
             .map(|&t| (((t * fps as f64).round() as u32).min(frames), t))

@@ -1,0 +1,206 @@
+//! End-to-end test of the render stage inside `rh-pipeline build` (SPEC §7, §8): every
+//! valid scene of a small rendered build has its three camera videos and the full-event
+//! video (ffprobe: H.264, yuv420p, the configured size and rate, the exact frame count),
+//! its fifteen observation frames, and the Parquet columns that name them; two rendered
+//! shards merge into the same bytes as one build; `rh-pipeline sheet` tiles the families.
+
+use rh_e2e::{files_under, python, run, run_ok};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const W: u32 = 160;
+const H: u32 = 96;
+const FAMILIES: &str = "object_drop,rolling_ball";
+
+/// A configuration directory: the embedded defaults with a small render size.
+fn small_config(dir: &Path) -> PathBuf {
+    let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs");
+    for name in ["labels.toml", "scoring.toml"] {
+        std::fs::copy(configs.join(name), dir.join(name)).unwrap();
+    }
+    let default = std::fs::read_to_string(configs.join("default.toml")).unwrap();
+    let small = default
+        .replace("\nwidth = 1280\n", &format!("\nwidth = {W}\n"))
+        .replace("\nheight = 720\n", &format!("\nheight = {H}\n"))
+        .replace("\nfull_width = 640\n", &format!("\nfull_width = {W}\n"))
+        .replace("\nfull_height = 360\n", &format!("\nfull_height = {H}\n"));
+    assert_ne!(small, default, "the [render] keys moved; update this test");
+    let path = dir.join("small.toml");
+    std::fs::write(&path, small).unwrap();
+    path
+}
+
+fn build(config: &Path, out: &Path, extra: &[&str]) {
+    let mut args = vec![
+        "--config",
+        config.to_str().unwrap(),
+        "build",
+        "--n",
+        "8",
+        "--seed",
+        "3",
+        "--quiet",
+        "--families",
+        FAMILIES,
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    run_ok("rh-pipeline", &args);
+}
+
+/// `(codec, pix_fmt, width, height, r_frame_rate, frames)` of a video's first stream.
+fn probe(path: &Path) -> (String, String, u64, u64, String, u64) {
+    let out = Command::new("ffprobe")
+        .args([
+            "-v",
+            "error",
+            "-select_streams",
+            "v:0",
+            "-count_frames",
+            "-show_entries",
+            "stream=codec_name,pix_fmt,width,height,r_frame_rate,nb_read_frames",
+            "-of",
+            "json",
+        ])
+        .arg(path)
+        .output()
+        .expect("ffprobe (scripts/setup.sh installs ffmpeg)");
+    assert!(out.status.success(), "ffprobe {}", path.display());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let s = &v["streams"][0];
+    (
+        s["codec_name"].as_str().unwrap().to_string(),
+        s["pix_fmt"].as_str().unwrap().to_string(),
+        s["width"].as_u64().unwrap(),
+        s["height"].as_u64().unwrap(),
+        s["r_frame_rate"].as_str().unwrap().to_string(),
+        s["nb_read_frames"].as_str().unwrap().parse().unwrap(),
+    )
+}
+
+/// Width and height from a PNG's header (and that it is one).
+fn png_size(path: &Path) -> (u32, u32) {
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{}", path.display());
+    let be = |i: usize| u32::from_be_bytes(bytes[i..i + 4].try_into().unwrap());
+    (be(16), be(20))
+}
+
+#[test]
+fn rendered_build_has_probed_videos_frames_columns_and_merges_byte_equal() {
+    let tmp = tempfile::tempdir().unwrap();
+    let config = small_config(tmp.path());
+    let single = tmp.path().join("single");
+    build(&config, &single, &["--jobs", "2"]);
+
+    // Per row: scene id, validity, the four video columns (pyarrow reads the table).
+    let rows = python(&format!(
+        "import pyarrow.parquet as pq\n\
+         t = pq.read_table('{}/data/test-00000-of-00001.parquet').to_pylist()\n\
+         for r in t:\n    print(r['scene_id'], r['valid'], r['ego_file_name'], r['closeup_file_name'], r['overhead_file_name'], r['full_event_file_name'], r['sim_steps'])",
+        single.display()
+    ));
+    let mut rendered = 0;
+    for line in rows.lines() {
+        let f: Vec<&str> = line.split(' ').collect();
+        let (id, valid, steps) = (f[0], f[1] == "True", f[6].parse::<u64>().unwrap());
+        if !valid {
+            assert!(
+                f[2..6].iter().all(|c| *c == "None"),
+                "{id}: invalid but rendered"
+            );
+            continue;
+        }
+        rendered += 1;
+        for (cam, file) in ["ego", "closeup", "overhead"].iter().zip(&f[2..5]) {
+            assert_eq!(*file, format!("videos/{cam}/{id}.mp4"));
+            let (codec, pix, w, h, rate, frames) = probe(&single.join(file));
+            assert_eq!(
+                (codec.as_str(), pix.as_str(), w, h, rate.as_str()),
+                ("h264", "yuv420p", W as u64, H as u64, "60/1"),
+                "{file}"
+            );
+            // The observation window [0, 0.6 s] at 60 fps, both ends included.
+            assert_eq!(frames, 37, "{file}");
+            for t in ["0.000", "0.150", "0.300", "0.450", "0.600"] {
+                let png = single.join(format!("frames/{id}/{cam}_t{t}.png"));
+                assert_eq!(png_size(&png), (W, H), "{}", png.display());
+            }
+        }
+        assert_eq!(f[5], format!("videos/full/{id}.mp4"));
+        let (codec, pix, w, h, rate, frames) = probe(&single.join(f[5]));
+        assert_eq!(
+            (codec.as_str(), pix.as_str(), w, h, rate.as_str()),
+            ("h264", "yuv420p", W as u64, H as u64, "30/1")
+        );
+        // The whole simulation (steps at 240 Hz) at 30 fps, both ends included.
+        assert_eq!(frames, steps * 30 / 240 + 1, "{}", f[5]);
+    }
+    assert!(rendered >= 6, "only {rendered} of 8 scenes rendered");
+
+    // Two rendered shards merge into exactly the single build.
+    let shards: Vec<PathBuf> = (0..2).map(|i| tmp.path().join(format!("s{i}"))).collect();
+    for (i, s) in shards.iter().enumerate() {
+        build(&config, s, &["--shard", &format!("{i}/2"), "--jobs", "1"]);
+    }
+    let merged = tmp.path().join("merged");
+    run_ok(
+        "rh-pipeline",
+        &[
+            "merge",
+            merged.to_str().unwrap(),
+            shards[1].to_str().unwrap(),
+            shards[0].to_str().unwrap(),
+        ],
+    );
+    let (a, b) = (files_under(&single), files_under(&merged));
+    assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
+    for (name, bytes) in &a {
+        assert!(
+            bytes == &b[name],
+            "{name} differs between the build and the merge"
+        );
+    }
+
+    // The contact sheet: one tile per family.
+    let sheet = tmp.path().join("sheet.png");
+    let json = run_ok(
+        "rh-pipeline",
+        &[
+            "sheet",
+            single.to_str().unwrap(),
+            "--out",
+            sheet.to_str().unwrap(),
+            "--json",
+        ],
+    );
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let families: Vec<&str> = v["tiles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["family"].as_str().unwrap())
+        .collect();
+    assert_eq!(families, ["object_drop", "rolling_ball"]);
+    let (w, h) = png_size(&sheet);
+    assert_eq!(
+        (w as u64, h as u64),
+        (v["width"].as_u64().unwrap(), v["height"].as_u64().unwrap())
+    );
+
+    // A dataset built without rendering has nothing to tile: a clear error, exit 2.
+    let bare = tmp.path().join("bare");
+    build(&config, &bare, &["--no-render"]);
+    let out = run(
+        "rh-pipeline",
+        &[
+            "sheet",
+            bare.to_str().unwrap(),
+            "--out",
+            sheet.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no rendered scenes"));
+}
