@@ -25,13 +25,15 @@ pub struct Uniforms {
     pub fill_rects: [[f32; 4]; MAX_REDRAW_RECTS],
 }
 
-/// One view to draw: the output slot (its own target), uniforms and vertex ranges.
+/// One view to draw: the output slot (its own target), uniforms, the static vertex
+/// ranges and the moving ones (drawn after a depth pre-pass: see `Gpu::main_pass`).
 pub struct ViewJob {
     pub slot: usize,
     pub width: u32,
     pub height: u32,
     pub uniforms: Uniforms,
     pub ranges: Vec<Range<u32>>,
+    pub dynamic: Range<u32>,
 }
 
 /// Most rectangles one overlay view redraws (more are merged by the caller).
@@ -73,6 +75,10 @@ pub struct Gpu {
     pub adapter_name: String,
     samples: u32,
     main: wgpu::RenderPipeline,
+    /// Depth only (no colour written): the moving bodies' pre-pass.
+    depth_only: wgpu::RenderPipeline,
+    /// Lit, depth test `LessEqual` without depth writes: shades each pre-passed pixel once.
+    main_over: wgpu::RenderPipeline,
     fill: wgpu::RenderPipeline,
     shadow: wgpu::RenderPipeline,
     main_bgl: wgpu::BindGroupLayout,
@@ -107,6 +113,8 @@ struct PipelineDesc<'a> {
     vertex_buffer: bool,
     fragment: Option<&'static str>,
     depth_compare: wgpu::CompareFunction,
+    depth_write: bool,
+    color_writes: wgpu::ColorWrites,
     depth_bias: wgpu::DepthBiasState,
     samples: u32,
 }
@@ -210,6 +218,11 @@ impl Gpu {
         let main_layout = layout(&main_bgl);
         let shadow_layout = layout(&shadow_bgl);
         let pipeline = |p: PipelineDesc| {
+            let targets = [Some(wgpu::ColorTargetState {
+                format: COLOR_FORMAT,
+                blend: None,
+                write_mask: p.color_writes,
+            })];
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(p.label),
                 layout: Some(p.layout),
@@ -225,7 +238,7 @@ impl Gpu {
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
                     format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
+                    depth_write_enabled: Some(p.depth_write),
                     depth_compare: Some(p.depth_compare),
                     stencil: Default::default(),
                     bias: p.depth_bias,
@@ -238,11 +251,7 @@ impl Gpu {
                     module: &shader,
                     entry_point: Some(entry),
                     compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: COLOR_FORMAT,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
+                    targets: &targets,
                 }),
                 multiview_mask: None,
                 cache: None,
@@ -255,6 +264,35 @@ impl Gpu {
             vertex_buffer: true,
             fragment: Some("fs_main"),
             depth_compare: wgpu::CompareFunction::Less,
+            depth_write: true,
+            color_writes: wgpu::ColorWrites::ALL,
+            depth_bias: Default::default(),
+            samples,
+        });
+        // Moving bodies are drawn twice: depth only, then shaded where their depth won,
+        // so overlapping and back-facing surfaces (meshes are not closed: a pan is an
+        // open disc) are shaded once per pixel instead of in draw order.
+        let depth_only = pipeline(PipelineDesc {
+            label: "depth-only",
+            layout: &main_layout,
+            vertex: "vs_main",
+            vertex_buffer: true,
+            fragment: Some("fs_fill"),
+            depth_compare: wgpu::CompareFunction::Less,
+            depth_write: true,
+            color_writes: wgpu::ColorWrites::empty(),
+            depth_bias: Default::default(),
+            samples,
+        });
+        let main_over = pipeline(PipelineDesc {
+            label: "main-over",
+            layout: &main_layout,
+            vertex: "vs_main",
+            vertex_buffer: true,
+            fragment: Some("fs_main"),
+            depth_compare: wgpu::CompareFunction::LessEqual,
+            depth_write: false,
+            color_writes: wgpu::ColorWrites::ALL,
             depth_bias: Default::default(),
             samples,
         });
@@ -266,6 +304,8 @@ impl Gpu {
             vertex_buffer: false,
             fragment: Some("fs_fill"),
             depth_compare: wgpu::CompareFunction::Always,
+            depth_write: true,
+            color_writes: wgpu::ColorWrites::ALL,
             depth_bias: Default::default(),
             samples,
         });
@@ -276,6 +316,8 @@ impl Gpu {
             vertex_buffer: true,
             fragment: None,
             depth_compare: wgpu::CompareFunction::Less,
+            depth_write: true,
+            color_writes: wgpu::ColorWrites::ALL,
             depth_bias: wgpu::DepthBiasState {
                 constant: 2,
                 slope_scale: 2.0,
@@ -329,6 +371,8 @@ impl Gpu {
             adapter_name,
             samples,
             main,
+            depth_only,
+            main_over,
             fill,
             shadow,
             main_bgl,
@@ -502,7 +546,7 @@ impl Gpu {
         self.shadow_pass(&mut enc, casters, true);
         for v in views {
             let t = self.targets[v.slot].as_ref().unwrap();
-            self.main_pass(&mut enc, t, Redraw::Whole(&v.ranges), &[]);
+            self.main_pass(&mut enc, t, Redraw::Whole(&v.ranges), &v.dynamic);
             Self::copy_to_readback(&mut enc, t);
         }
         self.queue.submit([enc.finish()]);
@@ -535,7 +579,7 @@ impl Gpu {
         );
         for v in views {
             let t = self.targets[v.slot].as_ref().unwrap();
-            self.main_pass(&mut enc, t, Redraw::Whole(&v.ranges), &[]);
+            self.main_pass(&mut enc, t, Redraw::Whole(&v.ranges), &v.dynamic);
             copy_whole(&mut enc, t.color(), &t.cache_color, t.width, t.height);
             copy_whole(&mut enc, &t.depth, &t.cache_depth, t.width, t.height);
         }
@@ -594,7 +638,7 @@ impl Gpu {
             copy_whole(&mut enc, &t.cache_color, t.color(), t.width, t.height);
             copy_whole(&mut enc, &t.cache_depth, &t.depth, t.width, t.height);
             let redraw = Redraw::Regions(rects);
-            self.main_pass(&mut enc, t, redraw, std::slice::from_ref(&v.dynamic));
+            self.main_pass(&mut enc, t, redraw, &v.dynamic);
             Self::copy_to_readback(&mut enc, t);
         }
         self.queue.submit([enc.finish()]);
@@ -665,14 +709,15 @@ impl Gpu {
 
     /// One lit pass into a target. `Redraw::Whole` clears it and draws its ranges;
     /// `Redraw::Regions` continues from the copied-in static image and re-clears and
-    /// redraws each rectangle (scissored). `dynamic` is then drawn over the whole target.
+    /// redraws each rectangle (scissored). `dynamic` is then drawn over the whole target,
+    /// depth first, then shaded.
     /// The colour is resolved (MSAA) at the end.
     fn main_pass(
         &self,
         enc: &mut wgpu::CommandEncoder,
         t: &Target,
         redraw: Redraw,
-        dynamic: &[Range<u32>],
+        dynamic: &Range<u32>,
     ) {
         let (view, resolve) = match &t.msaa {
             Some((_, m)) => (m, Some(&t.resolve_view)),
@@ -743,9 +788,11 @@ impl Gpu {
             }
         }
         pass.set_scissor_rect(0, 0, t.width, t.height);
-        pass.set_pipeline(&self.main);
-        for r in dynamic.iter().filter(|r| !r.is_empty()) {
-            pass.draw(r.clone(), 0..1);
+        if !dynamic.is_empty() {
+            pass.set_pipeline(&self.depth_only);
+            pass.draw(dynamic.clone(), 0..1);
+            pass.set_pipeline(&self.main_over);
+            pass.draw(dynamic.clone(), 0..1);
         }
     }
 

@@ -217,7 +217,7 @@ impl Renderer {
         let static_views: Vec<ViewJob> = all_cams
             .iter()
             .enumerate()
-            .map(|(slot, cam)| scene.view_job(slot, cam, Shading::Lit, scene.ranges_for(cam)))
+            .map(|(slot, cam)| scene.view_job(slot, cam, Shading::Lit, scene.ranges_for(cam), 0..0))
             .collect();
         self.gpu
             .cache_static(scene.light_vp, &scene.static_casters(), &static_views)?;
@@ -415,9 +415,7 @@ impl Renderer {
             .iter()
             .enumerate()
             .map(|(slot, cam)| {
-                let mut ranges = scene.ranges_for(cam);
-                ranges.push(dyn_range.clone());
-                scene.view_job(slot, cam, shading, ranges)
+                scene.view_job(slot, cam, shading, scene.ranges_for(cam), dyn_range.clone())
             })
             .collect();
         let mut casters = scene.static_casters();
@@ -1307,6 +1305,7 @@ impl SceneGeometry {
         cam: &CameraSpec,
         shading: Shading,
         ranges: Vec<Range<u32>>,
+        dynamic: Range<u32>,
     ) -> ViewJob {
         ViewJob {
             slot,
@@ -1314,6 +1313,7 @@ impl SceneGeometry {
             height: cam.height,
             uniforms: self.uniforms(cam, shading),
             ranges,
+            dynamic,
         }
     }
 

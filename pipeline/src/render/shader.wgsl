@@ -26,8 +26,9 @@ struct VIn {
 
 // Centroid interpolation: a multisampled edge pixel is shaded at a point on its
 // triangle, never extrapolated past it (which would look up shadows elsewhere).
+// Invariant: the depth pre-pass and the shading pass must compute identical depths.
 struct VOut {
-    @builtin(position) clip: vec4<f32>,
+    @builtin(position) @invariant clip: vec4<f32>,
     @location(0) @interpolate(perspective, centroid) world: vec3<f32>,
     @location(1) @interpolate(perspective, centroid) normal: vec3<f32>,
     @location(2) color: vec4<f32>,
