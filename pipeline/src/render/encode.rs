@@ -212,6 +212,32 @@ impl Drop for Mp4Writer {
     }
 }
 
+/// Frame buffers handed back by the encoder threads for the renderer to fill again: a
+/// 720p frame is 3.7 MB, and allocating one per frame costs page faults and zeroing.
+#[derive(Clone, Default)]
+pub struct FramePool(std::sync::Arc<std::sync::Mutex<Vec<Vec<u8>>>>);
+
+impl FramePool {
+    /// Most buffers kept (a few frames in flight per video).
+    const KEEP: usize = 48;
+
+    /// A buffer of `len` bytes (contents unspecified: the caller overwrites all of it).
+    pub fn take(&self, len: usize) -> Vec<u8> {
+        let mut free = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        match free.iter().position(|b| b.len() == len) {
+            Some(i) => free.swap_remove(i),
+            None => vec![0; len],
+        }
+    }
+
+    pub fn give(&self, buffer: Vec<u8>) {
+        let mut free = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if free.len() < Self::KEEP {
+            free.push(buffer);
+        }
+    }
+}
+
 /// A video encoded on its own thread: frames are sent through a bounded channel, so
 /// rendering (this thread) overlaps with encoding (that one).
 pub struct VideoJob {
@@ -226,6 +252,7 @@ impl VideoJob {
         height: u32,
         fps: u32,
         settings: EncodeSettings,
+        pool: FramePool,
     ) -> VideoJob {
         let (tx, rx) = sync_channel::<Vec<u8>>(8);
         let handle = std::thread::Builder::new()
@@ -234,6 +261,7 @@ impl VideoJob {
                 let mut writer = Mp4Writer::create(&path, width, height, fps, &settings)?;
                 for frame in rx {
                     writer.push(&frame)?;
+                    pool.give(frame);
                 }
                 writer.finish()
             })

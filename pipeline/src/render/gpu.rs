@@ -93,6 +93,8 @@ pub struct Gpu {
     vcap: u64,
     static_len: u32,
     targets: Vec<Option<Target>>,
+    /// Where read-back images come from (the encoders hand them back).
+    pub frames: super::encode::FramePool,
 }
 
 /// What a lit pass draws of the static scene.
@@ -386,6 +388,7 @@ impl Gpu {
             vcap,
             static_len: 0,
             targets: Vec::new(),
+            frames: Default::default(),
         })
     }
 
@@ -832,7 +835,7 @@ impl Gpu {
         for slot in slots {
             let t = self.targets[slot].as_ref().unwrap();
             let row = t.width as usize * 4;
-            let mut img = vec![0u8; row * t.height as usize];
+            let mut img = self.frames.take(row * t.height as usize);
             {
                 let data = t
                     .readback

@@ -240,6 +240,7 @@ impl Renderer {
                 cam.height,
                 fps,
                 self.opts.encode.clone(),
+                self.gpu.frames.clone(),
             ));
             videos.insert(cam.name.clone(), rel);
         }
@@ -296,6 +297,7 @@ impl Renderer {
             full_cam.height,
             full_fps,
             self.opts.encode.clone(),
+            self.gpu.frames.clone(),
         );
         if result.is_ok() {
             for &step in &full_event_steps {
