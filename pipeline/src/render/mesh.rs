@@ -224,16 +224,20 @@ impl Mesh {
     /// Axis-aligned box of half extents `h` centred at the local origin; faces are split
     /// into a grid of `div` cells per side so painters can draw patterns.
     pub fn boxy(&mut self, xf: &Xf, h: V3, div: usize, paint: Paint) {
-        let div = div.max(1);
+        // `div` cells along the longest edge, proportionally fewer along shorter ones
+        // (a thin panel's rim needs no grid: it only carries the paint's resolution).
+        let longest = h[0].max(h[1]).max(h[2]).max(1e-9);
+        let cells = h.map(|e| ((div.max(1) as f32 * e / longest).ceil() as usize).max(1));
         for axis in 0..3 {
             for sign in [-1.0f32, 1.0] {
                 let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-                for i in 0..div {
-                    for j in 0..div {
-                        let a0 = -1.0 + 2.0 * i as f32 / div as f32;
-                        let a1 = -1.0 + 2.0 * (i + 1) as f32 / div as f32;
-                        let b0 = -1.0 + 2.0 * j as f32 / div as f32;
-                        let b1 = -1.0 + 2.0 * (j + 1) as f32 / div as f32;
+                let (nu, nv) = (cells[u], cells[v]);
+                for i in 0..nu {
+                    for j in 0..nv {
+                        let a0 = -1.0 + 2.0 * i as f32 / nu as f32;
+                        let a1 = -1.0 + 2.0 * (i + 1) as f32 / nu as f32;
+                        let b0 = -1.0 + 2.0 * j as f32 / nv as f32;
+                        let b1 = -1.0 + 2.0 * (j + 1) as f32 / nv as f32;
                         let pt = |a: f32, b: f32| {
                             let mut p = [0.0; 3];
                             p[axis] = sign * h[axis];

@@ -1077,7 +1077,8 @@ impl SceneGeometry {
             };
             // Paint in world coordinates: the box is axis-aligned, so local z + centre.
             let paint = move |p: V3| wall_paint([p[0], p[1], p[2] + ch / 2.0]);
-            m.boxy(&Xf::at(pos), half_len, 12, &paint);
+            // 24 cells along the wall: 12 up its height, so the skirting stays a low band.
+            m.boxy(&Xf::at(pos), half_len, 24, &paint);
             m.transformed_into(&Xf::ID, &mut statics);
             pieces.extend(piece(&statics, s as usize));
             walls.push(Wall {
