@@ -223,14 +223,25 @@ fn remove_stale_temporaries(out: &Path) {
             }
         }
     }
-    for sub in ["", "data", "eval", "specs", ".rh-build/groups"] {
-        let Ok(entries) = std::fs::read_dir(out.join(sub)) else {
+    // Folders that hold files written atomically (videos and frames one level down).
+    let mut dirs: Vec<PathBuf> = ["", "data", "eval", "specs", ".rh-build/groups"]
+        .iter()
+        .map(|sub| out.join(sub))
+        .collect();
+    for media in ["videos", "frames"] {
+        if let Ok(entries) = std::fs::read_dir(out.join(media)) {
+            dirs.extend(entries.flatten().map(|e| e.path()).filter(|p| p.is_dir()));
+        }
+    }
+    for dir in dirs {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
             continue;
         };
         for e in entries.flatten() {
             let name = e.file_name();
             let name = name.to_string_lossy();
-            if name.starts_with('.') && name.ends_with(".tmp") {
+            // `write_atomic`'s `.<name>.<pid>.tmp`, the encoder's `.<name>.<pid>.<n>.tmp.mp4`.
+            if name.starts_with('.') && (name.ends_with(".tmp") || name.ends_with(".tmp.mp4")) {
                 let _ = std::fs::remove_file(e.path());
             }
         }

@@ -204,3 +204,78 @@ fn rendered_build_has_probed_videos_frames_columns_and_merges_byte_equal() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no rendered scenes"));
 }
+
+/// A rendered build killed (SIGKILL) while it writes videos resumes to exactly the bytes
+/// of an uninterrupted build: half-written videos are temporary files, swept on restart,
+/// and a group counts as done only once its videos and frames are all there.
+#[test]
+fn rendered_build_killed_mid_video_resumes_to_the_same_bytes() {
+    use std::process::Stdio;
+    use std::time::{Duration, Instant};
+    let tmp = tempfile::tempdir().unwrap();
+    let config = small_config(tmp.path());
+    let reference = tmp.path().join("reference");
+    build(&config, &reference, &["--jobs", "1"]);
+
+    let killed = tmp.path().join("killed");
+    let mut child = Command::new(rh_e2e::bin("rh-pipeline"))
+        .args([
+            "--config",
+            config.to_str().unwrap(),
+            "build",
+            "--n",
+            "8",
+            "--seed",
+            "3",
+            "--quiet",
+            "--families",
+            FAMILIES,
+            "--jobs",
+            "1",
+            "--out",
+            killed.to_str().unwrap(),
+        ])
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Kill it once the first group is done and the second one's videos are being written.
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let temporary_video = |dir: &Path| {
+        ["ego", "closeup", "overhead", "full"].iter().any(|cam| {
+            std::fs::read_dir(dir.join("videos").join(cam))
+                .map(|d| {
+                    d.flatten()
+                        .any(|e| e.file_name().to_string_lossy().ends_with(".tmp.mp4"))
+                })
+                .unwrap_or(false)
+        })
+    };
+    loop {
+        let records = std::fs::read_dir(killed.join(".rh-build/groups"))
+            .map(|d| d.count())
+            .unwrap_or(0);
+        if (records >= 1 && temporary_video(&killed)) || Instant::now() > deadline {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        !killed.join("README.md").exists(),
+        "the build finished before it could be killed"
+    );
+    assert!(
+        temporary_video(&killed),
+        "killed while no video was being written"
+    );
+
+    build(&config, &killed, &["--jobs", "1"]);
+    let (a, b) = (files_under(&reference), files_under(&killed));
+    assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
+    for (name, bytes) in &a {
+        assert!(bytes == &b[name], "{name} differs after the resumed build");
+    }
+}

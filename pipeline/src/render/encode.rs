@@ -95,6 +95,13 @@ impl Mp4Writer {
         opts.set("preset", &settings.preset);
         opts.set("crf", &settings.crf.to_string());
         opts.set("profile", "high");
+        // Macroblock-tree rate control off: with it, libx264 (r3095, Debian's) reads past
+        // the end of a lookahead buffer (valgrind: "invalid read of size 16"), so a
+        // video's bytes depended on whatever memory lay there — different bitstreams
+        // for identical frames when scenes were encoded concurrently. Without it the
+        // encoder reads only what it wrote, and a build's videos are reproducible byte
+        // for byte (tested by merging shards and resuming killed builds).
+        opts.set("x264-params", "mbtree=0");
         if settings.threads > 0 {
             opts.set("threads", &settings.threads.to_string());
         }
@@ -120,12 +127,20 @@ impl Mp4Writer {
             ff::software::scaling::Flags::BILINEAR,
         )
         .map_err(|e| fferr("swscale", e))?;
+        // FFmpeg leaves frame buffers uninitialised, row padding included: zeroed, so
+        // nothing but the pixels can reach the encoder.
+        let mut rgba = ff::frame::Video::new(ff::format::Pixel::RGBA, width, height);
+        let mut yuv = ff::frame::Video::new(ff::format::Pixel::YUV420P, width, height);
+        rgba.data_mut(0).fill(0);
+        for plane in 0..3 {
+            yuv.data_mut(plane).fill(0);
+        }
         Ok(Mp4Writer {
             octx,
             encoder,
             scaler,
-            rgba: ff::frame::Video::new(ff::format::Pixel::RGBA, width, height),
-            yuv: ff::frame::Video::new(ff::format::Pixel::YUV420P, width, height),
+            rgba,
+            yuv,
             enc_tb,
             width,
             height,
