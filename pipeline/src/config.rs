@@ -114,7 +114,7 @@ pub struct RenderConfig {
     #[serde(default = "default_msaa")]
     pub msaa: u32,
     /// MSAA samples (4 or 1) on a CPU rasterizer (Mesa's lavapipe), where 4 samples
-    /// cost about 2× the time.
+    /// cost about 3× the time.
     #[serde(default = "default_msaa_cpu")]
     pub msaa_cpu: u32,
 }
