@@ -70,9 +70,8 @@ impl View {
 /// hazard comes within `until_within` of the observer's torso axis: from then on the
 /// event has reached the observer, and leaving the view (past the head) is natural.
 fn window_steps(spec: &SceneSpec, sim: &Simulation, until_within: f64) -> Vec<u32> {
-    let frames = (spec.observation_window_s * spec.video.fps as f64).round() as u32;
-    (0..=frames)
-        .map(|f| spec.frame_step(f).min(sim.steps()))
+    spec.observation_frame_steps(sim.steps())
+        .into_iter()
         .take_while(|&k| {
             k == 0 || spec.observer.torso_axis_distance(sim.hazard_position(k)) > until_within
         })
