@@ -20,6 +20,7 @@ pub mod gpu;
 pub mod mesh;
 pub mod recipes;
 
+use crate::cameras::View;
 use crate::config::RenderConfig;
 use crate::simulate::Simulation;
 use crate::spec::vec3::{add, cross, dot, norm, scale, sub};
@@ -221,6 +222,13 @@ impl Renderer {
             .collect();
         self.gpu
             .cache_static(scene.light_vp, &scene.static_casters(), &static_views)?;
+        // What each view needs per frame that does not change within the scene.
+        let fixed_views: Vec<FixedView> = all_cams
+            .iter()
+            .enumerate()
+            .map(|(slot, cam)| scene.fixed_view(slot, cam))
+            .collect();
+        let (window_views, full_view) = fixed_views.split_at(cams.len());
 
         let fps = spec.video.fps;
         let frame_steps = spec.observation_frame_steps(sim.steps());
@@ -259,7 +267,7 @@ impl Renderer {
         let mut result = Ok(());
         for (k, &step) in frame_steps.iter().enumerate() {
             let t = std::time::Instant::now();
-            let images = self.draw_overlay_step(&scene, sim, step, &cams, 0)?;
+            let images = self.draw_overlay_step(&scene, sim, step, window_views)?;
             t_draw += t.elapsed().as_secs_f64();
             for (ci, (img, job)) in images.into_iter().zip(&jobs).enumerate() {
                 for (ti, &(pk, t)) in png_frames.iter().enumerate() {
@@ -301,8 +309,7 @@ impl Renderer {
         );
         if result.is_ok() {
             for &step in &full_event_steps {
-                let mut images =
-                    self.draw_overlay_step(&scene, sim, step, &[&full_cam], cams.len())?;
+                let mut images = self.draw_overlay_step(&scene, sim, step, full_view)?;
                 if !full_job.send(images.pop().unwrap()) {
                     break;
                 }
@@ -426,27 +433,25 @@ impl Renderer {
     }
 
     /// The same pixels as `draw_step` with `Shading::Lit`, drawn over the views cached
-    /// in `render_scene` (slots `first_slot..`): only the moving bodies and the static
-    /// surfaces their shadows can reach are drawn.
+    /// in `render_scene`: only the moving bodies and the static surfaces their shadows
+    /// can reach are drawn.
     fn draw_overlay_step(
         &mut self,
         scene: &SceneGeometry,
         sim: &Simulation,
         step: u32,
-        cams: &[&CameraSpec],
-        first_slot: usize,
+        views: &[FixedView],
     ) -> Result<Vec<Vec<u8>>, RenderError> {
         let dynamic = scene.dynamic_at(sim, step, false);
         let dyn_range = self.gpu.set_dynamic(&dynamic)?;
         let moving = bounds(&dynamic);
-        let jobs: Vec<OverlayJob> = cams
+        let jobs: Vec<OverlayJob> = views
             .iter()
-            .enumerate()
-            .map(|(i, cam)| OverlayJob {
-                slot: first_slot + i,
-                uniforms: scene.uniforms(cam, Shading::Lit),
+            .map(|v| OverlayJob {
+                slot: v.slot,
+                uniforms: v.uniforms,
                 redraw: moving
-                    .map(|m| scene.shadow_redraws(cam, m))
+                    .map(|m| scene.shadow_redraws(v, m))
                     .unwrap_or_default(),
                 dynamic: dyn_range.clone(),
             })
@@ -470,23 +475,23 @@ fn bounds(verts: &[Vertex]) -> Option<[Vec3; 2]> {
 }
 
 /// Screen bounds (x, y, width, height; clamped, padded by 2 pixels) of the box
-/// `[lo, hi]` in `cam` with view-projection `m`: `None` when off screen, the whole
-/// frame when the box reaches behind the camera.
-fn screen_rect(cam: &CameraSpec, m: &[[f32; 4]; 4], [lo, hi]: [Vec3; 2]) -> Option<[u32; 4]> {
+/// `[lo, hi]` in `cam` seen through `view` (its camera model): `None` when off screen,
+/// the whole frame when the box reaches behind the camera or there is no view (a
+/// camera looking straight up or down).
+fn screen_rect(cam: &CameraSpec, view: Option<&View>, [lo, hi]: [Vec3; 2]) -> Option<[u32; 4]> {
+    let whole = Some([0, 0, cam.width, cam.height]);
+    let Some(view) = view else {
+        return whole;
+    };
     let (mut x0, mut y0) = (f64::INFINITY, f64::INFINITY);
     let (mut x1, mut y1) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
     for corner in 0..8 {
         let p = [0, 1, 2].map(|i| if corner >> i & 1 == 1 { hi[i] } else { lo[i] });
-        let [cx, cy, cw] = [0, 1, 3].map(|row| {
-            (0..4)
-                .map(|col| m[col][row] as f64 * if col < 3 { p[col] } else { 1.0 })
-                .sum::<f64>()
-        });
-        if cw < 0.05 {
-            return Some([0, 0, cam.width, cam.height]);
-        }
-        let px = (cx / cw * 0.5 + 0.5) * cam.width as f64;
-        let py = (0.5 - cy / cw * 0.5) * cam.height as f64;
+        let Some([nx, ny]) = view.project(p) else {
+            return whole;
+        };
+        let px = (nx * 0.5 + 0.5) * cam.width as f64;
+        let py = (0.5 - ny * 0.5) * cam.height as f64;
         x0 = x0.min(px);
         y0 = y0.min(py);
         x1 = x1.max(px);
@@ -550,6 +555,7 @@ fn rects_meet(a: [u32; 4], b: [u32; 4]) -> bool {
 /// no area or more than `MAX_REDRAW_RECTS` remain.
 fn shadow_regions(
     cam: &CameraSpec,
+    view: Option<&View>,
     [lo, hi]: [Vec3; 2],
     reach: f64,
     sun_dir: [f32; 4],
@@ -560,7 +566,6 @@ fn shadow_regions(
     const PAD: f64 = 0.001;
     let (lo, hi) = (lo.map(|v| v - reach), hi.map(|v| v + reach));
     let d = [sun_dir[0] as f64, sun_dir[1] as f64, sun_dir[2] as f64];
-    let m = view_proj(cam);
     let mut rects: Vec<[u32; 4]> = Vec::new();
     for [rlo, rhi] in receivers {
         // The translates B + d·t that overlap R: t in [t0, t1], per axis.
@@ -589,7 +594,7 @@ fn shadow_regions(
         if (0..3).any(|i| box_lo[i] > box_hi[i]) {
             continue;
         }
-        if let Some(r) = screen_rect(cam, &m, [box_lo, box_hi]) {
+        if let Some(r) = screen_rect(cam, view, [box_lo, box_hi]) {
             rects.push(r);
         }
     }
@@ -831,6 +836,18 @@ fn piece(statics: &[Vertex], from: usize) -> Option<Piece> {
             .filter_map(bounds)
             .collect(),
     })
+}
+
+/// A camera's per-scene constants for overlay frames (`SceneGeometry::fixed_view`).
+struct FixedView<'a> {
+    slot: usize,
+    cam: &'a CameraSpec,
+    uniforms: Uniforms,
+    view: Option<View>,
+    /// Static pieces the camera sees: vertex range and screen bounds.
+    visible: Vec<(Range<u32>, [u32; 4])>,
+    /// Their receiver boxes (`Piece::receivers`).
+    receivers: Vec<[Vec3; 2]>,
 }
 
 struct Wall {
@@ -1261,40 +1278,60 @@ impl SceneGeometry {
         r
     }
 
-    /// Where moving geometry with bounds `moving` may shade static surfaces in `cam`
-    /// (`shadow_regions`), each rectangle with the static pieces it must redraw: those
-    /// the camera sees whose screen bounds meet it.
-    fn shadow_redraws(
-        &self,
-        cam: &CameraSpec,
-        moving: [Vec3; 2],
-    ) -> Vec<([u32; 4], Vec<Range<u32>>)> {
+    /// What a camera needs per overlay frame that does not change within the scene:
+    /// its uniforms, camera model, and the static pieces it sees with their screen
+    /// bounds and receiver boxes.
+    fn fixed_view<'a>(&self, slot: usize, cam: &'a CameraSpec) -> FixedView<'a> {
         let seen = self.ranges_for(cam);
-        let m = view_proj(cam);
-        let visible: Vec<(&Piece, [u32; 4])> = self
+        let view = View::new(cam);
+        let pieces: Vec<(&Piece, [u32; 4])> = self
             .pieces
             .iter()
             .filter(|p| {
                 seen.iter()
                     .any(|r| r.start <= p.range.start && p.range.end <= r.end)
             })
-            .filter_map(|p| screen_rect(cam, &m, p.bounds).map(|r| (p, r)))
+            .filter_map(|p| screen_rect(cam, view.as_ref(), p.bounds).map(|r| (p, r)))
             .collect();
-        let receivers: Vec<[Vec3; 2]> = visible
-            .iter()
-            .flat_map(|(p, _)| p.receivers.iter().copied())
-            .collect();
-        shadow_regions(cam, moving, self.shadow_reach, self.sun_dir, &receivers)
-            .into_iter()
-            .map(|rect| {
-                let ranges = visible
-                    .iter()
-                    .filter(|(_, r)| rects_meet(*r, rect))
-                    .map(|(p, _)| p.range.clone())
-                    .collect();
-                (rect, ranges)
-            })
-            .collect()
+        FixedView {
+            slot,
+            cam,
+            uniforms: self.uniforms(cam, Shading::Lit),
+            receivers: pieces
+                .iter()
+                .flat_map(|(p, _)| p.receivers.iter().copied())
+                .collect(),
+            visible: pieces
+                .into_iter()
+                .map(|(p, rect)| (p.range.clone(), rect))
+                .collect(),
+            view,
+        }
+    }
+
+    /// Where moving geometry with bounds `moving` may shade static surfaces in a view
+    /// (`shadow_regions`), each rectangle with the static pieces it must redraw: those
+    /// the camera sees whose screen bounds meet it.
+    fn shadow_redraws(&self, v: &FixedView, moving: [Vec3; 2]) -> Vec<([u32; 4], Vec<Range<u32>>)> {
+        shadow_regions(
+            v.cam,
+            v.view.as_ref(),
+            moving,
+            self.shadow_reach,
+            self.sun_dir,
+            &v.receivers,
+        )
+        .into_iter()
+        .map(|rect| {
+            let ranges = v
+                .visible
+                .iter()
+                .filter(|(_, r)| rects_meet(*r, rect))
+                .map(|(range, _)| range.clone())
+                .collect();
+            (rect, ranges)
+        })
+        .collect()
     }
 
     /// Fixed bodies and the observer: the shadow casters that never move.
