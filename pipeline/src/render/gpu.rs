@@ -330,11 +330,7 @@ impl Gpu {
         let shadow_map = |label| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
-                size: wgpu::Extent3d {
-                    width: SHADOW_SIZE,
-                    height: SHADOW_SIZE,
-                    depth_or_array_layers: 1,
-                },
+                size: extent(SHADOW_SIZE, SHADOW_SIZE),
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -451,11 +447,7 @@ impl Gpu {
     }
 
     fn make_target(&self, width: u32, height: u32) -> Target {
-        let size = wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        };
+        let size = extent(width, height);
         let tex = |samples: u32, format, usage| {
             self.device.create_texture(&wgpu::TextureDescriptor {
                 label: None,
@@ -540,18 +532,7 @@ impl Gpu {
         casters: &[Range<u32>],
         views: &[ViewJob],
     ) -> Result<Vec<Vec<u8>>, RenderError> {
-        for v in views {
-            self.target(v.slot, v.width, v.height);
-            self.write_uniforms(v.slot, &v.uniforms, Redraw::Whole(&[]));
-        }
-        self.write_shadow_uniforms(light_vp);
-        let mut enc = self.encoder();
-        self.shadow_pass(&mut enc, casters, true);
-        for v in views {
-            let t = self.targets[v.slot].as_ref().unwrap();
-            self.main_pass(&mut enc, t, Redraw::Whole(&v.ranges), &v.dynamic);
-            Self::copy_to_readback(&mut enc, t);
-        }
+        let enc = self.encode_whole(light_vp, casters, views, false);
         self.queue.submit([enc.finish()]);
         self.read_back(views.iter().map(|v| v.slot))
     }
@@ -566,6 +547,24 @@ impl Gpu {
         casters: &[Range<u32>],
         views: &[ViewJob],
     ) -> Result<(), RenderError> {
+        let enc = self.encode_whole(light_vp, casters, views, true);
+        self.queue.submit([enc.finish()]);
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| RenderError::Gpu(format!("poll: {e}")))?;
+        Ok(())
+    }
+
+    /// Encodes the shadow map from `casters` and every view drawn from a cleared
+    /// target; then either keeps shadow map and views as the static cache (`cache`) or
+    /// queues each view's read-back.
+    fn encode_whole(
+        &mut self,
+        light_vp: [[f32; 4]; 4],
+        casters: &[Range<u32>],
+        views: &[ViewJob],
+        cache: bool,
+    ) -> wgpu::CommandEncoder {
         for v in views {
             self.target(v.slot, v.width, v.height);
             self.write_uniforms(v.slot, &v.uniforms, Redraw::Whole(&[]));
@@ -573,24 +572,20 @@ impl Gpu {
         self.write_shadow_uniforms(light_vp);
         let mut enc = self.encoder();
         self.shadow_pass(&mut enc, casters, true);
-        copy_whole(
-            &mut enc,
-            &self.shadow_tex,
-            &self.static_shadow,
-            SHADOW_SIZE,
-            SHADOW_SIZE,
-        );
+        if cache {
+            copy_whole(&mut enc, &self.shadow_tex, &self.static_shadow);
+        }
         for v in views {
             let t = self.targets[v.slot].as_ref().unwrap();
             self.main_pass(&mut enc, t, Redraw::Whole(&v.ranges), &v.dynamic);
-            copy_whole(&mut enc, t.color(), &t.cache_color, t.width, t.height);
-            copy_whole(&mut enc, &t.depth, &t.cache_depth, t.width, t.height);
+            if cache {
+                copy_whole(&mut enc, t.color(), &t.cache_color);
+                copy_whole(&mut enc, &t.depth, &t.cache_depth);
+            } else {
+                Self::copy_to_readback(&mut enc, t);
+            }
         }
-        self.queue.submit([enc.finish()]);
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Gpu(format!("poll: {e}")))?;
-        Ok(())
+        enc
     }
 
     /// One frame over the cached static images (same pixels as [`Gpu::draw`] of the
@@ -628,18 +623,12 @@ impl Gpu {
         }
         self.write_shadow_uniforms(light_vp);
         let mut enc = self.encoder();
-        copy_whole(
-            &mut enc,
-            &self.static_shadow,
-            &self.shadow_tex,
-            SHADOW_SIZE,
-            SHADOW_SIZE,
-        );
+        copy_whole(&mut enc, &self.static_shadow, &self.shadow_tex);
         self.shadow_pass(&mut enc, casters, false);
         for (v, rects) in views.iter().zip(&redraws) {
             let t = self.targets[v.slot].as_ref().unwrap();
-            copy_whole(&mut enc, &t.cache_color, t.color(), t.width, t.height);
-            copy_whole(&mut enc, &t.cache_depth, &t.depth, t.width, t.height);
+            copy_whole(&mut enc, &t.cache_color, t.color());
+            copy_whole(&mut enc, &t.cache_depth, &t.depth);
             let redraw = Redraw::Regions(rects);
             self.main_pass(&mut enc, t, redraw, &v.dynamic);
             Self::copy_to_readback(&mut enc, t);
@@ -801,12 +790,7 @@ impl Gpu {
 
     fn copy_to_readback(enc: &mut wgpu::CommandEncoder, t: &Target) {
         enc.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture: &t.resolve,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
+            whole(&t.resolve),
             wgpu::TexelCopyBufferInfo {
                 buffer: &t.readback,
                 layout: wgpu::TexelCopyBufferLayout {
@@ -815,7 +799,7 @@ impl Gpu {
                     rows_per_image: Some(t.height),
                 },
             },
-            extent(t.width, t.height),
+            t.resolve.size(),
         );
     }
 
@@ -872,21 +856,19 @@ fn extent(width: u32, height: u32) -> wgpu::Extent3d {
     }
 }
 
-/// Copies a whole single-level texture (colour or depth, any sample count).
-fn copy_whole(
-    enc: &mut wgpu::CommandEncoder,
-    from: &wgpu::Texture,
-    to: &wgpu::Texture,
-    width: u32,
-    height: u32,
-) {
-    let info = |texture| wgpu::TexelCopyTextureInfo {
+/// A whole single-level texture as a copy source or destination.
+fn whole(texture: &wgpu::Texture) -> wgpu::TexelCopyTextureInfo<'_> {
+    wgpu::TexelCopyTextureInfo {
         texture,
         mip_level: 0,
         origin: wgpu::Origin3d::ZERO,
         aspect: wgpu::TextureAspect::All,
-    };
-    enc.copy_texture_to_texture(info(from), info(to), extent(width, height));
+    }
+}
+
+/// Copies a whole texture into one of the same size (colour or depth, any sample count).
+fn copy_whole(enc: &mut wgpu::CommandEncoder, from: &wgpu::Texture, to: &wgpu::Texture) {
+    enc.copy_texture_to_texture(whole(from), whole(to), from.size());
 }
 
 fn uniform_buffer(device: &wgpu::Device) -> wgpu::Buffer {

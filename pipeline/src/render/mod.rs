@@ -1399,8 +1399,8 @@ fn object_look_mesh(catalog: &Catalog, id: &str, parts: &[crate::spec::PartSpec]
     Some(recipes::object_mesh(&look))
 }
 
-/// Orthographic light matrix covering the room (and a margin) along the sun direction.
-/// The sun's orthographic view-projection over the room, and its half-width (m).
+/// The sun's orthographic view-projection covering the room (and a margin) along its
+/// direction, and its half-width (m).
 fn light_matrix(dir: Vec3, size: [f64; 2], ceiling: f64) -> ([[f32; 4]; 4], f64) {
     let center = [0.0, 0.0, ceiling / 2.0];
     let radius = 0.5 * (size[0].hypot(size[1])).hypot(ceiling) + 0.5;
