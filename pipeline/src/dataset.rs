@@ -424,12 +424,9 @@ pub fn frame_files(scene_id: &str) -> Vec<String> {
     CAMERA_NAMES
         .iter()
         .flat_map(|cam| {
-            crate::render::FRAME_TIMES.iter().map(move |&t| {
-                format!(
-                    "frames/{scene_id}/{}",
-                    crate::render::frame_file_name(cam, t)
-                )
-            })
+            crate::render::FRAME_TIMES
+                .iter()
+                .map(move |&t| crate::render::frame_path(scene_id, cam, t))
         })
         .collect()
 }

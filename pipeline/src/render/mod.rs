@@ -272,7 +272,7 @@ impl Renderer {
             for (ci, (img, job)) in images.into_iter().zip(&jobs).enumerate() {
                 for (ti, &(pk, t)) in png_frames.iter().enumerate() {
                     if pk as usize == k {
-                        let rel = format!("frames/{id}/{}", frame_file_name(&cams[ci].name, t));
+                        let rel = frame_path(id, &cams[ci].name, t);
                         let _ = png_tx.send((
                             out_dir.join(&rel),
                             cams[ci].width,
@@ -666,6 +666,11 @@ fn cover_with_tiles(rects: &[[u32; 4]], width: u32, height: u32) -> Vec<[u32; 4]
 /// `<cam>_t0.150.png`
 pub fn frame_file_name(camera: &str, t: f64) -> String {
     format!("{camera}_t{t:.3}.png")
+}
+
+/// `frames/<scene_id>/<cam>_t0.150.png`, relative to the dataset root.
+pub fn frame_path(scene_id: &str, camera: &str, t: f64) -> String {
+    format!("frames/{scene_id}/{}", frame_file_name(camera, t))
 }
 
 fn write_png(path: &Path, w: u32, h: u32, rgba: &[u8]) -> Result<(), String> {
@@ -1460,7 +1465,7 @@ pub fn contact_sheet(dataset_dir: &Path, out_png: &Path) -> Result<ContactSheet,
     let specs_dir = dataset_dir.join("specs");
     let entries = std::fs::read_dir(&specs_dir)
         .map_err(|e| RenderError::Io(format!("{}: {e}", specs_dir.display())))?;
-    let mut first: BTreeMap<String, (u64, String)> = BTreeMap::new();
+    let mut first: BTreeMap<String, (u64, String, PathBuf)> = BTreeMap::new();
     for entry in entries {
         let path = entry.map_err(|e| RenderError::Io(e.to_string()))?.path();
         if path.extension().and_then(|e| e.to_str()) != Some("json") {
@@ -1470,17 +1475,20 @@ pub fn contact_sheet(dataset_dir: &Path, out_png: &Path) -> Result<ContactSheet,
             .map_err(|e| RenderError::Io(format!("{}: {e}", path.display())))?;
         let spec = SceneSpec::from_json(&text)
             .map_err(|e| RenderError::Io(format!("{}: {e}", path.display())))?;
-        let frames = dataset_dir.join("frames").join(&spec.scene_id);
-        if !frames.join(frame_file_name("closeup", 0.30)).exists()
-            && !frames.join(frame_file_name("ego", 0.30)).exists()
-        {
+        // The close-up frame at 0.30 s, or the ego one when there is no close-up.
+        let Some(frame) = ["closeup", "ego"]
+            .into_iter()
+            .map(|cam| dataset_dir.join(frame_path(&spec.scene_id, cam, 0.30)))
+            .find(|p| p.exists())
+        else {
             continue;
-        }
-        let e = first
-            .entry(spec.family.clone())
-            .or_insert((u64::MAX, String::new()));
+        };
+        let e =
+            first
+                .entry(spec.family.clone())
+                .or_insert((u64::MAX, String::new(), PathBuf::new()));
         if spec.scene_index < e.0 {
-            *e = (spec.scene_index, spec.scene_id.clone());
+            *e = (spec.scene_index, spec.scene_id.clone(), frame);
         }
     }
     if first.is_empty() {
@@ -1508,17 +1516,8 @@ pub fn contact_sheet(dataset_dir: &Path, out_png: &Path) -> Result<ContactSheet,
     let mut sheet = image::RgbImage::from_pixel(w, h, image::Rgb([24, 24, 28]));
     let mut tiles = Vec::new();
     for (i, family) in order.iter().enumerate() {
-        let id = &first[family].1;
-        let frames = dataset_dir.join("frames").join(id);
-        let path = [
-            frame_file_name("closeup", 0.30),
-            frame_file_name("ego", 0.30),
-        ]
-        .into_iter()
-        .map(|n| frames.join(n))
-        .find(|p| p.exists())
-        .unwrap();
-        let img = image::open(&path)
+        let (_, id, path) = &first[family];
+        let img = image::open(path)
             .map_err(|e| RenderError::Io(format!("{}: {e}", path.display())))?
             .to_rgb8();
         let tile = image::imageops::resize(&img, tw, th, image::imageops::FilterType::Triangle);
