@@ -30,7 +30,8 @@ fn small_config(dir: &Path) -> PathBuf {
     path
 }
 
-fn build(config: &Path, out: &Path, extra: &[&str]) {
+/// `rh-pipeline` arguments of the tests' 8-scene build into `out`, plus `extra`.
+fn build_args<'a>(config: &'a Path, out: &'a Path, extra: &[&'a str]) -> Vec<&'a str> {
     let mut args = vec![
         "--config",
         config.to_str().unwrap(),
@@ -46,7 +47,11 @@ fn build(config: &Path, out: &Path, extra: &[&str]) {
         out.to_str().unwrap(),
     ];
     args.extend_from_slice(extra);
-    run_ok("rh-pipeline", &args);
+    args
+}
+
+fn build(config: &Path, out: &Path, extra: &[&str]) {
+    run_ok("rh-pipeline", &build_args(config, out, extra));
 }
 
 /// `(codec, pix_fmt, width, height, r_frame_rate, frames)` of a video's first stream.
@@ -219,22 +224,7 @@ fn rendered_build_killed_mid_video_resumes_to_the_same_bytes() {
 
     let killed = tmp.path().join("killed");
     let mut child = Command::new(rh_e2e::bin("rh-pipeline"))
-        .args([
-            "--config",
-            config.to_str().unwrap(),
-            "build",
-            "--n",
-            "8",
-            "--seed",
-            "3",
-            "--quiet",
-            "--families",
-            FAMILIES,
-            "--jobs",
-            "1",
-            "--out",
-            killed.to_str().unwrap(),
-        ])
+        .args(build_args(&config, &killed, &["--jobs", "1"]))
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
         .stdout(Stdio::null())
         .stderr(Stdio::null())
