@@ -19,7 +19,7 @@ use crate::config::Config;
 use crate::families;
 use crate::label::Action;
 use crate::plan::plan_group;
-use crate::scene::produce_group;
+use crate::scene::produce_group_counted;
 use rh_catalog::Catalog;
 use serde::Serialize;
 
@@ -32,6 +32,21 @@ pub struct FamilyBalance {
     pub no_action: usize,
     /// Scenes that failed a validator after every resampling attempt.
     pub invalid: usize,
+    /// Group attempts made (one per group when nothing is rejected).
+    pub attempts: u32,
+    /// Attempts rejected by each validator (`validate::VALIDATOR_COLUMNS` order).
+    pub rejected_by: Vec<u32>,
+}
+
+impl FamilyBalance {
+    /// Share of this family's attempts that the reaction-time validator rejected.
+    pub fn reaction_rejection_rate(&self) -> f64 {
+        let i = crate::validate::VALIDATOR_COLUMNS
+            .iter()
+            .position(|c| *c == "valid_reaction_time")
+            .expect("a validator column");
+        self.rejected_by[i] as f64 / self.attempts.max(1) as f64
+    }
 }
 
 impl FamilyBalance {
@@ -73,12 +88,19 @@ pub fn label_balance(
             dodge: 0,
             no_action: 0,
             invalid: 0,
+            attempts: 0,
+            rejected_by: vec![0; crate::validate::VALIDATOR_COLUMNS.len()],
         };
         let mut taken = 0;
         for j in 0..groups_per_family {
             let group = index as u64 + all.len() as u64 * j;
             let selection = plan_group(catalog, &all, build_seed, group)?;
-            let results = produce_group(&selection, build_seed, group * 4, 4, catalog, config)?;
+            let (results, rejections) =
+                produce_group_counted(&selection, build_seed, group * 4, 4, catalog, config)?;
+            balance.attempts += rejections.attempts;
+            for (total, n) in balance.rejected_by.iter_mut().zip(rejections.rejected_by) {
+                *total += n;
+            }
             for r in results {
                 if taken == per_family {
                     break;
@@ -99,26 +121,60 @@ pub fn label_balance(
     Ok(out)
 }
 
-/// The balance as a plain-text table.
+/// The balance as a plain-text table: label counts, then the group attempts made and
+/// the share of them each validator rejected (`reaction`: the reaction-time rule of
+/// label rule v2; `other`: any other validator).
 pub fn format_table(rows: &[FamilyBalance]) -> String {
-    let mut s = format!(
-        "{:<16} {:>6} {:>6} {:>9} {:>7}\n",
-        "family", "CATCH", "DODGE", "NO_ACTION", "invalid"
+    let header = format!(
+        "{:<16} {:>6} {:>6} {:>9} {:>7} {:>8} {:>9} {:>7}\n",
+        "family", "CATCH", "DODGE", "NO_ACTION", "invalid", "attempts", "reaction", "other"
     );
-    let (mut c, mut d, mut n, mut i) = (0, 0, 0, 0);
+    let mut s = header;
+    let reaction = crate::validate::VALIDATOR_COLUMNS
+        .iter()
+        .position(|c| *c == "valid_reaction_time")
+        .expect("a validator column");
+    let mut total = FamilyBalance {
+        family: "total".into(),
+        catch: 0,
+        dodge: 0,
+        no_action: 0,
+        invalid: 0,
+        attempts: 0,
+        rejected_by: vec![0; crate::validate::VALIDATOR_COLUMNS.len()],
+    };
+    let line = |r: &FamilyBalance| {
+        let other: u32 = r
+            .rejected_by
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != reaction)
+            .map(|(_, n)| n)
+            .sum();
+        let pct = |n: u32| format!("{:.0}%", 100.0 * n as f64 / r.attempts.max(1) as f64);
+        format!(
+            "{:<16} {:>6} {:>6} {:>9} {:>7} {:>8} {:>9} {:>7}\n",
+            r.family,
+            r.catch,
+            r.dodge,
+            r.no_action,
+            r.invalid,
+            r.attempts,
+            pct(r.rejected_by[reaction]),
+            pct(other)
+        )
+    };
     for r in rows {
-        s.push_str(&format!(
-            "{:<16} {:>6} {:>6} {:>9} {:>7}\n",
-            r.family, r.catch, r.dodge, r.no_action, r.invalid
-        ));
-        c += r.catch;
-        d += r.dodge;
-        n += r.no_action;
-        i += r.invalid;
+        s.push_str(&line(r));
+        total.catch += r.catch;
+        total.dodge += r.dodge;
+        total.no_action += r.no_action;
+        total.invalid += r.invalid;
+        total.attempts += r.attempts;
+        for (t, n) in total.rejected_by.iter_mut().zip(&r.rejected_by) {
+            *t += n;
+        }
     }
-    s.push_str(&format!(
-        "{:<16} {:>6} {:>6} {:>9} {:>7}\n",
-        "total", c, d, n, i
-    ));
+    s.push_str(&line(&total));
     s
 }

@@ -317,35 +317,80 @@ pub fn render(input: &CardInput) -> String {
     v.insert("features_table", features.trim_end().to_string());
 
     let l = &labels;
+    let shoulder = m
+        .config
+        .pointer("/observer/shoulder_z")
+        .and_then(|x| x.as_f64())
+        .unwrap_or(1.10);
     v.insert(
         "label_rule",
         format!(
-            "* **Impact point**: the hazard's centre where it first descends through the reach \
-plane z = {} m after t = 0 (interpolated within the physics step); for a body that never \
-does, its closest approach to the observer's torso axis if within {} m; else null.
+            "* **Decision moment** Δ = the end of the observation window ({window} s): the model \
+commits its plan then, so every label about reaching the observer looks at t ≥ Δ.
+* **Reach envelope**: every point within {arm} m (arm reach) of the *shoulder region* — the \
+horizontal discs around the observer's torso axis of radius {offset} m (half the shoulder \
+width) + {step} m (one step), at heights from shoulder height − {crouch} m (a knee bend) up to \
+shoulder height ({shoulder} m). It reaches {reach_out:.2} m from the torso axis at shoulder height \
+and spans heights {lo:.2}–{hi:.2} m near the body.
+* **Impact point** (`impact_kind = envelope`): the hazard's centre of mass at the first \
+physics step at or after Δ at which it is inside the reach envelope and within {tol} m of the \
+closest it comes to the torso axis (the vertical segment floor → head) while inside — where \
+the hands would meet it. A hazard that never enters the envelope after Δ: its closest \
+approach to the torso axis after Δ if within {closest} m (`closest_approach`); else null. \
+`time_to_impact` and `impact_speed` (of the centre of mass) are taken at that step.
+* **Reaction time** (validator `valid_reaction_time`): the hazard must not reach the \
+observer — the same interception computed from t = 0, a closest approach within {reach} m, \
+or a strike of the standing body — before Δ + {reaction} s; such a scene is resampled.
+* **time_to_floor**: the first floor contact of the hazard's lowest point (within {eps} m), \
+refined by its ballistic fall from the last step above the floor; for a body that starts on \
+the floor (a toppling wardrobe, a ladder), the moment the top corners of its bounding box \
+first come within {eps} m of the floor, interpolated within the step.
 * **dangerous**: the object is sharp, hot, or large and fragile (catalog hazard flags of its \
-true physics), or its mass is ≥ {} kg, or its impact momentum is ≥ {} kg·m/s.
+true physics), or its mass is ≥ {heavy} kg, or its impact momentum is ≥ {momentum} kg·m/s.
 * **danger_present**: in a counterfactual simulation with the observer's body (a capsule of \
-radius {} m, floor to {} m) as a static collider, the hazard touches it at ≥ {} m/s.
-* **reachable**: the hazard passes within {} m of the torso axis, or danger is present.
+radius {torso} m, floor to {height} m) as a static collider, the hazard's point of contact \
+moves at ≥ {strike} m/s relative to the body (`strike_speed`: `v + ω × r` of the hazard just \
+before contact) and the body receives an impulse ≥ {impulse} N·s within {window_strike} s of \
+the first contact (`strike_impulse`).
+* **reachable**: the hazard passes within {reach} m of the torso axis at or after Δ, or \
+danger is present.
 * **gt_action**: `NO_ACTION` when not reachable; else `DODGE` when dangerous, or the impact \
-speed is > {} m/s, or the impact kinetic energy is > {} J; else `CATCH`.",
-            l.reach_plane_z,
-            l.closest_approach_max,
-            l.heavy_mass_kg,
-            l.heavy_momentum,
-            m.config
+speed is > {fast} m/s, or the impact kinetic energy is > {energy} J; else `CATCH`.",
+            window = m
+                .config
+                .pointer("/observation/window_s")
+                .and_then(|x| x.as_f64())
+                .unwrap_or(0.6),
+            arm = l.envelope_arm_reach,
+            offset = l.envelope_shoulder_offset,
+            step = l.envelope_step,
+            crouch = l.envelope_crouch,
+            shoulder = shoulder,
+            reach_out = l.envelope_shoulder_offset + l.envelope_step + l.envelope_arm_reach,
+            lo = shoulder - l.envelope_crouch - l.envelope_arm_reach,
+            hi = shoulder + l.envelope_arm_reach,
+            tol = l.interception_tolerance,
+            closest = l.closest_approach_max,
+            reach = l.reach_radius,
+            reaction = l.reaction_time_min,
+            eps = l.floor_contact_eps,
+            heavy = l.heavy_mass_kg,
+            momentum = l.heavy_momentum,
+            torso = m
+                .config
                 .pointer("/observer/torso_radius")
                 .and_then(|x| x.as_f64())
                 .unwrap_or(0.18),
-            m.config
+            height = m
+                .config
                 .pointer("/observer/height")
                 .and_then(|x| x.as_f64())
                 .unwrap_or(1.32),
-            l.strike_speed_min,
-            l.reach_radius,
-            l.catch_speed_max,
-            l.catch_energy_max,
+            strike = l.strike_speed_min,
+            impulse = l.strike_impulse_min,
+            window_strike = l.strike_window_s,
+            fast = l.catch_speed_max,
+            energy = l.catch_energy_max,
         ),
     );
 

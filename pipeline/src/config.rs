@@ -22,14 +22,22 @@ pub struct ConfigError {
 #[serde(deny_unknown_fields)]
 pub struct LabelConfig {
     pub rule_version: String,
-    pub reach_plane_z: f64,
+    pub envelope_shoulder_offset: f64,
+    pub envelope_step: f64,
+    pub envelope_arm_reach: f64,
+    pub envelope_crouch: f64,
+    pub interception_tolerance: f64,
     pub closest_approach_max: f64,
     pub reach_radius: f64,
+    pub reaction_time_min: f64,
+    pub floor_contact_eps: f64,
     pub heavy_mass_kg: f64,
     pub heavy_momentum: f64,
     pub catch_speed_max: f64,
     pub catch_energy_max: f64,
     pub strike_speed_min: f64,
+    pub strike_impulse_min: f64,
+    pub strike_window_s: f64,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -221,7 +229,21 @@ impl Config {
         positive("physics.horizon_s", self.physics.horizon_s)?;
         positive("physics.min_duration_s", self.physics.min_duration_s)?;
         positive("observation.window_s", self.observation.window_s)?;
-        positive("labels.reach_plane_z", self.labels.reach_plane_z)?;
+        let l = &self.labels;
+        for (field, v) in [
+            ("labels.envelope_shoulder_offset", l.envelope_shoulder_offset),
+            ("labels.envelope_step", l.envelope_step),
+            ("labels.envelope_arm_reach", l.envelope_arm_reach),
+            ("labels.envelope_crouch", l.envelope_crouch),
+            ("labels.interception_tolerance", l.interception_tolerance),
+            ("labels.reaction_time_min", l.reaction_time_min),
+            ("labels.floor_contact_eps", l.floor_contact_eps),
+            ("labels.strike_speed_min", l.strike_speed_min),
+            ("labels.strike_impulse_min", l.strike_impulse_min),
+            ("labels.strike_window_s", l.strike_window_s),
+        ] {
+            positive(field, v)?;
+        }
         positive("labels.reach_radius", self.labels.reach_radius)?;
         positive(
             "labels.closest_approach_max",
@@ -321,7 +343,7 @@ mod tests {
     fn embedded_config_is_valid() {
         let c = Config::embedded().unwrap();
         assert!((c.physics.dt - 1.0 / 240.0).abs() < 1e-15);
-        assert_eq!(c.labels.rule_version, "v1");
+        assert_eq!(c.labels.rule_version, "v2");
         for f in &c.build.families {
             assert!(
                 c.speed_bands(f).is_some(),

@@ -31,10 +31,20 @@ impl Action {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ImpactKind {
-    /// The hazard's centre descended through the reach plane.
-    ReachPlane,
-    /// The hazard never did; its closest approach to the torso axis is used.
+    /// Where the hazard's centre of mass, at or after Δ, is inside the reach envelope
+    /// and (within `interception_tolerance`) as close to the torso axis as it gets there.
+    Envelope,
+    /// It never enters the envelope after Δ; its closest approach to the torso axis is used.
     ClosestApproach,
+}
+
+impl ImpactKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            ImpactKind::Envelope => "envelope",
+            ImpactKind::ClosestApproach => "closest_approach",
+        }
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -49,76 +59,187 @@ pub struct Labels {
     pub time_to_impact: Option<f64>,
     pub time_to_floor: Option<f64>,
     pub impact_speed: Option<f64>,
-    /// Closest distance of the hazard's centre to the observer's torso axis (m).
+    /// Closest distance of the hazard's centre of mass to the observer's torso axis at
+    /// or after the decision moment Δ (m).
     pub closest_approach: f64,
-    /// The hazard comes within the observer's reach radius (or strikes them).
+    /// The hazard comes within the observer's reach radius after Δ (or strikes them).
     pub reachable: bool,
-    /// Hazard speed when it struck the standing observer in the counterfactual (m/s).
+    /// Speed of the hazard's contact point relative to the standing observer in the
+    /// counterfactual run (m/s); `None` when it never touches them.
     pub strike_speed: Option<f64>,
-}
-
-fn lerp3(a: Vec3, b: Vec3, f: f64) -> Vec3 {
-    [
-        a[0] + (b[0] - a[0]) * f,
-        a[1] + (b[1] - a[1]) * f,
-        a[2] + (b[2] - a[2]) * f,
-    ]
+    /// Impulse the standing observer receives in the counterfactual run (N·s).
+    pub strike_impulse: Option<f64>,
+    /// When the hazard first reaches the observer over the whole run (interception,
+    /// closest approach within `reach_radius`, or a strike), from t = 0 (s).
+    pub time_to_reach: Option<f64>,
 }
 
 fn length(v: Vec3) -> f64 {
     (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }
 
-/// Time of first floor contact, refined within the contact step by the ballistic motion
-/// of the hazard's lowest point from the previous step (a step is 4.2 ms; the refinement
-/// keeps `time_to_floor` well inside 1% of a closed-form fall).
-pub fn time_to_floor(sim: &Simulation, gravity: f64) -> Option<f64> {
-    let k = sim.time_to_floor_step()?;
-    let h = sim.hazard_lowest_z[(k - 1) as usize].max(0.0);
-    let vz = sim.hazard_velocity(k - 1)[2];
-    // h + vz τ − ½ g τ² = 0, the positive root.
+/// How far `p` lies outside the observer's reach envelope (≤ 0 inside): its distance to
+/// the shoulder region minus the arm's reach (see `configs/labels.toml`).
+pub fn envelope_excess(spec: &SceneSpec, p: Vec3) -> f64 {
+    let cfg = &spec.labels;
+    let o = &spec.observer;
+    let rho = ((p[0] - o.x).powi(2) + (p[1] - o.y).powi(2)).sqrt();
+    let d_rho = (rho - (cfg.envelope_shoulder_offset + cfg.envelope_step)).max(0.0);
+    let top = o.shoulder_z;
+    let bottom = o.shoulder_z - cfg.envelope_crouch;
+    let d_z = if p[2] > top {
+        p[2] - top
+    } else if p[2] < bottom {
+        bottom - p[2]
+    } else {
+        0.0
+    };
+    (d_rho * d_rho + d_z * d_z).sqrt() - cfg.envelope_arm_reach
+}
+
+/// The physics step of the decision moment Δ (the end of the observation window).
+pub fn decision_step(spec: &SceneSpec) -> u32 {
+    (spec.observation_window_s / spec.physics.dt).round() as u32
+}
+
+/// Where, from step `from` on, the hazard meets the observer: the interception in the
+/// reach envelope, else the closest approach if within `max_distance`.
+pub fn approach(
+    spec: &SceneSpec,
+    sim: &Simulation,
+    from: u32,
+    max_distance: f64,
+) -> Option<(u32, ImpactKind)> {
+    let steps = sim.steps();
+    if from > steps {
+        return None;
+    }
+    let d = |k: u32| spec.observer.torso_axis_distance(sim.hazard_com(k));
+    let inside = |k: u32| envelope_excess(spec, sim.hazard_com(k)) <= 0.0;
+    let closest_inside = (from..=steps)
+        .filter(|&k| inside(k))
+        .map(d)
+        .fold(f64::INFINITY, f64::min);
+    if closest_inside.is_finite() {
+        let tolerance = spec.labels.interception_tolerance;
+        return (from..=steps)
+            .find(|&k| inside(k) && d(k) <= closest_inside + tolerance)
+            .map(|k| (k, ImpactKind::Envelope));
+    }
+    let (k, dist) = closest_after(spec, sim, from);
+    (dist <= max_distance).then_some((k, ImpactKind::ClosestApproach))
+}
+
+/// First step (≥ `from`) of the hazard's closest approach to the torso axis, and that distance.
+fn closest_after(spec: &SceneSpec, sim: &Simulation, from: u32) -> (u32, f64) {
+    (from..=sim.steps())
+        .map(|k| (k, spec.observer.torso_axis_distance(sim.hazard_com(k))))
+        .fold((from, f64::INFINITY), |best, cur| {
+            if cur.1 < best.1 {
+                cur
+            } else {
+                best
+            }
+        })
+}
+
+/// Time of first floor contact (SPEC §6). A hazard that starts above the floor: the first
+/// floor contact with its lowest point within `floor_contact_eps`, refined by the
+/// ballistic motion of the lowest point from the last step it was above the floor. A
+/// hazard that starts on the floor (a toppling wardrobe, a slipping ladder): the moment
+/// its top — the top corners of its parts' bounding box in its own frame — first comes
+/// within `floor_contact_eps` of the floor, interpolated within the step.
+pub fn time_to_floor(spec: &SceneSpec, sim: &Simulation) -> Option<f64> {
+    let eps = spec.labels.floor_contact_eps;
+    let gravity = -spec.physics.gravity[2];
+    if sim.hazard_lowest_z[0] <= eps {
+        return top_touches_floor(spec, sim, eps);
+    }
+    let k = sim.time_to_floor_step(eps)?;
+    // The last step with the lowest point above the floor, and the ballistic fall of
+    // the lowest point from there to z = 0 (at most to the contact step and one more:
+    // the solver may hold a fast body a few millimetres up at its contact step).
+    let mut j = k - 1;
+    while j > 0 && sim.hazard_lowest_z[j as usize] <= 0.0 {
+        j -= 1;
+    }
+    let h = sim.hazard_lowest_z[j as usize].max(0.0);
+    let vz = sim.hazard_velocity(j)[2];
     let tau = (vz + (vz * vz + 2.0 * gravity * h).sqrt()) / gravity;
-    Some((k - 1) as f64 * sim.dt + tau.clamp(0.0, sim.dt))
+    Some(j as f64 * sim.dt + tau.clamp(0.0, (k - j + 1) as f64 * sim.dt))
+}
+
+/// Top corners of the hazard's parts' bounding box, in its body frame.
+fn top_corners(spec: &SceneSpec) -> [Vec3; 4] {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for part in &spec.hazard_body().parts {
+        let r = part.shape.bounding_radius();
+        let half = match part.shape {
+            crate::spec::ShapeSpec::Box { half_extents } => half_extents,
+            crate::spec::ShapeSpec::Sphere { radius } => [radius; 3],
+            crate::spec::ShapeSpec::Cylinder {
+                half_height,
+                radius,
+            } => [radius, radius, half_height],
+            crate::spec::ShapeSpec::Capsule {
+                half_height,
+                radius,
+            } => [radius, radius, half_height + radius],
+        };
+        // A part rotated within the body: its bounding sphere bounds it.
+        let half = if part.rotation == crate::spec::IDENTITY {
+            half
+        } else {
+            [r; 3]
+        };
+        for a in 0..3 {
+            lo[a] = lo[a].min(part.offset[a] - half[a]);
+            hi[a] = hi[a].max(part.offset[a] + half[a]);
+        }
+    }
+    [
+        [lo[0], lo[1], hi[2]],
+        [hi[0], lo[1], hi[2]],
+        [lo[0], hi[1], hi[2]],
+        [hi[0], hi[1], hi[2]],
+    ]
+}
+
+fn top_touches_floor(spec: &SceneSpec, sim: &Simulation, eps: f64) -> Option<f64> {
+    let corners = top_corners(spec);
+    let top_z = |k: u32| {
+        let s = sim.hazard_state(k);
+        let q = s.rotation.map(f64::from);
+        corners
+            .iter()
+            .map(|&c| crate::spec::quat::rotate(q, c)[2] + s.position[2] as f64)
+            .fold(f64::INFINITY, f64::min)
+    };
+    if top_z(0) <= eps {
+        return None;
+    }
+    let k = (1..=sim.steps()).find(|&k| top_z(k) <= eps)?;
+    let (a, b) = (top_z(k - 1), top_z(k));
+    let f = ((a - eps) / (a - b)).clamp(0.0, 1.0);
+    Some((k - 1) as f64 * sim.dt + f * sim.dt)
 }
 
 pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labels {
     let cfg = &spec.labels;
-    let g = -spec.physics.gravity[2];
     let steps = sim.steps();
+    let decision = decision_step(spec).min(steps);
+    let at = |k: u32| k as f64 * sim.dt;
 
-    // Impact point: first descent of the centre through the reach plane after t0 …
-    let mut impact: Option<(Vec3, f64, f64, ImpactKind)> = None;
-    for k in 1..=steps {
-        let a = sim.hazard_position(k - 1);
-        let b = sim.hazard_position(k);
-        if a[2] > cfg.reach_plane_z && b[2] <= cfg.reach_plane_z {
-            let f = (a[2] - cfg.reach_plane_z) / (a[2] - b[2]);
-            let point = lerp3(a, b, f);
-            let speed = length(lerp3(sim.hazard_velocity(k - 1), sim.hazard_velocity(k), f));
-            impact = Some((
-                point,
-                (k - 1) as f64 * sim.dt + f * sim.dt,
-                speed,
-                ImpactKind::ReachPlane,
-            ));
-            break;
-        }
-    }
-    // … else its closest approach to the torso axis, if near enough.
-    let (closest_step, closest_approach) = (0..=steps)
-        .map(|k| (k, spec.observer.torso_axis_distance(sim.hazard_position(k))))
-        .fold(
-            (0, f64::INFINITY),
-            |best, cur| if cur.1 < best.1 { cur } else { best },
-        );
-    if impact.is_none() && closest_approach <= cfg.closest_approach_max {
-        impact = Some((
-            sim.hazard_position(closest_step),
-            closest_step as f64 * sim.dt,
-            length(sim.hazard_velocity(closest_step)),
-            ImpactKind::ClosestApproach,
-        ));
-    }
+    let impact = approach(spec, sim, decision, cfg.closest_approach_max);
+    let closest_approach = closest_after(spec, sim, decision).1;
+    let impact_speed = impact.map(|(k, _)| length(sim.hazard_velocity(k)));
+
+    let reach = approach(spec, sim, 0, cfg.reach_radius).map(|(k, _)| at(k));
+    let strike_time = strike.map(|s| at(s.step));
+    let time_to_reach = match (reach, strike_time) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    };
 
     let mass = spec.hazard_body().mass;
     let flags = &spec.hazard_flags;
@@ -126,7 +247,6 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labe
     let max_speed = (0..=steps)
         .map(|k| length(sim.hazard_velocity(k)))
         .fold(0.0, f64::max);
-    let impact_speed = impact.map(|i| i.2);
     let momentum = mass * impact_speed.unwrap_or(max_speed);
     let mut danger_reasons = Vec::new();
     for flag in ["sharp", "hot"] {
@@ -145,8 +265,8 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labe
     }
     let dangerous = !danger_reasons.is_empty();
 
-    let strike_speed = strike.map(|s| s.speed);
-    let danger_present = strike_speed.is_some_and(|s| s >= cfg.strike_speed_min);
+    let danger_present = strike
+        .is_some_and(|s| s.speed >= cfg.strike_speed_min && s.impulse >= cfg.strike_impulse_min);
     let reachable = closest_approach <= cfg.reach_radius || danger_present;
 
     let speed = impact_speed.unwrap_or(max_speed);
@@ -164,14 +284,16 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labe
         dangerous,
         danger_present,
         danger_reasons,
-        impact_point: impact.map(|i| i.0),
-        impact_kind: impact.map(|i| i.3),
-        time_to_impact: impact.map(|i| i.1),
-        time_to_floor: time_to_floor(sim, g),
+        impact_point: impact.map(|(k, _)| sim.hazard_com(k)),
+        impact_kind: impact.map(|(_, kind)| kind),
+        time_to_impact: impact.map(|(k, _)| at(k)),
+        time_to_floor: time_to_floor(spec, sim),
         impact_speed,
         closest_approach,
         reachable,
-        strike_speed,
+        strike_speed: strike.map(|s| s.speed),
+        strike_impulse: strike.map(|s| s.impulse),
+        time_to_reach,
     }
 }
 
@@ -183,6 +305,8 @@ mod tests {
     use crate::simulate::{BodyState, TOUCH_FLOOR};
     use crate::spec::Selection;
     use rh_catalog::Catalog;
+
+    const G: f64 = 9.81;
 
     /// A real spec (thrown apple) whose observer stands at the origin facing +x.
     fn spec(object: &str) -> SceneSpec {
@@ -200,7 +324,8 @@ mod tests {
         spec
     }
 
-    /// A one-body simulation following `path(t)` (velocity by finite differences).
+    /// A one-body simulation whose centre of mass follows `path(t)` (velocity by finite
+    /// differences).
     fn synthetic(spec: &SceneSpec, steps: u32, path: impl Fn(f64) -> [f64; 3]) -> Simulation {
         let dt = spec.physics.dt;
         let mut sim = Simulation {
@@ -209,6 +334,7 @@ mod tests {
             states: vec![],
             hazard_slot: 0,
             hazard_lowest_z: vec![],
+            hazard_com: vec![],
             hazard_contacts: vec![],
             energy: vec![],
             initial_penetration: 0.0,
@@ -227,6 +353,7 @@ mod tests {
                 linvel: v.map(|c| c as f32),
                 angvel: [0.0; 3],
             });
+            sim.hazard_com.push(p);
             sim.hazard_lowest_z.push(p[2] - r);
             sim.hazard_contacts
                 .push(if p[2] - r <= 0.005 { TOUCH_FLOOR } else { 0 });
@@ -235,32 +362,73 @@ mod tests {
         sim
     }
 
-    fn falling_at(x: f64) -> impl Fn(f64) -> [f64; 3] {
-        move |t| [x, 0.0, (2.0 - 0.5 * 9.81 * t * t).max(0.04)]
+    /// Held at 2 m until `release`, then in free fall, `x` in front of the observer.
+    fn dropped_at(x: f64, release: f64) -> impl Fn(f64) -> [f64; 3] {
+        move |t| {
+            let s = (t - release).max(0.0);
+            [x, 0.0, (2.0 - 0.5 * G * s * s).max(0.04)]
+        }
     }
 
     #[test]
-    fn reach_plane_crossing_is_interpolated() {
+    fn the_interception_is_where_a_falling_object_comes_within_reach_after_the_decision() {
         let s = spec("apple");
-        let sim = synthetic(&s, 240, falling_at(0.5));
+        let sim = synthetic(&s, 480, dropped_at(0.5, 0.9));
         let l = label(&s, &sim, None);
-        assert_eq!(l.impact_kind, Some(ImpactKind::ReachPlane));
+        assert_eq!(l.impact_kind, Some(ImpactKind::Envelope));
+        // 0.5 m from the torso axis, inside the envelope's top (1.65 m) from z = 1.65 on;
+        // the closest it comes there is 0.5 m (at and below head height, 1.32 m), so the
+        // interception is where √(0.5² + (z − 1.32)²) = 0.5 + tolerance.
+        let tol = s.labels.interception_tolerance;
+        let z = 1.32 + ((0.5 + tol).powi(2) - 0.25).sqrt();
+        let t = 0.9 + (2.0 * (2.0 - z) / G).sqrt();
+        assert!((l.time_to_impact.unwrap() - t).abs() <= 1.5 * s.physics.dt, "{l:?}");
         let p = l.impact_point.unwrap();
-        assert!((p[2] - s.labels.reach_plane_z).abs() < 1e-9);
-        // Free fall from 2 m to 0.9 m: t = sqrt(2·1.1/g).
-        let t = (2.0 * 1.1 / 9.81f64).sqrt();
-        assert!((l.time_to_impact.unwrap() - t).abs() < 2.0 * s.physics.dt);
-        assert!((l.impact_speed.unwrap() - 9.81 * t).abs() < 0.1);
+        assert!((p[2] - z).abs() < 0.02 && (p[0] - 0.5).abs() < 1e-9, "{p:?}");
+        assert!((l.impact_speed.unwrap() - G * (t - 0.9)).abs() < 0.05);
+        // It reaches the observer at that same moment: well after Δ + the reaction minimum.
+        assert_eq!(l.time_to_reach, l.time_to_impact);
+    }
+
+    #[test]
+    fn a_ball_launched_above_the_old_reach_plane_is_intercepted_at_the_observer() {
+        // v1 took the first descent through z = 0.9 m, i.e. where it starts; v2 takes the
+        // envelope: the ball flies level at 1.2 m through the observer's position.
+        let s = spec("apple");
+        let sim = synthetic(&s, 480, |t| [3.0 - 2.5 * t, 0.0, 1.2]);
+        let l = label(&s, &sim, None);
+        assert_eq!(l.impact_kind, Some(ImpactKind::Envelope));
+        let p = l.impact_point.unwrap();
+        let tol = s.labels.interception_tolerance;
+        assert!(p[0] <= tol + 1e-9 && p[0] > 0.0, "{p:?}");
+        let t = (3.0 - tol) / 2.5;
+        assert!((l.time_to_impact.unwrap() - t).abs() <= 1.5 * s.physics.dt);
+        assert!(l.closest_approach < 0.02);
+    }
+
+    #[test]
+    fn a_hazard_that_arrives_before_the_decision_reaches_too_early() {
+        let s = spec("apple");
+        // Through the observer at t = 0.5 s.
+        let sim = synthetic(&s, 480, |t| [1.0 - 2.0 * t, 0.0, 1.0]);
+        let l = label(&s, &sim, None);
+        let reach = l.time_to_reach.unwrap();
+        assert!(reach < s.observation_window_s + s.labels.reaction_time_min);
+        assert!(
+            (reach - (1.0 - s.labels.interception_tolerance) / 2.0).abs() <= 1.5 * s.physics.dt,
+            "{l:?}"
+        );
     }
 
     #[test]
     fn benign_reachable_object_is_caught_and_far_one_is_no_action() {
         let s = spec("apple");
-        let near = label(&s, &synthetic(&s, 240, falling_at(0.5)), None);
+        let near = label(&s, &synthetic(&s, 480, dropped_at(0.5, 0.9)), None);
         assert!(near.reachable && !near.dangerous && !near.danger_present);
         assert_eq!(near.gt_action, Action::Catch);
-        let far = label(&s, &synthetic(&s, 240, falling_at(3.0)), None);
+        let far = label(&s, &synthetic(&s, 480, dropped_at(3.0, 0.9)), None);
         assert!(!far.reachable);
+        assert_eq!(far.impact_point, None);
         assert_eq!(far.gt_action, Action::NoAction);
     }
 
@@ -268,19 +436,19 @@ mod tests {
     fn dangerous_or_fast_objects_are_dodged() {
         // Sharp.
         let knife = spec("chef_knife");
-        let l = label(&knife, &synthetic(&knife, 240, falling_at(0.5)), None);
+        let l = label(&knife, &synthetic(&knife, 480, dropped_at(0.5, 0.9)), None);
         assert!(l.dangerous && l.danger_reasons.contains(&"sharp".to_string()));
         assert_eq!(l.gt_action, Action::Dodge);
         // Heavy by mass (a steel apple looks like an apple).
         let steel = spec("steel_apple");
-        let l = label(&steel, &synthetic(&steel, 240, falling_at(0.5)), None);
+        let l = label(&steel, &synthetic(&steel, 480, dropped_at(0.5, 0.9)), None);
         assert!(l.danger_reasons.contains(&"heavy_mass".to_string()));
         assert_eq!(l.gt_action, Action::Dodge);
         // Too fast to catch: a benign apple arriving at 12 m/s.
         let apple = spec("apple");
         let l = label(
             &apple,
-            &synthetic(&apple, 120, |t| [0.5, 3.0 - 12.0 * t, 1.0]),
+            &synthetic(&apple, 240, |t| [0.5, 12.0 - 12.0 * t, 1.0]),
             None,
         );
         assert!(!l.dangerous);
@@ -289,57 +457,77 @@ mod tests {
     }
 
     #[test]
-    fn closest_approach_is_used_when_the_reach_plane_is_never_crossed() {
+    fn closest_approach_is_used_when_the_envelope_is_never_entered() {
         let s = spec("apple");
-        // Rolling along the floor, passing 0.4 m from the observer.
-        let sim = synthetic(&s, 480, |t| [2.0 - 1.0 * t, 0.4, 0.04]);
+        // Rolling along the floor (below the envelope), passing 0.4 m from the observer.
+        let sim = synthetic(&s, 720, |t| [2.0 - 1.0 * t, 0.4, 0.04]);
         let l = label(&s, &sim, None);
         assert_eq!(l.impact_kind, Some(ImpactKind::ClosestApproach));
         let p = l.impact_point.unwrap();
         assert!(p[0].abs() < 0.01 && (p[1] - 0.4).abs() < 1e-6);
         assert!((l.closest_approach - 0.4).abs() < 1e-3);
+        assert!((l.time_to_impact.unwrap() - 2.0).abs() <= s.physics.dt);
         // Never within 1.5 m: no impact point at all.
-        let sim = synthetic(&s, 480, |t| [2.0 - 1.0 * t, 2.0, 0.04]);
+        let sim = synthetic(&s, 720, |t| [2.0 - 1.0 * t, 2.0, 0.04]);
         let l = label(&s, &sim, None);
         assert_eq!(l.impact_point, None);
         assert_eq!(l.gt_action, Action::NoAction);
     }
 
     #[test]
-    fn strike_in_the_counterfactual_sets_danger_present() {
+    fn the_envelope_follows_the_configured_body() {
         let s = spec("apple");
-        let sim = synthetic(&s, 240, falling_at(3.0));
-        let fast = label(
-            &s,
-            &sim,
+        let out = s.labels.envelope_shoulder_offset + s.labels.envelope_step;
+        let reach = s.labels.envelope_arm_reach;
+        let sz = s.observer.shoulder_z;
+        // Shoulder height: out to offset + step + arm reach.
+        assert!(envelope_excess(&s, [out + reach - 1e-6, 0.0, sz]) <= 0.0);
+        assert!(envelope_excess(&s, [out + reach + 1e-3, 0.0, sz]) > 0.0);
+        // Straight up from the shoulder, and down from the crouched shoulder.
+        assert!(envelope_excess(&s, [0.0, 0.0, sz + reach - 1e-6]) <= 0.0);
+        assert!(envelope_excess(&s, [0.0, 0.0, sz + reach + 1e-3]) > 0.0);
+        let low = sz - s.labels.envelope_crouch - reach;
+        assert!(envelope_excess(&s, [0.0, 0.3, low + 1e-6]) <= 0.0);
+        assert!(envelope_excess(&s, [0.0, 0.3, low - 1e-3]) > 0.0);
+    }
+
+    #[test]
+    fn a_strike_needs_contact_speed_and_impulse() {
+        let s = spec("apple");
+        let sim = synthetic(&s, 480, dropped_at(3.0, 0.9));
+        let strike = |speed, impulse| {
             Some(Strike {
-                step: 10,
-                speed: 3.0,
-            }),
+                step: 300,
+                speed,
+                impulse,
+            })
+        };
+        let hard = label(&s, &sim, strike(3.0, 1.0));
+        assert!(hard.danger_present && hard.reachable);
+        assert_ne!(hard.gt_action, Action::NoAction);
+        assert_eq!(hard.strike_impulse, Some(1.0));
+        assert!(!label(&s, &sim, strike(0.1, 1.0)).danger_present);
+        assert!(!label(&s, &sim, strike(3.0, 0.0)).danger_present);
+        // A strike is the observer being reached.
+        assert_eq!(
+            label(&s, &sim, strike(3.0, 1.0)).time_to_reach,
+            Some(300.0 * s.physics.dt)
         );
-        assert!(fast.danger_present && fast.reachable);
-        assert_ne!(fast.gt_action, Action::NoAction);
-        let gentle = label(
-            &s,
-            &sim,
-            Some(Strike {
-                step: 10,
-                speed: 0.1,
-            }),
-        );
-        assert!(!gentle.danger_present);
     }
 
     #[test]
     fn time_to_floor_is_refined_within_the_step() {
         let s = spec("apple");
-        let sim = synthetic(&s, 240, falling_at(0.5));
+        let sim = synthetic(&s, 480, dropped_at(0.5, 0.0));
         // The lowest point (centre − 4 cm) falls 1.96 m.
-        let expected = (2.0 * 1.96 / 9.81f64).sqrt();
-        let measured = time_to_floor(&sim, 9.81).unwrap();
+        let expected = (2.0 * 1.96 / G).sqrt();
+        let measured = time_to_floor(&s, &sim).unwrap();
         assert!(
-            (measured - expected).abs() / expected < 0.005,
+            (measured - expected).abs() / expected < 0.002,
             "{measured} vs {expected}"
         );
+        // Not a multiple of the step: it is interpolated.
+        let steps = measured / s.physics.dt;
+        assert!((steps - steps.round()).abs() > 1e-6);
     }
 }

@@ -1,5 +1,5 @@
-//! One scene group through the DAG: randomize → simulate → frame cameras → validate →
-//! label, with attempt-indexed resampling when any band fails a validator.
+//! One scene group through the DAG: randomize → simulate → frame cameras → counterfactual
+//! → label → validate, with attempt-indexed resampling when any band fails a validator.
 
 use crate::cameras;
 use crate::config::Config;
@@ -18,7 +18,7 @@ pub struct SceneResult {
     pub labels: Labels,
     pub verdicts: Verdicts,
     pub state_hash: String,
-    /// The hazard's centre at each video frame: `[t, x, y, z]` until the scene ends.
+    /// The hazard's centre of mass at each video frame: `[t, x, y, z]` until the scene ends.
     pub trajectory: Vec<[f32; 4]>,
     pub steps: u32,
     /// What the render stage wrote (`None` until rendered, and for unrendered scenes).
@@ -41,19 +41,20 @@ pub fn run_scene(mut spec: SceneSpec, config: &Config) -> SceneResult {
     let framed = cameras::frame(&spec, &sim, &config.validators.framing());
     let in_frame = framed.is_some();
     spec.cameras = framed.unwrap_or_default();
-    let verdicts = validate(&spec, &sim, family, &config.validators, in_frame);
     let strike = if may_touch_observer(&spec, &sim) {
-        simulate(
-            &spec,
-            SimOptions {
-                observer_collider: true,
-            },
-        )
-        .strike
+        simulate(&spec, counterfactual_options(&spec)).strike
     } else {
         None
     };
     let labels = label(&spec, &sim, strike);
+    let verdicts = validate(
+        &spec,
+        &sim,
+        family,
+        &config.validators,
+        in_frame,
+        &labels,
+    );
     let trajectory = hazard_trajectory(&spec, &sim);
     SceneResult {
         state_hash: sim.state_hash.clone(),
@@ -63,6 +64,15 @@ pub fn run_scene(mut spec: SceneSpec, config: &Config) -> SceneResult {
         verdicts,
         trajectory,
         media: None,
+    }
+}
+
+/// The counterfactual run of SPEC §6: the observer's body as a static collider, the
+/// strike followed for `labels.strike_window_s`.
+pub fn counterfactual_options(spec: &SceneSpec) -> SimOptions {
+    SimOptions {
+        observer_collider: true,
+        strike_window_steps: (spec.labels.strike_window_s / spec.physics.dt).round() as u32,
     }
 }
 
@@ -88,15 +98,24 @@ fn hazard_trajectory(spec: &SceneSpec, sim: &Simulation) -> Vec<[f32; 4]> {
         .map(|frame| (frame, spec.frame_step(frame)))
         .take_while(|&(_, step)| step <= sim.steps())
         .map(|(frame, step)| {
-            let p = sim.hazard_state(step).position;
+            let p = sim.hazard_com(step);
             [
                 (frame as f64 / spec.video.fps as f64) as f32,
-                p[0],
-                p[1],
-                p[2],
+                p[0] as f32,
+                p[1] as f32,
+                p[2] as f32,
             ]
         })
         .collect()
+}
+
+/// How a group's attempts went: attempts made, and per validator (in
+/// `validate::VALIDATOR_COLUMNS` order) how many attempts it rejected (an attempt is
+/// rejected when any band fails; it counts once for each validator that failed).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Rejections {
+    pub attempts: u32,
+    pub rejected_by: [u32; 6],
 }
 
 /// Produces scenes `first_index .. first_index + count` (one group, `count` ≤ 4 bands).
@@ -110,9 +129,24 @@ pub fn produce_group(
     catalog: &Catalog,
     config: &Config,
 ) -> Result<Vec<SceneResult>, RandomizeError> {
+    produce_group_counted(selection, build_seed, first_index, count, catalog, config)
+        .map(|(results, _)| results)
+}
+
+/// `produce_group`, also saying which validators rejected which attempts.
+pub fn produce_group_counted(
+    selection: &Selection,
+    build_seed: u64,
+    first_index: u64,
+    count: u64,
+    catalog: &Catalog,
+    config: &Config,
+) -> Result<(Vec<SceneResult>, Rejections), RandomizeError> {
     let mut results = Vec::new();
+    let mut rejections = Rejections::default();
     for attempt in 0..config.validators.max_attempts {
         results.clear();
+        rejections.attempts += 1;
         for index in first_index..first_index + count {
             let spec = randomize(
                 selection,
@@ -128,6 +162,11 @@ pub fn produce_group(
         if results.iter().all(|r| r.verdicts.all()) {
             break;
         }
+        for (v, count) in rejections.rejected_by.iter_mut().enumerate() {
+            if results.iter().any(|r| !r.verdicts.as_array()[v]) {
+                *count += 1;
+            }
+        }
     }
-    Ok(results)
+    Ok((results, rejections))
 }

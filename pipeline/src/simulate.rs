@@ -18,9 +18,11 @@ pub const TOUCH_OBSERVER: u8 = 8;
 
 #[derive(Debug, Clone, Copy, Default)]
 pub struct SimOptions {
-    /// Adds the observer's body as a static collider (the counterfactual of SPEC §6) and
-    /// stops at the hazard's first contact with it.
+    /// Adds the observer's body as a static collider (the counterfactual of SPEC §6);
+    /// the run then stops `strike_window_steps` after the hazard first touches it.
     pub observer_collider: bool,
+    /// How long a strike is followed to add up the impulse it delivers (steps).
+    pub strike_window_steps: u32,
 }
 
 /// State of one dynamic body at one step (f32, exactly as the solver holds it).
@@ -32,12 +34,18 @@ pub struct BodyState {
     pub angvel: [f32; 3],
 }
 
-/// The hazard struck the standing observer.
+/// The hazard struck the standing observer (counterfactual run).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Strike {
+    /// First step with an active hazard–observer contact.
     pub step: u32,
-    /// Hazard speed just before the contact (m/s).
+    /// Largest speed, relative to the (static) observer, of the hazard's point of contact
+    /// just before a contact step, over the strike window (m/s): `v + ω × (p − c)` with
+    /// the body's velocities of the previous step and `p` the hazard's point nearest the
+    /// observer's body.
     pub speed: f64,
+    /// Total normal impulse the observer's body received over the strike window (N·s).
+    pub impulse: f64,
 }
 
 #[derive(Debug, Clone)]
@@ -51,6 +59,8 @@ pub struct Simulation {
     pub hazard_slot: usize,
     /// The hazard's lowest point (m above the floor) per step.
     pub hazard_lowest_z: Vec<f64>,
+    /// The hazard's centre of mass (world) per step; labels use it, the hash does not.
+    pub hazard_com: Vec<[f64; 3]>,
     /// The hazard's contact flags per step.
     pub hazard_contacts: Vec<u8>,
     /// Total mechanical energy of the dynamic bodies per step (J).
@@ -80,8 +90,14 @@ impl Simulation {
         self.hazard_state(step).position.map(f64::from)
     }
 
+    /// Velocity of the hazard's centre of mass (rapier's linear velocity is the CoM's).
     pub fn hazard_velocity(&self, step: u32) -> [f64; 3] {
         self.hazard_state(step).linvel.map(f64::from)
+    }
+
+    /// The hazard's centre of mass (not its body origin, which may sit elsewhere).
+    pub fn hazard_com(&self, step: u32) -> [f64; 3] {
+        self.hazard_com[step as usize]
     }
 
     /// First step (≥ 1) whose hazard touches anything.
@@ -93,13 +109,13 @@ impl Simulation {
     /// The solver's contacts engage a few millimetres before touching (a fast body can
     /// be held at ~5 mm by continuous collision detection), so a floor contact with the
     /// lowest point within 1 cm counts.
-    pub fn time_to_floor_step(&self) -> Option<u32> {
-        const FLOOR_EPS: f64 = 0.01;
-        if self.hazard_lowest_z[0] <= FLOOR_EPS {
+    /// `floor_eps` is `labels.floor_contact_eps`.
+    pub fn time_to_floor_step(&self, floor_eps: f64) -> Option<u32> {
+        if self.hazard_lowest_z[0] <= floor_eps {
             return None;
         }
         (1..=self.steps()).find(|&k| {
-            self.hazard_lowest_z[k as usize] <= FLOOR_EPS
+            self.hazard_lowest_z[k as usize] <= floor_eps
                 && self.hazard_contacts[k as usize] & TOUCH_FLOOR != 0
         })
     }
@@ -210,6 +226,42 @@ fn lowest_z(collider: &Collider) -> f64 {
             .fold(Real::MAX, Real::min) as f64,
         None => collider.compute_aabb().mins.z as f64,
     }
+}
+
+/// Speed of the hazard's point nearest the observer's body, relative to that (static)
+/// body, with the hazard's velocities of the step before `step` (before the contact
+/// impulse) and its pose at `step`.
+fn contact_point_speed(
+    sim: &Simulation,
+    step: u32,
+    world: &PhysicsWorld,
+    hazard: ColliderHandle,
+    observer: ColliderHandle,
+) -> f64 {
+    let (h, o) = (&world.colliders[hazard], &world.colliders[observer]);
+    let com = sim.hazard_com(step);
+    // The contact query gives the hazard's deepest (or nearest) point even when the
+    // shapes overlap; should it find none, the centre of mass stands in.
+    let point = match rapier3d::parry::query::contact(
+        h.position(),
+        h.shape(),
+        o.position(),
+        o.shape(),
+        0.1,
+    ) {
+        Ok(Some(c)) => [c.point1.x as f64, c.point1.y as f64, c.point1.z as f64],
+        _ => com,
+    };
+    let state = sim.hazard_state(step - 1);
+    let v = state.linvel.map(f64::from);
+    let w = state.angvel.map(f64::from);
+    let r = [point[0] - com[0], point[1] - com[1], point[2] - com[2]];
+    let u = [
+        v[0] + w[1] * r[2] - w[2] * r[1],
+        v[1] + w[2] * r[0] - w[0] * r[2],
+        v[2] + w[0] * r[1] - w[1] * r[0],
+    ];
+    (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt()
 }
 
 const FLOOR_HALF_EXTENT: Real = 50.0;
@@ -347,6 +399,7 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         states: Vec::with_capacity((max_steps + 1) * n_dyn),
         hazard_slot,
         hazard_lowest_z: Vec::with_capacity(max_steps + 1),
+        hazard_com: Vec::with_capacity(max_steps + 1),
         hazard_contacts: Vec::with_capacity(max_steps + 1),
         energy: Vec::with_capacity(max_steps + 1),
         initial_penetration,
@@ -390,11 +443,20 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         sim.energy.push(energy);
         sim.hazard_lowest_z
             .push(lowest_z(&world.colliders[hazard_collider]));
+        let com = world.bodies[body_handles[spec.hazard]].center_of_mass();
+        sim.hazard_com
+            .push([com.x as f64, com.y as f64, com.z as f64]);
 
         let mut flags = 0u8;
+        let mut observer_impulse = 0.0f64;
         for pair in world.narrow_phase.contact_pairs_with(hazard_collider) {
             if !pair.has_any_active_contact() {
                 continue;
+            }
+            if Some(pair.collider1) == observer_collider
+                || Some(pair.collider2) == observer_collider
+            {
+                observer_impulse += pair.total_impulse_magnitude() as f64;
             }
             let other = if pair.collider1 == hazard_collider {
                 pair.collider2
@@ -416,11 +478,22 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         if step == 0 {
             continue;
         }
-        if flags & TOUCH_OBSERVER != 0 {
-            let before = sim.hazard_velocity(step - 1);
-            let speed = (before[0].powi(2) + before[1].powi(2) + before[2].powi(2)).sqrt();
-            sim.strike = Some(Strike { step, speed });
-            break;
+        if let Some(observer) = observer_collider {
+            if flags & TOUCH_OBSERVER != 0 {
+                let speed = contact_point_speed(&sim, step, &world, hazard_collider, observer);
+                let strike = sim.strike.get_or_insert(Strike {
+                    step,
+                    speed: 0.0,
+                    impulse: 0.0,
+                });
+                strike.speed = strike.speed.max(speed);
+            }
+            if let Some(strike) = sim.strike.as_mut() {
+                strike.impulse += observer_impulse;
+                if step >= strike.step + options.strike_window_steps {
+                    break;
+                }
+            }
         }
         let calm = dynamic_bodies.iter().all(|&i| {
             let rb = &world.bodies[body_handles[i]];

@@ -4,16 +4,18 @@
 use crate::cameras;
 use crate::config::ValidatorConfig;
 use crate::families::Family;
+use crate::label::Labels;
 use crate::simulate::Simulation;
 use crate::spec::SceneSpec;
 use serde::{Deserialize, Serialize};
 
-pub const VALIDATOR_COLUMNS: [&str; 5] = [
+pub const VALIDATOR_COLUMNS: [&str; 6] = [
     "valid_no_interpenetration",
     "valid_energy",
     "valid_no_tunnelling",
     "valid_in_frame",
     "valid_intended_event",
+    "valid_reaction_time",
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -28,6 +30,9 @@ pub struct Verdicts {
     pub in_frame: bool,
     /// The family's intended event happened.
     pub intended_event: bool,
+    /// The hazard reaches the observer no earlier than Δ + `labels.reaction_time_min`
+    /// (label rule v2): a decision made at Δ can still matter.
+    pub reaction_time: bool,
 }
 
 impl Verdicts {
@@ -35,13 +40,14 @@ impl Verdicts {
         self.as_array().iter().all(|&v| v)
     }
 
-    pub fn as_array(&self) -> [bool; 5] {
+    pub fn as_array(&self) -> [bool; 6] {
         [
             self.no_interpenetration,
             self.energy,
             self.no_tunnelling,
             self.in_frame,
             self.intended_event,
+            self.reaction_time,
         ]
     }
 
@@ -56,13 +62,15 @@ impl Verdicts {
     }
 }
 
-/// Runs every validator. `cameras_in_frame` is the framing outcome (see `cameras::frame`).
+/// Runs every validator. `cameras_in_frame` is the framing outcome (see `cameras::frame`);
+/// `labels` are the scene's labels (the reaction-time rule reads their times).
 pub fn validate(
     spec: &SceneSpec,
     sim: &Simulation,
     family: &dyn Family,
     cfg: &ValidatorConfig,
     cameras_in_frame: bool,
+    labels: &Labels,
 ) -> Verdicts {
     let e0 = sim.energy[0];
     let energy_limit = e0 + (cfg.energy_gain_relative * e0.abs()).max(cfg.energy_gain_absolute);
@@ -76,5 +84,16 @@ pub fn validate(
         in_frame: cameras_in_frame
             && cameras::hazard_in_frame(spec, sim, &spec.cameras, &cfg.framing()),
         intended_event: family.event_happened(spec, sim),
+        reaction_time: reaction_time_ok(spec, labels),
     }
+}
+
+/// Label rule v2's reaction-time rule: neither the moment the hazard first reaches the
+/// observer (`time_to_reach`) nor the impact point's time comes before Δ +
+/// `labels.reaction_time_min`, so a plan committed at Δ can still matter.
+pub fn reaction_time_ok(spec: &SceneSpec, labels: &Labels) -> bool {
+    // Times are multiples of the physics step; allow for rounding.
+    let earliest = spec.observation_window_s + spec.labels.reaction_time_min - 1e-9;
+    labels.time_to_reach.is_none_or(|t| t >= earliest)
+        && labels.time_to_impact.is_none_or(|t| t >= earliest)
 }

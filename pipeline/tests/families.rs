@@ -107,7 +107,7 @@ fn hanging_fall_falls_freely_once_detached() {
                 r.spec.speed_band.name(),
             );
         }
-        assert!(sim.time_to_floor_step().is_some(), "it reached the floor");
+        assert!(sim.time_to_floor_step(0.01).is_some(), "it reached the floor");
     }
 }
 

@@ -68,7 +68,7 @@ fn object_drop_falls_ballistically_once_clear_of_the_table() {
     let mut clear_falls = 0;
     for r in &results {
         let sim = plain(r);
-        let floor = sim.time_to_floor_step().expect("reaches the floor");
+        let floor = sim.time_to_floor_step(r.spec.labels.floor_contact_eps).expect("reaches the floor");
         // Release: the step after the last contact with the table before the floor.
         let Some(last_table) = (0..floor)
             .rev()

@@ -81,9 +81,9 @@ impl Family for BouncingObject {
         }
     }
 
-    fn event_happened(&self, _spec: &SceneSpec, sim: &Simulation) -> bool {
+    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
         // It bounced: after its first floor contact it moved up again.
-        let Some(k) = sim.time_to_floor_step() else {
+        let Some(k) = sim.time_to_floor_step(spec.labels.floor_contact_eps) else {
             return false;
         };
         (k..=sim.steps()).any(|j| sim.hazard_velocity(j)[2] > 0.1)

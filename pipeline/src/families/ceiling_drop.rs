@@ -59,7 +59,7 @@ impl Family for CeilingDrop {
         }
     }
 
-    fn event_happened(&self, _spec: &SceneSpec, sim: &Simulation) -> bool {
-        reached_floor(sim)
+    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
+        reached_floor(spec, sim)
     }
 }

@@ -108,9 +108,10 @@ impl Family for ChainReaction {
         }
     }
 
-    fn event_happened(&self, _spec: &SceneSpec, sim: &Simulation) -> bool {
-        // The target was launched: struck, it moved at least 10 cm.
-        max_displacement(sim) >= 0.1
+    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
+        // The target was launched off its table: it started on it and reached the floor
+        // (a target nudged a few centimetres that stays on the table is no event).
+        reached_floor(spec, sim)
     }
 }
 

@@ -94,9 +94,11 @@ impl Family for FurnitureTip {
         }
     }
 
-    fn event_happened(&self, _spec: &SceneSpec, sim: &Simulation) -> bool {
-        // It toppled: its up axis turned more than 45° from vertical.
+    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
+        // It toppled: its up axis turned more than 45° from vertical (past its balance
+        // angle) and its top came down to the floor.
         (0..=sim.steps())
             .any(|k| up_z(sim.hazard_state(k).rotation) < std::f64::consts::FRAC_1_SQRT_2)
+            && crate::label::time_to_floor(spec, sim).is_some()
     }
 }

@@ -104,6 +104,6 @@ impl Family for HangingFall {
             .get("drop_height_m")
             .copied()
             .unwrap_or(0.0);
-        drop >= 0.5 && reached_floor(sim)
+        drop >= 0.5 && reached_floor(spec, sim)
     }
 }

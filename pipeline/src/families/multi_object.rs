@@ -98,8 +98,9 @@ impl Family for MultiObject {
         }
     }
 
-    fn event_happened(&self, _spec: &SceneSpec, sim: &Simulation) -> bool {
-        // Momentum reached the last object: it moved at least 5 cm.
-        max_displacement(sim) >= 0.05
+    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
+        // Momentum ran down the row and pushed the last object off the table: it started
+        // on the table and reached the floor.
+        reached_floor(spec, sim)
     }
 }

@@ -91,8 +91,8 @@ impl Family for ObjectDrop {
         }
     }
 
-    fn event_happened(&self, _spec: &SceneSpec, sim: &Simulation) -> bool {
+    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
         // The object left the table and reached the floor.
-        reached_floor(sim)
+        reached_floor(spec, sim)
     }
 }

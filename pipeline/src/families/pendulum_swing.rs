@@ -81,15 +81,20 @@ impl Family for PendulumSwing {
     }
 
     fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
-        // It swung: the arm turned at least 0.1 rad from vertical.
+        // It swung: the arm turned at least 0.1 rad from vertical and the mass travelled
+        // at least 0.2 m sideways.
         let Some(joint) = spec.joints.first() else {
             return false;
         };
         let a = joint.anchor_a;
+        let start = sim.hazard_position(0);
         (0..=sim.steps()).any(|k| {
             let p = sim.hazard_position(k);
             let horizontal = ((p[0] - a[0]).powi(2) + (p[1] - a[1]).powi(2)).sqrt();
             horizontal.atan2(a[2] - p[2]) >= 0.1
+        }) && (0..=sim.steps()).any(|k| {
+            let p = sim.hazard_position(k);
+            ((p[0] - start[0]).powi(2) + (p[1] - start[1]).powi(2)).sqrt() >= 0.2
         })
     }
 }

@@ -65,7 +65,7 @@ impl Family for RollingBall {
 
     fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
         // It left the table, reached the floor, and rolled on for at least 0.3 m.
-        let Some(k) = sim.time_to_floor_step() else {
+        let Some(k) = sim.time_to_floor_step(spec.labels.floor_contact_eps) else {
             return false;
         };
         let at_floor = sim.hazard_position(k);

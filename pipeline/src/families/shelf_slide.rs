@@ -67,7 +67,7 @@ impl Family for ShelfSlide {
         }
     }
 
-    fn event_happened(&self, _spec: &SceneSpec, sim: &Simulation) -> bool {
-        reached_floor(sim)
+    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
+        reached_floor(spec, sim)
     }
 }

@@ -99,15 +99,15 @@ impl Family for SurfaceCascade {
         }
     }
 
-    fn event_happened(&self, _spec: &SceneSpec, sim: &Simulation) -> bool {
-        touched_stool_before_floor(sim)
+    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
+        touched_stool_before_floor(spec, sim)
     }
 }
 
 /// The hazard touched the stool (not its table, not the floor) before it first reached
 /// the floor, and it did reach the floor.
-pub fn touched_stool_before_floor(sim: &Simulation) -> bool {
-    let Some(floor) = sim.time_to_floor_step() else {
+pub fn touched_stool_before_floor(spec: &SceneSpec, sim: &Simulation) -> bool {
+    let Some(floor) = sim.time_to_floor_step(spec.labels.floor_contact_eps) else {
         return false;
     };
     (0..floor).any(|k| sim.hazard_contacts[k as usize] & crate::simulate::TOUCH_OTHER != 0)
