@@ -351,7 +351,8 @@ true physics), or its mass is ≥ {heavy} kg, or its impact momentum is ≥ {mom
 radius {torso} m, floor to {height} m) as a static collider, the hazard's point of contact \
 moves at ≥ {strike} m/s relative to the body (`strike_speed`: `v + ω × r` of the hazard just \
 before contact) and the body receives an impulse ≥ {impulse} N·s within {window_strike} s of \
-the first contact (`strike_impulse`).
+the first contact (`strike_impulse`) — or, at any speed, an impulse ≥ {heavy_push} N·s (a heavy \
+door or wardrobe pressing into the body).
 * **reachable**: the hazard passes within {reach} m of the torso axis at or after Δ, or \
 danger is present.
 * **gt_action**: `NO_ACTION` when not reachable; else `DODGE` when dangerous, or the impact \
@@ -388,6 +389,7 @@ speed is > {fast} m/s, or the impact kinetic energy is > {energy} J; else `CATCH
                 .unwrap_or(1.32),
             strike = l.strike_speed_min,
             impulse = l.strike_impulse_min,
+            heavy_push = l.strike_impulse_heavy,
             window_strike = l.strike_window_s,
             fast = l.catch_speed_max,
             energy = l.catch_energy_max,

@@ -37,6 +37,7 @@ pub struct LabelConfig {
     pub catch_energy_max: f64,
     pub strike_speed_min: f64,
     pub strike_impulse_min: f64,
+    pub strike_impulse_heavy: f64,
     pub strike_window_s: f64,
 }
 
@@ -231,7 +232,10 @@ impl Config {
         positive("observation.window_s", self.observation.window_s)?;
         let l = &self.labels;
         for (field, v) in [
-            ("labels.envelope_shoulder_offset", l.envelope_shoulder_offset),
+            (
+                "labels.envelope_shoulder_offset",
+                l.envelope_shoulder_offset,
+            ),
             ("labels.envelope_step", l.envelope_step),
             ("labels.envelope_arm_reach", l.envelope_arm_reach),
             ("labels.envelope_crouch", l.envelope_crouch),
@@ -240,6 +244,7 @@ impl Config {
             ("labels.floor_contact_eps", l.floor_contact_eps),
             ("labels.strike_speed_min", l.strike_speed_min),
             ("labels.strike_impulse_min", l.strike_impulse_min),
+            ("labels.strike_impulse_heavy", l.strike_impulse_heavy),
             ("labels.strike_window_s", l.strike_window_s),
         ] {
             positive(field, v)?;

@@ -216,7 +216,7 @@ pub fn column_description(name: &str) -> Option<String> {
         "description" => "Free-text description the scene was planned from; null when none",
         "gt_action" => "Ground-truth action: CATCH, DODGE or NO_ACTION (label rule below)",
         "dangerous" => "The object is dangerous by its true physical properties (rule below)",
-        "danger_present" => "The hazard would strike the observer standing still (counterfactual simulation)",
+        "danger_present" => "The hazard would strike the observer standing still (counterfactual simulation; judged by the contact point's speed and the impulse, rule below)",
         "danger_reasons" => "Why `dangerous` holds (sharp, hot, large_fragile, heavy_mass, momentum); empty if not",
         "impact_point" => "World [x, y, z] (m) of the hazard's centre of mass where it meets the observer at or after the decision moment Δ: the interception in the reach envelope, else the closest approach within the limit; null if none (rule below)",
         "impact_kind" => "envelope or closest_approach: how `impact_point` was found; null if none",

@@ -265,8 +265,10 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labe
     }
     let dangerous = !danger_reasons.is_empty();
 
-    let danger_present = strike
-        .is_some_and(|s| s.speed >= cfg.strike_speed_min && s.impulse >= cfg.strike_impulse_min);
+    let danger_present = strike.is_some_and(|s| {
+        (s.speed >= cfg.strike_speed_min && s.impulse >= cfg.strike_impulse_min)
+            || s.impulse >= cfg.strike_impulse_heavy
+    });
     let reachable = closest_approach <= cfg.reach_radius || danger_present;
 
     let speed = impact_speed.unwrap_or(max_speed);
@@ -382,9 +384,15 @@ mod tests {
         let tol = s.labels.interception_tolerance;
         let z = 1.32 + ((0.5 + tol).powi(2) - 0.25).sqrt();
         let t = 0.9 + (2.0 * (2.0 - z) / G).sqrt();
-        assert!((l.time_to_impact.unwrap() - t).abs() <= 1.5 * s.physics.dt, "{l:?}");
+        assert!(
+            (l.time_to_impact.unwrap() - t).abs() <= 1.5 * s.physics.dt,
+            "{l:?}"
+        );
         let p = l.impact_point.unwrap();
-        assert!((p[2] - z).abs() < 0.02 && (p[0] - 0.5).abs() < 1e-9, "{p:?}");
+        assert!(
+            (p[2] - z).abs() < 0.02 && (p[0] - 0.5).abs() < 1e-9,
+            "{p:?}"
+        );
         assert!((l.impact_speed.unwrap() - G * (t - 0.9)).abs() < 0.05);
         // It reaches the observer at that same moment: well after Δ + the reaction minimum.
         assert_eq!(l.time_to_reach, l.time_to_impact);
@@ -508,6 +516,9 @@ mod tests {
         assert_eq!(hard.strike_impulse, Some(1.0));
         assert!(!label(&s, &sim, strike(0.1, 1.0)).danger_present);
         assert!(!label(&s, &sim, strike(3.0, 0.0)).danger_present);
+        // A slow but heavy push (a door pressing into the body) is a strike too.
+        let heavy = s.labels.strike_impulse_heavy;
+        assert!(label(&s, &sim, strike(0.1, heavy)).danger_present);
         // A strike is the observer being reached.
         assert_eq!(
             label(&s, &sim, strike(3.0, 1.0)).time_to_reach,

@@ -47,14 +47,7 @@ pub fn run_scene(mut spec: SceneSpec, config: &Config) -> SceneResult {
         None
     };
     let labels = label(&spec, &sim, strike);
-    let verdicts = validate(
-        &spec,
-        &sim,
-        family,
-        &config.validators,
-        in_frame,
-        &labels,
-    );
+    let verdicts = validate(&spec, &sim, family, &config.validators, in_frame, &labels);
     let trajectory = hazard_trajectory(&spec, &sim);
     SceneResult {
         state_hash: sim.state_hash.clone(),

@@ -107,7 +107,10 @@ fn hanging_fall_falls_freely_once_detached() {
                 r.spec.speed_band.name(),
             );
         }
-        assert!(sim.time_to_floor_step(0.01).is_some(), "it reached the floor");
+        assert!(
+            sim.time_to_floor_step(0.01).is_some(),
+            "it reached the floor"
+        );
     }
 }
 
@@ -404,7 +407,9 @@ fn surface_cascade_touches_the_stool_between_table_and_floor() {
             table_last.is_none_or(|t| t <= stool),
             "{id}: back on the table after the stool"
         );
-        assert!(families::surface_cascade::touched_stool_before_floor(&sim));
+        assert!(families::surface_cascade::touched_stool_before_floor(
+            &r.spec, &sim
+        ));
     }
 }
 

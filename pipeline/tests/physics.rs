@@ -68,7 +68,9 @@ fn object_drop_falls_ballistically_once_clear_of_the_table() {
     let mut clear_falls = 0;
     for r in &results {
         let sim = plain(r);
-        let floor = sim.time_to_floor_step(r.spec.labels.floor_contact_eps).expect("reaches the floor");
+        let floor = sim
+            .time_to_floor_step(r.spec.labels.floor_contact_eps)
+            .expect("reaches the floor");
         // Release: the step after the last contact with the table before the floor.
         let Some(last_table) = (0..floor)
             .rev()
@@ -356,16 +358,11 @@ fn counterfactual_strike_matches_a_full_counterfactual_run() {
     let (_, config) = setup();
     for family in ["thrown_object", "ceiling_drop", "rolling_ball"] {
         for r in scenes(family, 3, 21) {
-            let full = simulate(
-                &r.spec,
-                SimOptions {
-                    observer_collider: true,
-                },
-            );
+            let full = simulate(&r.spec, rh_pipeline::scene::counterfactual_options(&r.spec));
             let rerun = run_scene(r.spec.clone(), &config);
             assert_eq!(
-                rerun.labels.strike_speed,
-                full.strike.map(|s| s.speed),
+                (rerun.labels.strike_speed, rerun.labels.strike_impulse),
+                (full.strike.map(|s| s.speed), full.strike.map(|s| s.impulse)),
                 "{}",
                 r.spec.scene_id
             );

@@ -501,7 +501,8 @@ pub fn far_shift(input: &FamilyInput) -> f64 {
 
 /// The hazard's speed at the end of the run is small and it touched the floor.
 pub fn reached_floor(spec: &SceneSpec, sim: &Simulation) -> bool {
-    sim.time_to_floor_step(spec.labels.floor_contact_eps).is_some()
+    sim.time_to_floor_step(spec.labels.floor_contact_eps)
+        .is_some()
 }
 
 /// Shared layout for "pushed off the edge of a horizontal surface" families
