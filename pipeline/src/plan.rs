@@ -250,7 +250,7 @@ impl Planner for LexiconPlanner<'_> {
             (None, Some(o)) => o.families[rng.random_range(0..o.families.len())].clone(),
             (None, None) => {
                 let r = room.expect("checked above");
-                let hosted: Vec<&str> = rh_catalog::FAMILIES
+                let hosted: Vec<&str> = rh_contract::FAMILIES
                     .iter()
                     .copied()
                     .filter(|f| r.hosts(f))
