@@ -213,7 +213,9 @@ pub fn dataset_of(rows: &[FixtureRow]) -> Dataset {
 }
 
 fn vec3_col<'a>(it: impl Iterator<Item = Option<&'a [f64; 3]>>) -> ArrayRef {
-    let mut b = FixedSizeListBuilder::new(Float64Builder::new(), 3);
+    // The contract's type: a fixed-size list of 3 non-null float64.
+    let item = arrow::datatypes::Field::new("item", arrow::datatypes::DataType::Float64, false);
+    let mut b = FixedSizeListBuilder::new(Float64Builder::new(), 3).with_field(item);
     for v in it {
         match v {
             Some(p) => {
