@@ -3,7 +3,7 @@
 
 use crate::build::{build, BuildError, BuildOptions};
 use crate::config::Config;
-use crate::plan::{LexiconPlanner, Planner};
+use crate::selection::{LexiconPlanner, Planner};
 use crate::verify::verify;
 use clap::{Parser, Subcommand};
 use rh_catalog::Catalog;

@@ -437,8 +437,8 @@ pub fn read_hashes(dir: &Path) -> Result<Vec<(String, String, String)>, String> 
 mod tests {
     use super::*;
     use crate::config::Config;
-    use crate::plan::plan_group;
     use crate::scene::produce_group;
+    use crate::selection::plan_group;
 
     #[test]
     fn every_column_is_described_and_has_a_feature() {

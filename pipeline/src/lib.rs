@@ -3,7 +3,7 @@
 //! replay verification.
 //!
 //! Each stage is a module with one entry point over plain data:
-//! `plan::plan_group` / `plan::LexiconPlanner`, `randomize::randomize`,
+//! `selection::plan_group` / `selection::LexiconPlanner`, `randomize::randomize`,
 //! `simulate::simulate`, `cameras::frame`, `validate::validate`, `label::label`,
 //! `render::render_stage`. `scene::run_group` is the one place that chains them for a
 //! scene group; `build::build` runs the groups in parallel and writes the dataset.
@@ -23,7 +23,9 @@ pub mod fsio;
 pub mod label;
 pub mod manifest;
 pub mod merge;
-pub mod plan;
+pub mod selection;
+/// The old name of [`selection`], kept so that code written against `plan` still builds.
+pub use selection as plan;
 pub mod randomize;
 #[cfg(feature = "render")]
 pub mod render;

@@ -1,4 +1,5 @@
-//! Report renderings: terminal table, Markdown, CSV (JSON is `serde_json` of [`Report`]).
+//! Report text tables: terminal table, Markdown, CSV (JSON is `serde_json` of [`Report`]).
+//! (Named `tables`, not `render`, which in this project means the video renderer.)
 
 use crate::report::{MetricsRow, ModelReport, Report};
 use crate::types::Rule;
