@@ -257,10 +257,79 @@ pub fn render(input: &CardInput) -> String {
         },
     );
 
-    // Per-family table, in the build's family order.
-    let mut ft = String::from(
-        "Label counts are over valid scenes.\n\n| family | scenes | valid | CATCH | DODGE | NO_ACTION |",
+    v.insert("family_table", family_table(input, &counts, total_eval));
+
+    v.insert("features_table", features_table());
+
+    v.insert("label_rule", label_rule(m, &labels));
+
+    insert_provenance(input, &mut v);
+    fill(TEMPLATE, &v)
+}
+
+/// The build summary table and the command that rebuilds this dataset.
+fn insert_provenance(input: &CardInput, v: &mut BTreeMap<&str, String>) {
+    let m = input.manifest;
+    let default_config = crate::config::Config::embedded()
+        .map(|c| crate::manifest::config_sha256(&c) == m.config_sha256)
+        .unwrap_or(false);
+    v.insert(
+        "build_summary",
+        format!(
+            "| | |\n|---|---|\n| build seed | {} |\n| scenes (whole build) | {} |\n| scene groups | {} |\n\
+| families | {} |\n| shard | {}/{} |\n| render | {} |\n| configuration | {} (sha256 `{}`) |\n\
+| catalog | sha256 `{}` |\n| rh-pipeline | {} |\n| data files | {} |",
+            m.seed,
+            m.n,
+            m.n_groups(),
+            m.families.join(", "),
+            m.shard[0],
+            m.shard[1],
+            if m.render { "yes (valid scenes)" } else { "no (--no-render)" },
+            if default_config { "the default `configs/default.toml`" } else { "custom" },
+            m.config_sha256,
+            m.catalog_sha256,
+            m.rh_pipeline_version,
+            input
+                .data_files
+                .iter()
+                .map(|f| format!("`{f}`"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        ),
     );
+    v.insert(
+        "rebuild_command",
+        format!(
+            "rh-pipeline{} build --n {} --seed {} --families {}{}{} --out DIR",
+            if default_config {
+                ""
+            } else {
+                " --config YOUR_CONFIG.toml"
+            },
+            m.n,
+            m.seed,
+            m.families.join(","),
+            if m.render { "" } else { " --no-render" },
+            if m.is_whole() {
+                String::new()
+            } else {
+                format!(" --shard {}/{}", m.shard[0], m.shard[1])
+            }
+        ),
+    );
+}
+
+/// The per-family table, in the build's family order (label counts over valid scenes).
+fn family_table(
+    input: &CardInput,
+    counts: &BTreeMap<String, FamilyCounts>,
+    total_eval: usize,
+) -> String {
+    let m = input.manifest;
+    let mut ft = String::from(
+    "Label counts are over valid scenes.\n\n| family | scenes | valid | CATCH | DODGE | NO_ACTION |",
+);
     if input.eval.is_some() {
         ft.push_str(" eval |");
     }
@@ -295,9 +364,11 @@ pub fn render(input: &CardInput) -> String {
     if input.eval.is_some() {
         let _ = write!(ft, " {total_eval} |");
     }
-    v.insert("family_table", ft);
+    ft
+}
 
-    // Features.
+/// The feature table: every column of the scene table with its type and meaning.
+fn features_table() -> String {
     let schema = dataset::schema();
     let mut features = String::new();
     for field in schema.fields() {
@@ -314,17 +385,18 @@ pub fn render(input: &CardInput) -> String {
             dataset::column_description(field.name()).unwrap_or_default()
         );
     }
-    v.insert("features_table", features.trim_end().to_string());
+    features.trim_end().to_string()
+}
 
-    let l = &labels;
+/// The label rule in words, with the build's thresholds.
+fn label_rule(m: &Manifest, labels: &crate::config::LabelConfig) -> String {
+    let l = labels;
     let shoulder = m
         .config
         .pointer("/observer/shoulder_z")
         .and_then(|x| x.as_f64())
         .unwrap_or(1.10);
-    v.insert(
-        "label_rule",
-        format!(
+    format!(
             "* **Decision moment** Δ = the end of the observation window ({window} s): the model \
 commits its plan then, so every label about reaching the observer looks at t ≥ Δ.
 * **Reach envelope**: every point within {arm} m (arm reach) of the *shoulder region* — the \
@@ -393,58 +465,7 @@ speed is > {fast} m/s, or the impact kinetic energy is > {energy} J; else `CATCH
             window_strike = l.strike_window_s,
             fast = l.catch_speed_max,
             energy = l.catch_energy_max,
-        ),
-    );
-
-    let default_config = crate::config::Config::embedded()
-        .map(|c| crate::manifest::config_sha256(&c) == m.config_sha256)
-        .unwrap_or(false);
-    v.insert(
-        "build_summary",
-        format!(
-            "| | |\n|---|---|\n| build seed | {} |\n| scenes (whole build) | {} |\n| scene groups | {} |\n\
-| families | {} |\n| shard | {}/{} |\n| render | {} |\n| configuration | {} (sha256 `{}`) |\n\
-| catalog | sha256 `{}` |\n| rh-pipeline | {} |\n| data files | {} |",
-            m.seed,
-            m.n,
-            m.n_groups(),
-            m.families.join(", "),
-            m.shard[0],
-            m.shard[1],
-            if m.render { "yes (valid scenes)" } else { "no (--no-render)" },
-            if default_config { "the default `configs/default.toml`" } else { "custom" },
-            m.config_sha256,
-            m.catalog_sha256,
-            m.rh_pipeline_version,
-            input
-                .data_files
-                .iter()
-                .map(|f| format!("`{f}`"))
-                .collect::<Vec<_>>()
-                .join(", "),
-        ),
-    );
-    v.insert(
-        "rebuild_command",
-        format!(
-            "rh-pipeline{} build --n {} --seed {} --families {}{}{} --out DIR",
-            if default_config {
-                ""
-            } else {
-                " --config YOUR_CONFIG.toml"
-            },
-            m.n,
-            m.seed,
-            m.families.join(","),
-            if m.render { "" } else { " --no-render" },
-            if m.is_whole() {
-                String::new()
-            } else {
-                format!(" --shard {}/{}", m.shard[0], m.shard[1])
-            }
-        ),
-    );
-    fill(TEMPLATE, &v)
+        )
 }
 
 #[cfg(test)]

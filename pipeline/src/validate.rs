@@ -9,14 +9,8 @@ use crate::simulate::Simulation;
 use crate::spec::SceneSpec;
 use serde::{Deserialize, Serialize};
 
-pub const VALIDATOR_COLUMNS: [&str; 6] = [
-    "valid_no_interpenetration",
-    "valid_energy",
-    "valid_no_tunnelling",
-    "valid_in_frame",
-    "valid_intended_event",
-    "valid_reaction_time",
-];
+/// The verdict columns, in `Verdicts::as_array` order (the data contract's list).
+pub use rh_contract::VALIDATOR_COLUMNS;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Verdicts {
