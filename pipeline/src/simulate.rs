@@ -383,28 +383,15 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
             source_collider,
             observer_collider,
         );
-        let observer_impulse = observer_collider
-            .map_or(0.0, |o| contact_impulse(&world, hazard_collider, o));
         sim.hazard_contacts.push(flags);
 
         if step == 0 {
             continue;
         }
         if let Some(observer) = observer_collider {
-            if flags & TOUCH_OBSERVER != 0 {
-                let speed = contact_point_speed(&sim, step, &world, hazard_collider, observer);
-                let strike = sim.strike.get_or_insert(Strike {
-                    step,
-                    speed: 0.0,
-                    impulse: 0.0,
-                });
-                strike.speed = strike.speed.max(speed);
-            }
-            if let Some(strike) = sim.strike.as_mut() {
-                strike.impulse += observer_impulse;
-                if step >= strike.step + options.strike_window_steps {
-                    break;
-                }
+            let window = options.strike_window_steps;
+            if track_strike(&mut sim, step, &world, hazard_collider, observer, window) {
+                break;
             }
         }
         let calm = dynamic_bodies.iter().all(|&i| {
@@ -513,6 +500,35 @@ fn initial_penetration(world: &PhysicsWorld) -> f64 {
 }
 
 /// The hazard's active contacts this step, as `TOUCH_*` flags.
+/// Follows a strike of the standing observer (counterfactual run) at `step`: opens it at
+/// the first contact, keeps the largest contact-point speed and adds up the impulse.
+/// Returns true once the strike window is over (the run can stop).
+fn track_strike(
+    sim: &mut Simulation,
+    step: u32,
+    world: &PhysicsWorld,
+    hazard: ColliderHandle,
+    observer: ColliderHandle,
+    window_steps: u32,
+) -> bool {
+    if sim.hazard_contacts[step as usize] & TOUCH_OBSERVER != 0 {
+        let speed = contact_point_speed(sim, step, world, hazard, observer);
+        let strike = sim.strike.get_or_insert(Strike {
+            step,
+            speed: 0.0,
+            impulse: 0.0,
+        });
+        strike.speed = strike.speed.max(speed);
+    }
+    match sim.strike.as_mut() {
+        Some(strike) => {
+            strike.impulse += contact_impulse(world, hazard, observer);
+            step >= strike.step + window_steps
+        }
+        None => false,
+    }
+}
+
 /// Total normal impulse between two colliders in the last step (N·s).
 fn contact_impulse(world: &PhysicsWorld, a: ColliderHandle, b: ColliderHandle) -> f64 {
     world
