@@ -376,7 +376,8 @@ pub fn build(
                 out.display()
             );
         }
-        let rows = dataset::read_batch(&out.join(&data_file)).map_err(BuildError::Internal)?;
+        let rows = dataset::read_columns(&out.join(&data_file), &dataset::SUMMARY_COLUMNS)
+            .map_err(BuildError::Internal)?;
         let eval = out
             .join(card::EVAL_FILE)
             .exists()
@@ -434,16 +435,15 @@ pub fn build(
     })?;
     progress.finish();
 
-    // Every group's rows, from the records, in scene-index order.
-    let batches: Vec<RecordBatch> = groups
-        .iter()
-        .map(|&g| {
-            let path = record_path(out, g);
-            dataset::read_batch(&path).map_err(BuildError::Internal)
-        })
-        .collect::<Result<_, _>>()?;
-    let rows = dataset::concat(&batches).map_err(BuildError::Internal)?;
-    let eval = finalize(out, &manifest, &rows)?;
+    // Every group's rows, from the records, in scene-index order: streamed, one group
+    // at a time, so memory does not grow with --n.
+    let records = |f: &mut RowSink| -> Result<(), BuildError> {
+        for &g in &groups {
+            f(dataset::read_batch(&record_path(out, g)).map_err(BuildError::Internal)?)?;
+        }
+        Ok(())
+    };
+    let (rows, eval) = finalize(out, &manifest, &records)?;
     // Retire the records in one atomic step (a rename), then delete them: a crash in
     // between leaves a finished build whose next run only removes the leftover.
     let work = out.join(WORK_DIR);
@@ -460,19 +460,49 @@ pub fn build(
     ))
 }
 
-/// Writes the dataset's final files from its rows (in scene-index order): the data
-/// Parquet, the eval subset (whole builds), and the card. Returns the eval subset's size.
+/// Receives a dataset's rows, a batch at a time.
+pub type RowSink<'a> = dyn FnMut(RecordBatch) -> Result<(), BuildError> + 'a;
+
+/// Feeds every row of a dataset, in scene-index order, to the sink; may be called more
+/// than once and must give the same rows each time.
+pub type RowSource<'a> = dyn Fn(&mut RowSink) -> Result<(), BuildError> + 'a;
+
+/// Writes the dataset's final files from its rows (in scene-index order, streamed from
+/// `rows`): the data Parquet (row group by row group), the eval subset (whole builds; a
+/// second pass over the rows picks it), and the card. Memory stays flat in the number of
+/// rows but for `dataset::SUMMARY_COLUMNS`, which it returns (every row, those columns)
+/// with the eval subset's size.
 pub fn finalize(
     out: &Path,
     manifest: &Manifest,
-    rows: &RecordBatch,
-) -> Result<Option<usize>, BuildError> {
+    rows: &RowSource,
+) -> Result<(RecordBatch, Option<usize>), BuildError> {
     let data_file = dataset::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
-    let path = out.join(&data_file);
-    dataset::write_atomic(&path, &dataset::parquet_bytes(rows)).map_err(|e| internal(&path, e))?;
+    let mut data =
+        dataset::ParquetStream::create(&out.join(&data_file)).map_err(BuildError::Internal)?;
+    let summary_schema = dataset::project(
+        &RecordBatch::new_empty(std::sync::Arc::new(dataset::schema())),
+        &dataset::SUMMARY_COLUMNS,
+    )
+    .schema();
+    let compact = |parts: &[RecordBatch]| {
+        arrow::compute::concat_batches(&summary_schema, parts)
+            .map_err(|e| BuildError::Internal(e.to_string()))
+    };
+    let mut summary: Vec<RecordBatch> = Vec::new();
+    rows(&mut |batch| {
+        data.write(&batch).map_err(BuildError::Internal)?;
+        summary.push(dataset::project(&batch, &dataset::SUMMARY_COLUMNS));
+        if summary.len() >= 256 {
+            summary = vec![compact(&summary)?];
+        }
+        Ok(())
+    })?;
+    data.finish().map_err(BuildError::Internal)?;
+    let summary = compact(&summary)?;
     let eval = if manifest.is_whole() {
-        let (indices, counts) = card::eval_selection(rows);
-        let subset = dataset::take_rows(rows, &indices);
+        let (indices, counts) = card::eval_selection(&summary);
+        let subset = take_streamed(rows, &indices)?;
         let path = out.join(card::EVAL_FILE);
         dataset::write_atomic(&path, &dataset::parquet_bytes(&subset))
             .map_err(|e| internal(&path, e))?;
@@ -482,13 +512,34 @@ pub fn finalize(
     };
     let readme = card::render(&card::CardInput {
         manifest,
-        rows,
+        rows: &summary,
         data_files: std::slice::from_ref(&data_file),
         eval: eval.as_ref(),
     });
     let path = out.join("README.md");
     dataset::write_atomic(&path, readme.as_bytes()).map_err(|e| internal(&path, e))?;
-    Ok(eval.map(|c| c.values().sum()))
+    Ok((summary, eval.map(|c| c.values().sum())))
+}
+
+/// The rows at `indices` (ascending positions in the whole table) of a streamed table.
+fn take_streamed(rows: &RowSource, indices: &[u32]) -> Result<RecordBatch, BuildError> {
+    let mut parts = Vec::new();
+    let (mut offset, mut next) = (0usize, 0usize);
+    rows(&mut |batch| {
+        let end = offset + batch.num_rows();
+        let local: Vec<u32> = indices[next..]
+            .iter()
+            .take_while(|&&i| (i as usize) < end)
+            .map(|&i| i - offset as u32)
+            .collect();
+        next += local.len();
+        if !local.is_empty() {
+            parts.push(dataset::take_rows(&batch, &local));
+        }
+        offset = end;
+        Ok(())
+    })?;
+    dataset::concat(&parts).map_err(BuildError::Internal)
 }
 
 fn summarize(
