@@ -166,12 +166,13 @@ submit() { sbatch --parsable --array="$1" --cpus-per-task=1 --mem=256M --time=10
 job="$(submit 0-3)"
 echo "slurm e2e: submitted array job $job (tasks 0-3, $N scenes, seed $SEED)"
 
-records0() { compgen -G "$RH_SHARD_DIR/0/.rh-build/groups/*.parquet" >/dev/null; }
+# Task 0 is cancelled once it has finished 3 of its scene groups.
+records0() { [ "$(find "$RH_SHARD_DIR/0/.rh-build/groups" -name '*.parquet' 2>/dev/null | wc -l)" -ge 3 ]; }
 task0_started_or_over() {
   records0 || [ -f "$RH_SHARD_DIR/0/README.md" ] || [ -z "$(squeue -h -j "${job}_0" 2>/dev/null)" ]
 }
-wait_for "task 0 to finish its first scene group" task0_started_or_over
-records0 || fail "task ${job}_0 ended before writing a scene group; log: $(cat "logs/build-${job}_0.out" 2>/dev/null)"
+wait_for "task 0 to finish 3 scene groups" task0_started_or_over
+records0 || fail "task ${job}_0 ended before writing 3 scene groups; log: $(cat "logs/build-${job}_0.out" 2>/dev/null)"
 scancel "${job}_0"
 task_gone() { [ -z "$(squeue -h -j "$1" 2>/dev/null)" ]; }
 wait_for "task ${job}_0 to leave the queue after scancel" task_gone "${job}_0"
