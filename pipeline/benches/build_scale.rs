@@ -67,6 +67,7 @@ fn run_build(n: u64, args: &Args) -> (f64, u64) {
         .arg(args.jobs.to_string())
         .arg("--out")
         .arg(&out)
+        .stdout(std::process::Stdio::null())
         .spawn()
         .expect("rh-pipeline starts");
     // wait4 reaps the child and reports its own peak RSS (kB on Linux).

@@ -13,6 +13,7 @@ pub mod card;
 pub mod cli;
 pub mod config;
 pub mod dataset;
+pub mod dataset_stream;
 pub mod families;
 pub mod label;
 pub mod manifest;

@@ -93,7 +93,11 @@ print(json.dumps({{"job": job, "checks": checks}}))
         .env("JOB_COMPLETION_INDEX", "3")
         .env(
             "PATH",
-            format!("{}:{}", dir.path().display(), std::env::var("PATH").unwrap()),
+            format!(
+                "{}:{}",
+                dir.path().display(),
+                std::env::var("PATH").unwrap()
+            ),
         )
         .status()
         .unwrap();
