@@ -2,7 +2,8 @@
 //! n = 10,000 (or the sizes given), each in a fresh output directory: wall-clock scenes/s
 //! and the process's peak RSS. Then the physics-only ceiling for the same scenes: plan →
 //! randomize → simulate (plain + counterfactual) → validate → label on the same number of
-//! threads, nothing written, nothing kept. Prints how close the build comes to it.
+//! threads, nothing written, nothing kept (run before and after each build, averaged).
+//! Prints how close the build comes to it.
 //! Goals: RSS at 10 k ≤ 1.2 × RSS at 1 k; build ≥ 90% of the physics-only rate.
 //!
 //! `cargo bench -p rh-pipeline --bench build_scale [-- N...] [--jobs J] [--seed S]`
@@ -126,8 +127,11 @@ fn main() {
     run_build(40, &args);
     let mut rss = Vec::new();
     for &n in &args.sizes {
-        let physics = run_physics(n, &args, &catalog, &config);
+        // Physics-only right before and right after the build, averaged: on a shared
+        // machine the load drifts, and the build should be compared with the same load.
+        let before = run_physics(n, &args, &catalog, &config);
         let (secs, peak) = run_build(n, &args);
+        let physics = (before + run_physics(n, &args, &catalog, &config)) / 2.0;
         let (rate, ceiling) = (n as f64 / secs, n as f64 / physics);
         println!(
             "  n = {n:>6}: build {secs:7.1} s = {rate:6.1} scenes/s, peak RSS {:6.1} MiB | physics-only {physics:7.1} s = {ceiling:6.1} scenes/s | build at {:.0}% of physics-only | load {}",
