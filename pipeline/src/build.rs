@@ -23,10 +23,7 @@ use crate::config::Config;
 use crate::dataset;
 use crate::families;
 use crate::manifest::{Manifest, MANIFEST_FILE};
-use crate::plan::plan_group;
-use crate::render::{with_thread_renderer, RenderOptions, Renderer};
-use crate::scene::{produce_group, SceneMedia, SceneResult};
-use crate::simulate::{simulate, SimOptions};
+use crate::scene::{run_group, GroupError, RenderStage};
 use arrow::array::RecordBatch;
 use rayon::prelude::*;
 use rh_catalog::Catalog;
@@ -103,10 +100,10 @@ pub fn check_options(
         ));
     }
     for f in &opts.families {
-        if !rh_catalog::FAMILIES.contains(&f.as_str()) {
+        if !rh_contract::FAMILIES.contains(&f.as_str()) {
             return Err(BuildError::Input(format!(
                 "unknown family '{f}' (known: {})",
-                rh_catalog::FAMILIES.join(", ")
+                rh_contract::FAMILIES.join(", ")
             )));
         }
         if families::get(f).is_none() {
@@ -189,7 +186,7 @@ fn internal(path: &Path, e: impl std::fmt::Display) -> BuildError {
 /// while a few threads wait on the disk (fsync is I/O wait, not CPU: done inline it took
 /// 10-30% of a label-only build on a busy disk). At most `SYNC_BACKLOG` groups wait.
 struct Syncer {
-    tx: Option<std::sync::mpsc::SyncSender<Vec<dataset::Unsynced>>>,
+    tx: Option<std::sync::mpsc::SyncSender<Vec<crate::fsio::Unsynced>>>,
     threads: Vec<std::thread::JoinHandle<Result<(), BuildError>>>,
 }
 
@@ -198,7 +195,7 @@ const SYNC_BACKLOG: usize = 32;
 
 impl Syncer {
     fn start() -> Syncer {
-        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<dataset::Unsynced>>(SYNC_BACKLOG);
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<crate::fsio::Unsynced>>(SYNC_BACKLOG);
         let rx = std::sync::Arc::new(std::sync::Mutex::new(rx));
         let threads = (0..SYNC_THREADS)
             .map(|_| {
@@ -219,7 +216,7 @@ impl Syncer {
         }
     }
 
-    fn submit(&self, files: Vec<dataset::Unsynced>) -> Result<(), BuildError> {
+    fn submit(&self, files: Vec<crate::fsio::Unsynced>) -> Result<(), BuildError> {
         let tx = self.tx.as_ref().expect("open until finish");
         tx.send(files)
             .map_err(|_| BuildError::Internal("the file syncer stopped".into()))
@@ -345,28 +342,38 @@ pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError
     Ok(!out.join(WORK_DIR).exists() && data.exists() && out.join("README.md").exists())
 }
 
-/// Renders a valid scene's videos and frames into `out` (stage 4). Invalid scenes are
-/// not rendered: their video columns stay null. The simulation is run again from the
-/// spec (milliseconds, and identical by construction) rather than kept per group.
-fn render_scene(
-    r: &SceneResult,
-    catalog: &Catalog,
-    opts: &RenderOptions,
-    out: &Path,
-) -> Result<Option<SceneMedia>, BuildError> {
-    if !r.verdicts.all() || r.spec.cameras.is_empty() {
-        return Ok(None);
+/// Fails before any work when rendering is requested but impossible: no GPU, no
+/// encoder, or a program built without the `render` feature.
+fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<(), BuildError> {
+    if !opts.render {
+        return Ok(());
     }
-    let sim = simulate(&r.spec, SimOptions::default());
-    let rendered = with_thread_renderer(opts, |renderer| {
-        renderer.render_scene(&r.spec, &sim, catalog, out)
-    })
-    .and_then(|x| x)
-    .map_err(|e| BuildError::Internal(format!("render {}: {e}", r.spec.scene_id)))?;
-    Ok(Some(SceneMedia {
-        videos: rendered.videos,
-        full_event: rendered.full_event,
-    }))
+    #[cfg(not(feature = "render"))]
+    {
+        let _ = config;
+        Err(BuildError::Input(
+            "rendering was requested, but this rh-pipeline was built without the `render` \
+             feature (cargo build --no-default-features): build with --no-render, or use a \
+             build with default features"
+                .into(),
+        ))
+    }
+    #[cfg(feature = "render")]
+    {
+        let renderer =
+            crate::render::Renderer::new(crate::render::RenderOptions::from_config(&config.render))
+                .map_err(|e| {
+                    BuildError::Input(format!("render stage: {e} (or build with --no-render)"))
+                })?;
+        if opts.progress {
+            eprintln!(
+                "rendering on {} ({} MSAA samples)",
+                renderer.adapter_name(),
+                renderer.samples()
+            );
+        }
+        Ok(())
+    }
 }
 
 /// Reads group `g`'s record if it is there and whole (right rows, every file it names
@@ -395,20 +402,7 @@ pub fn build(
     config: &Config,
 ) -> Result<BuildSummary, BuildError> {
     check_options(opts, catalog, config)?;
-    let render_opts = RenderOptions::from_config(&config.render);
-    if opts.render {
-        // Fail before any work when there is nothing to render with.
-        let renderer = Renderer::new(render_opts.clone()).map_err(|e| {
-            BuildError::Input(format!("render stage: {e} (or build with --no-render)"))
-        })?;
-        if opts.progress {
-            eprintln!(
-                "rendering on {} ({} MSAA samples)",
-                renderer.adapter_name(),
-                renderer.samples()
-            );
-        }
-    }
+    check_render_stage(opts, config)?;
     let manifest = Manifest::new(
         opts.seed,
         opts.n,
@@ -458,6 +452,19 @@ pub fn build(
         );
     }
 
+    // Stage 4 for the DAG driver (`scene::run_group`): a valid scene's videos and frames.
+    #[cfg(feature = "render")]
+    let render_opts = crate::render::RenderOptions::from_config(&config.render);
+    #[cfg(feature = "render")]
+    let render_stage = |r: &crate::scene::SceneResult| {
+        crate::render::render_stage(r, catalog, &render_opts, out)
+            .map_err(|e| format!("render {}: {e}", r.spec.scene_id))
+    };
+    #[cfg(feature = "render")]
+    let render: Option<&RenderStage> = opts.render.then_some(&render_stage as &RenderStage);
+    #[cfg(not(feature = "render"))]
+    let render: Option<&RenderStage> = None;
+
     let scenes_todo: u64 = todo.iter().map(|&g| manifest.group_size(g)).sum();
     let progress = Progress::new(scenes_todo, opts.progress);
     let pool = rayon::ThreadPoolBuilder::new()
@@ -468,29 +475,27 @@ pub fn build(
     let produced = pool.install(|| {
         todo.par_iter()
             .try_for_each(|&g| -> Result<(), BuildError> {
-                let selection = plan_group(catalog, &opts.families, opts.seed, g)
-                    .map_err(|e| BuildError::Input(e.to_string()))?;
                 let count = manifest.group_size(g);
-                let mut results =
-                    produce_group(&selection, opts.seed, g * 4, count, catalog, config)
-                        .map_err(|e| BuildError::Input(e.to_string()))?;
-                if opts.render {
-                    for r in results.iter_mut() {
-                        r.media = render_scene(r, catalog, &render_opts, out)?;
-                    }
-                }
+                let results =
+                    run_group(catalog, &opts.families, opts.seed, g, count, config, render)
+                        .map_err(|e| match e {
+                            GroupError::Input(m) => BuildError::Input(m),
+                            GroupError::Render(m) => BuildError::Internal(m),
+                        })?;
                 let mut files = Vec::with_capacity(results.len() + 1);
                 for r in &results {
                     let path = out.join(dataset::spec_path(&r.spec.scene_id));
                     files.push(
-                        dataset::write_unsynced(&path, r.spec.to_json().as_bytes())
+                        crate::fsio::write_unsynced(&path, r.spec.to_json().as_bytes())
                             .map_err(|e| internal(&path, e))?,
                     );
                 }
                 // The record last: its presence says the group (specs included) is done.
                 let path = record_path(out, g);
                 let bytes = dataset::parquet_bytes(&dataset::record_batch(&results, catalog));
-                files.push(dataset::write_unsynced(&path, &bytes).map_err(|e| internal(&path, e))?);
+                files.push(
+                    crate::fsio::write_unsynced(&path, &bytes).map_err(|e| internal(&path, e))?,
+                );
                 syncer.submit(files)?;
                 progress.advance(count, opts.progress);
                 Ok(())

@@ -1,8 +1,7 @@
 //! Scene tables and files written as a build goes, so memory stays flat in the number of
 //! scenes: `ParquetStream` (the final Parquet, row group by row group, byte-identical to
-//! writing the whole table at once), the small `SUMMARY_COLUMNS` projection that the card,
-//! eval selection and summaries read, and `Unsynced` (a temp file whose fsync and rename
-//! can run off the caller's path). Re-exported by `dataset`.
+//! writing the whole table at once), and the small `SUMMARY_COLUMNS` projection that the
+//! card, eval selection and summaries read. Re-exported by `dataset`.
 
 use crate::dataset::{concat, schema, writer_props, ROW_GROUP_SIZE};
 use arrow::array::RecordBatch;
@@ -10,42 +9,6 @@ use parquet::arrow::ArrowWriter;
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-
-/// A file written under its temporary name (`write_atomic`'s), not yet synced or renamed:
-/// `write_atomic` in two halves, so the slow half (fsync) can run off the caller's path.
-pub struct Unsynced {
-    tmp: PathBuf,
-    path: PathBuf,
-}
-
-/// Writes `bytes` to `path`'s temporary sibling; `Unsynced::commit` makes it durable and
-/// renames it into place.
-pub fn write_unsynced(path: &Path, bytes: &[u8]) -> std::io::Result<Unsynced> {
-    let dir = path.parent().unwrap_or(Path::new("."));
-    fs::create_dir_all(dir)?;
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("file");
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    if let Err(e) = fs::write(&tmp, bytes) {
-        let _ = fs::remove_file(&tmp);
-        return Err(e);
-    }
-    Ok(Unsynced {
-        tmp,
-        path: path.to_path_buf(),
-    })
-}
-
-impl Unsynced {
-    /// fsync, then rename onto the final path.
-    pub fn commit(self) -> std::io::Result<()> {
-        fs::File::open(&self.tmp)?.sync_all()?;
-        fs::rename(&self.tmp, &self.path)
-    }
-
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
-}
 
 /// A scene table written to disk as its rows arrive, one row group at a time: at most
 /// `ROW_GROUP_SIZE` rows are held in memory, whatever the table's length. The rows are
@@ -189,8 +152,8 @@ mod tests {
     use super::*;
     use crate::config::Config;
     use crate::dataset::{parquet_bytes, record_batch, string_column, take_rows};
-    use crate::plan::plan_group;
     use crate::scene::produce_group;
+    use crate::selection::plan_group;
     use rh_catalog::Catalog;
 
     /// A table streamed in small pieces (as a build feeds its groups) is written row
