@@ -338,19 +338,20 @@ pub fn build(
 ) -> Result<BuildSummary, BuildError> {
     check_options(opts, catalog, config)?;
     let render_opts = RenderOptions::from_config(&config.render);
-    if opts.render {
-        // Fail before any work when there is nothing to render with.
+    let render_banner = if opts.render {
+        // Fail before any work when there is nothing to render with; say what renders
+        // only once there is something to render (not before "nothing to do").
         let renderer = Renderer::new(render_opts.clone()).map_err(|e| {
             BuildError::Input(format!("render stage: {e} (or build with --no-render)"))
         })?;
-        if opts.progress {
-            eprintln!(
-                "rendering on {} ({} MSAA samples)",
-                renderer.adapter_name(),
-                renderer.samples()
-            );
-        }
-    }
+        Some(format!(
+            "rendering on {} ({} MSAA samples)",
+            renderer.adapter_name(),
+            renderer.samples()
+        ))
+    } else {
+        None
+    };
     let manifest = Manifest::new(
         opts.seed,
         opts.n,
@@ -400,6 +401,9 @@ pub fn build(
     }
 
     let scenes_todo: u64 = todo.iter().map(|&g| manifest.group_size(g)).sum();
+    if let (Some(banner), true) = (&render_banner, opts.progress && scenes_todo > 0) {
+        eprintln!("{banner}");
+    }
     let progress = Progress::new(scenes_todo, opts.progress);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs)

@@ -234,7 +234,7 @@ pub fn column_description(name: &str) -> Option<String> {
         "valid_intended_event" => "Validator: the family's intended event really happened",
         "spec_file" => "Relative path of the scene's full, replayable SceneSpec JSON",
         "frame_steps" => "Physics step shown by each frame k of the camera videos (observation window, both ends included): round(k / video.fps / physics.dt), at most sim_steps",
-        "trajectory" => "Hazard centre [t (s), x, y, z (m)] at each video frame (float32)",
+        "trajectory" => "Hazard centre [t (s), x, y, z (m)] over the whole simulation (t = 0 to its last step), sampled at the video rate (every 1/fps s, physics step round(t / dt)); the first entries, t ≤ the observation window, match the camera videos' frames (float32)",
         _ => return None,
     };
     Some(text.to_string())
