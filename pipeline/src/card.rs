@@ -241,12 +241,13 @@ pub fn render(input: &CardInput) -> String {
 
     let mut scope = if m.is_whole() {
         format!(
-            "This build holds **{n_rows} scenes** ({} valid) of {} famil{} in {} scene groups \
+            "This build holds **{n_rows} scenes** ({} valid) of {} famil{} in {} scene group{} \
              (four speed bands per group: slow, normal, fast, very_fast).",
             counts.values().map(|c| c.valid).sum::<usize>(),
             counts.len(),
             if counts.len() == 1 { "y" } else { "ies" },
-            m.n_groups()
+            m.n_groups(),
+            if m.n_groups() == 1 { "" } else { "s" }
         )
     } else {
         format!(
