@@ -203,6 +203,35 @@ fn html_site_opens_in_headless_chromium() {
 
     assert!(b.errors.is_empty(), "console errors: {:#?}", b.errors);
 
+    // Predictions that carry a prompt version show it on the leaderboard; rewriting a
+    // site replaces it, and a directory that is not a site is refused (exit 2).
+    let tagged: String = std::fs::read_to_string(&preds_file)
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let mut v: serde_json::Value = serde_json::from_str(l).unwrap();
+            if v["model"] == "oracle" {
+                v["prompt_version"] = serde_json::json!("rh-prompt-test-7");
+            }
+            v.to_string() + "\n"
+        })
+        .collect();
+    std::fs::write(&preds_file, tagged).unwrap();
+    run_ok(
+        "rh-score",
+        &[preds_file.to_str().unwrap(), "--dataset", ds, "--quiet", "--html", site.to_str().unwrap()],
+    );
+    let index = std::fs::read_to_string(site.join("index.html")).unwrap();
+    assert!(index.contains("\"prompt_versions\":[\"rh-prompt-test-7\"]"), "prompt version on the board");
+    let scene_js = std::fs::read_to_string(site.join(format!("data/{}", scene.replace("scene.html#", "scenes/") + ".js"))).unwrap();
+    assert!(scene_js.contains("rh-prompt-test-7"), "prompt version on the scene page");
+    let refused = rh_e2e::run(
+        "rh-score",
+        &[preds_file.to_str().unwrap(), "--dataset", ds, "--quiet", "--html", dataset.to_str().unwrap()],
+    );
+    assert_eq!(refused.status.code(), Some(2), "a non-site directory is not replaced");
+    assert!(dataset.join("README.md").exists());
+
     let shots = Path::new(env!("CARGO_TARGET_TMPDIR")).join("screenshots");
     std::fs::create_dir_all(&shots).unwrap();
     std::fs::write(shots.join("leaderboard.png"), &shot_board).unwrap();
