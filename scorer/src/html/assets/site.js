@@ -324,7 +324,9 @@
         overheadCam = cam;
         stage.appendChild(canvas);
       }
-      cams.appendChild(el("figure", null, stage, el("figcaption", null, name + (name === "overhead" ? " + planned hands" : ""))));
+      cams.appendChild(el("figure", null, stage, el("figcaption", null, name + (name === "overhead"
+        ? " + each model's planned hand path (its colour; ring: base at the end of the walk), hazard path (dashed), " +
+          "hazard now (yellow), impact point (red ring), observer (white bar)" : ""))));
     });
     var full = document.getElementById("full");
     if (S.media.full_event) {
