@@ -191,3 +191,52 @@ pub fn collect(path: &Path, ds: &Dataset, cfg: &Config, models: &[String]) -> Re
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fixture::synth_rows;
+
+    #[test]
+    fn first_line_wins_a_retry_replaces_an_error_and_prompt_versions_are_kept() {
+        let rows = synth_rows(8, 3);
+        let valid: Vec<&str> = rows
+            .iter()
+            .filter(|r| r.scene.valid)
+            .map(|r| r.scene.scene_id.as_str())
+            .collect();
+        let (a, b) = (valid[0], valid[1]);
+        let ds = Dataset::from_scenes("fixture".into(), rows.iter().map(|r| r.scene.clone()).collect());
+        let cfg = Config::default();
+        let plan = |intent: &str| {
+            serde_json::json!({"intent": intent, "walking_cmd": [0.0, 0.0, 0.0], "walking_duration": 0.0,
+                "keyframes": [{"t": 0.2, "left_hand": [0.6, 0.15, 0.3], "right_hand": [0.6, -0.15, 0.3]}]})
+        };
+        let lines = [
+            serde_json::json!({"scene_id": a, "model": "m", "error": "timeout", "prompt_version": "p1"}),
+            serde_json::json!({"scene_id": a, "model": "m", "plan": plan("catch it"), "prompt_version": "p1"}),
+            serde_json::json!({"scene_id": a, "model": "m", "plan": plan("second answer ignored")}),
+            serde_json::json!({"scene_id": b, "model": "m", "plan": plan("first wins"), "prompt_version": "p2"}),
+            serde_json::json!({"scene_id": b, "model": "m", "error": "late error ignored"}),
+            serde_json::json!({"scene_id": "nosuchid", "model": "m", "plan": plan("unknown scene")}),
+            serde_json::json!({"scene_id": a, "model": "other", "plan": plan("not in the report")}),
+        ];
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("preds.jsonl");
+        let text: String = lines.iter().map(|l| l.to_string() + "\n").collect();
+        std::fs::write(&path, text + "not json\n").unwrap();
+        let c = collect(&path, &ds, &cfg, &["m".to_string()]).unwrap();
+        let (ia, ib) = (ds.get(a).unwrap().0, ds.get(b).unwrap().0);
+        assert_eq!(c.decisions.len(), 2);
+        let da = &c.decisions[&ia][&0];
+        assert_eq!((da.status, da.intent.as_deref()), ("scored", Some("catch it")));
+        assert_eq!(da.action, Some("CATCH"));
+        assert_eq!(da.hands.len(), 1);
+        assert!((da.hands[0][0] - 0.2).abs() < 1e-12);
+        let db = &c.decisions[&ib][&0];
+        assert_eq!(db.intent.as_deref(), Some("first wins"));
+        let pv: Vec<&str> = c.prompt_versions[0].iter().map(String::as_str).collect();
+        assert_eq!(pv, ["p1", "p2"]);
+        assert_eq!(da.action_code(), 1);
+    }
+}
