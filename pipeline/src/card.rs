@@ -264,7 +264,8 @@ pub fn render(input: &CardInput) -> String {
         .map(String::as_str)
         .collect();
     if !absent.is_empty() {
-        let _ = write!(
+        let _ =
+            write!(
             scope,
             "\n\nThe build was asked for {} families; {} got no scene group because the build is \
              smaller than one group per family (families are dealt to groups in turn): {}.",

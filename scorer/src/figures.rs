@@ -291,7 +291,11 @@ fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -
             continue;
         };
         chart
-            .draw_series(std::iter::once(Text::new(label, (1.0, y + 0.12), (FONT, 12))))
+            .draw_series(std::iter::once(Text::new(
+                label,
+                (1.0, y + 0.12),
+                (FONT, 12),
+            )))
             .map_err(e)?;
     }
     for rule in Rule::ALL {

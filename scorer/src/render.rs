@@ -95,7 +95,8 @@ impl Table {
 
 /// The CATCH row of a per-GT-action breakdown.
 fn catch_row(rows: &[MetricsRow]) -> Option<&MetricsRow> {
-    rows.iter().find(|g| g.group == crate::types::Action::Catch.as_str())
+    rows.iter()
+        .find(|g| g.group == crate::types::Action::Catch.as_str())
 }
 
 const MAIN_NOTE: &str = "d_end and HDE (hand-distance error: d_min and d1-d_min over the keyframes) are over CATCH scenes, \
@@ -158,13 +159,21 @@ fn distance_table(r: &Report) -> Table {
         "HDE d1-d_min (m)",
         "n/missing",
     ]);
-    for m in r.models.iter().chain((r.models.len() > 1).then_some(&r.pooled)) {
+    for m in r
+        .models
+        .iter()
+        .chain((r.models.len() > 1).then_some(&r.pooled))
+    {
         for g in &m.by_gt_action {
             if g.decisions == 0 {
                 continue;
             }
             t.row(vec![
-                if m.model == "ALL" { "ALL (pooled)".into() } else { m.model.clone() },
+                if m.model == "ALL" {
+                    "ALL (pooled)".into()
+                } else {
+                    m.model.clone()
+                },
                 g.group.clone(),
                 g.decisions.to_string(),
                 num(g.d_end, 2),
@@ -178,7 +187,11 @@ fn distance_table(r: &Report) -> Table {
 }
 
 /// d_end and AIA per group (family or speed band) and model: "d_end / AIA (n)".
-fn distance_aia_table(r: &Report, title: &str, pick: fn(&ModelReport) -> &Vec<MetricsRow>) -> Table {
+fn distance_aia_table(
+    r: &Report,
+    title: &str,
+    pick: fn(&ModelReport) -> &Vec<MetricsRow>,
+) -> Table {
     let models: Vec<&ModelReport> = r
         .models
         .iter()
@@ -188,7 +201,10 @@ fn distance_aia_table(r: &Report, title: &str, pick: fn(&ModelReport) -> &Vec<Me
     for m in &models {
         head.push(format!("{} d_end m / AIA", m.model));
     }
-    let mut t = Table { head, rows: Vec::new() };
+    let mut t = Table {
+        head,
+        rows: Vec::new(),
+    };
     let groups: Vec<String> = pick(&r.pooled).iter().map(|g| g.group.clone()).collect();
     for (gi, g) in groups.iter().enumerate() {
         let mut row = vec![g.clone()];
@@ -210,8 +226,14 @@ type Pick = fn(&ModelReport) -> &Vec<MetricsRow>;
 /// The per-family and per-band d_end / AIA tables: (title, first column, picker).
 fn distance_breakdowns() -> [(&'static str, &'static str, Pick); 2] {
     [
-        ("d_end and AIA by family (d_end over all scenes of the family with an impact point)", "Family", |m| &m.by_family),
-        ("d_end and AIA by speed band", "Speed band", |m| &m.by_speed_band),
+        (
+            "d_end and AIA by family (d_end over all scenes of the family with an impact point)",
+            "Family",
+            |m| &m.by_family,
+        ),
+        ("d_end and AIA by speed band", "Speed band", |m| {
+            &m.by_speed_band
+        }),
     ]
 }
 
@@ -503,7 +525,10 @@ pub fn markdown(r: &Report) -> String {
     }
     s.push_str("\nRates in %, distances in metres. Missing values (no impact point, no plan) leave the denominator; their counts are shown.\n\n## Main results\n\n");
     s.push_str(&main_table(r).markdown());
-    let _ = write!(s, "\n{MAIN_NOTE}\n\n## d_end and HDE per ground-truth action\n\n");
+    let _ = write!(
+        s,
+        "\n{MAIN_NOTE}\n\n## d_end and HDE per ground-truth action\n\n"
+    );
     s.push_str(&distance_table(r).markdown());
     for (title, column, pick) in distance_breakdowns() {
         let _ = write!(s, "\n## {title}\n\n");

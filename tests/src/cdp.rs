@@ -20,9 +20,8 @@ pub fn chromium_path() -> Option<String> {
     ["chromium", "chromium-browser", "google-chrome"]
         .into_iter()
         .find(|name| {
-            std::env::var_os("PATH").is_some_and(|path| {
-                std::env::split_paths(&path).any(|d| d.join(name).is_file())
-            })
+            std::env::var_os("PATH")
+                .is_some_and(|path| std::env::split_paths(&path).any(|d| d.join(name).is_file()))
         })
         .map(String::from)
 }
@@ -81,7 +80,9 @@ impl Browser {
                 Ok(())
             });
         }
-        let child = cmd.spawn().unwrap_or_else(|e| panic!("cannot start {chromium}: {e}"));
+        let child = cmd
+            .spawn()
+            .unwrap_or_else(|e| panic!("cannot start {chromium}: {e}"));
         drop(child_in);
         drop(child_out);
         let (tx, rx) = channel();
@@ -119,7 +120,10 @@ impl Browser {
             "Target.attachToTarget",
             json!({"targetId": target_id, "flatten": true}),
         );
-        b.session = attached["sessionId"].as_str().expect("sessionId").to_string();
+        b.session = attached["sessionId"]
+            .as_str()
+            .expect("sessionId")
+            .to_string();
         for m in ["Runtime.enable", "Log.enable", "Page.enable"] {
             b.call(m, json!({}));
         }
@@ -141,12 +145,15 @@ impl Browser {
                     .or(p["exceptionDetails"]["text"].as_str())
                     .unwrap_or("?")
             )),
-            "Runtime.consoleAPICalled" if matches!(p["type"].as_str(), Some("error" | "assert")) => {
-                self.errors.push(format!("console.{}: {}", p["type"], p["args"]))
+            "Runtime.consoleAPICalled"
+                if matches!(p["type"].as_str(), Some("error" | "assert")) =>
+            {
+                self.errors
+                    .push(format!("console.{}: {}", p["type"], p["args"]))
             }
-            "Log.entryAdded" if p["entry"]["level"].as_str() == Some("error") => self.errors.push(
-                format!("log: {} {}", p["entry"]["text"], p["entry"]["url"]),
-            ),
+            "Log.entryAdded" if p["entry"]["level"].as_str() == Some("error") => self
+                .errors
+                .push(format!("log: {} {}", p["entry"]["text"], p["entry"]["url"])),
             _ => {}
         }
         if !method.is_empty() {
@@ -175,7 +182,9 @@ impl Browser {
         }
         let mut bytes = serde_json::to_vec(&msg).unwrap();
         bytes.push(0);
-        self.to_browser.write_all(&bytes).expect("write to chromium");
+        self.to_browser
+            .write_all(&bytes)
+            .expect("write to chromium");
         let deadline = Instant::now() + Duration::from_secs(60);
         loop {
             let v = self
@@ -260,10 +269,9 @@ pub fn decode_base64(s: &str) -> Vec<u8> {
     let mut out = Vec::with_capacity(bytes.len() / 4 * 3);
     for chunk in bytes.chunks(4) {
         let pad = chunk.iter().filter(|&&c| c == b'=').count();
-        let n = chunk
-            .iter()
-            .fold(0u32, |acc, &c| (acc << 6) | if c == b'=' { 0 } else { val(c) })
-            << (6 * (4 - chunk.len()));
+        let n = chunk.iter().fold(0u32, |acc, &c| {
+            (acc << 6) | if c == b'=' { 0 } else { val(c) }
+        }) << (6 * (4 - chunk.len()));
         let three = [(n >> 16) as u8, (n >> 8) as u8, n as u8];
         out.extend_from_slice(&three[..3 - pad.min(2)]);
     }

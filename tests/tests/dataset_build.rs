@@ -123,13 +123,28 @@ fn dataset_build_layout_card_and_manifest() {
     let small = tmp.path().join("small");
     run_ok(
         "rh-pipeline",
-        &["build", "--n", "4", "--no-render", "--quiet", "--families", "object_drop,rolling_ball",
-          "--out", small.to_str().unwrap()],
+        &[
+            "build",
+            "--n",
+            "4",
+            "--no-render",
+            "--quiet",
+            "--families",
+            "object_drop,rolling_ball",
+            "--out",
+            small.to_str().unwrap(),
+        ],
     );
     let card = std::fs::read_to_string(small.join("README.md")).unwrap();
     assert!(card.contains("of 1 family in 1 scene group "), "{card}");
-    assert!(card.contains("got no scene group") && card.contains("`rolling_ball`"), "{card}");
-    assert!(card.contains("| object_drop |") && !card.contains("| rolling_ball |"), "{card}");
+    assert!(
+        card.contains("got no scene group") && card.contains("`rolling_ball`"),
+        "{card}"
+    );
+    assert!(
+        card.contains("| object_drop |") && !card.contains("| rolling_ball |"),
+        "{card}"
+    );
     let manifest: serde_json::Value = serde_json::from_slice(&files["build.json"]).unwrap();
     assert_eq!(manifest["seed"], 11);
     assert_eq!(manifest["n"], 40);

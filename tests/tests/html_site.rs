@@ -86,17 +86,33 @@ fn html_site_opens_in_headless_chromium() {
             site.to_str().unwrap(),
         ],
     );
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("index.html"), "says where to open it: {stderr}");
-    for f in ["index.html", "scenes.html", "scene.html", "data/index.js", "assets/site.js"] {
+    assert!(
+        stderr.contains("index.html"),
+        "says where to open it: {stderr}"
+    );
+    for f in [
+        "index.html",
+        "scenes.html",
+        "scene.html",
+        "data/index.js",
+        "assets/site.js",
+    ] {
         assert!(site.join(f).is_file(), "{f}");
     }
     // Self-contained: nothing is fetched from another origin.
     for f in ["index.html", "scenes.html", "scene.html", "assets/site.js"] {
         let text = std::fs::read_to_string(site.join(f)).unwrap();
         for pat in ["src=\"http", "href=\"http", "url(http", "import "] {
-            assert!(!text.contains(pat), "{f} loads something from the network: {pat}");
+            assert!(
+                !text.contains(pat),
+                "{f} loads something from the network: {pat}"
+            );
         }
     }
 
@@ -129,7 +145,10 @@ fn html_site_opens_in_headless_chromium() {
          s.dispatchEvent(new Event('change', {bubbles: true})); })()",
     );
     let family = count(&mut b);
-    assert!(family > 0 && family < all, "family filter: {family} of {all}");
+    assert!(
+        family > 0 && family < all,
+        "family filter: {family} of {all}"
+    );
     let model_rule = b.eval(
         "(() => { const f = document.getElementById('f-family'); f.value = ''; \
          const m = document.getElementById('f-model'); m.value = 'oracle'; \
@@ -137,7 +156,11 @@ fn html_site_opens_in_headless_chromium() {
          r.dispatchEvent(new Event('change', {bubbles: true})); \
          return +document.getElementById('count').dataset.count; })()",
     );
-    assert_eq!(model_rule.as_u64(), Some(0), "the oracle never fires a safety rule");
+    assert_eq!(
+        model_rule.as_u64(),
+        Some(0),
+        "the oracle never fires a safety rule"
+    );
     // A CATCH scene for the scene page (the oracle reaches for it), else the first one.
     let scene = b.eval(
         "(() => { const r = document.getElementById('f-rule'); r.value = ''; \
@@ -161,12 +184,23 @@ fn html_site_opens_in_headless_chromium() {
            else setTimeout(poll, 100); })(); })",
     );
     let states = states.as_array().expect("video states").clone();
-    assert_eq!(states.len(), 4, "three observation videos and the full event: {states:?}");
+    assert_eq!(
+        states.len(),
+        4,
+        "three observation videos and the full event: {states:?}"
+    );
     for s in &states {
-        assert!(s[1].as_u64().unwrap() >= 2, "video not decodable: {states:?}");
+        assert!(
+            s[1].as_u64().unwrap() >= 2,
+            "video not decodable: {states:?}"
+        );
     }
     let paths = b.eval("+document.getElementById('overlay').dataset.paths");
-    assert_eq!(paths.as_u64(), Some(BASELINES.len() as u64), "one hand path per model");
+    assert_eq!(
+        paths.as_u64(),
+        Some(BASELINES.len() as u64),
+        "one hand path per model"
+    );
     // Pixels in the models' colours (the site's palette) on the overlay canvas.
     let coloured = b.eval(
         "(() => { const c = document.getElementById('overlay'); \
@@ -176,7 +210,10 @@ fn html_site_opens_in_headless_chromium() {
            if (d[i+3] > 200 && pal.some(p => Math.abs(d[i]-p[0]) < 20 && Math.abs(d[i+1]-p[1]) < 20 && Math.abs(d[i+2]-p[2]) < 20)) n++; \
          return n; })()",
     );
-    assert!(coloured.as_u64().unwrap() >= 10, "the planned hands are drawn: {coloured}");
+    assert!(
+        coloured.as_u64().unwrap() >= 10,
+        "the planned hands are drawn: {coloured}"
+    );
     let decisions = b.eval("document.querySelectorAll('#decisions tbody tr').length");
     assert_eq!(decisions.as_u64(), Some(BASELINES.len() as u64));
     // Screenshot mid-window (paused), then play.
@@ -193,13 +230,21 @@ fn html_site_opens_in_headless_chromium() {
     );
     b.eval("document.getElementById('play').click()");
     b.pause(Duration::from_millis(300));
-    let times = b.eval(
-        "[...document.querySelectorAll('.cams video')].map(v => v.currentTime)",
-    );
-    let times: Vec<f64> = times.as_array().unwrap().iter().map(|t| t.as_f64().unwrap()).collect();
+    let times = b.eval("[...document.querySelectorAll('.cams video')].map(v => v.currentTime)");
+    let times: Vec<f64> = times
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_f64().unwrap())
+        .collect();
     assert_eq!(times.len(), 3);
-    let (lo, hi) = times.iter().fold((f64::MAX, f64::MIN), |(a, b), &t| (a.min(t), b.max(t)));
-    assert!(lo > 0.05 && hi - lo < 0.1, "videos play (from 0) in sync: {times:?}");
+    let (lo, hi) = times
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &t| (a.min(t), b.max(t)));
+    assert!(
+        lo > 0.05 && hi - lo < 0.1,
+        "videos play (from 0) in sync: {times:?}"
+    );
 
     assert!(b.errors.is_empty(), "console errors: {:#?}", b.errors);
 
@@ -219,17 +264,45 @@ fn html_site_opens_in_headless_chromium() {
     std::fs::write(&preds_file, tagged).unwrap();
     run_ok(
         "rh-score",
-        &[preds_file.to_str().unwrap(), "--dataset", ds, "--quiet", "--html", site.to_str().unwrap()],
+        &[
+            preds_file.to_str().unwrap(),
+            "--dataset",
+            ds,
+            "--quiet",
+            "--html",
+            site.to_str().unwrap(),
+        ],
     );
     let index = std::fs::read_to_string(site.join("index.html")).unwrap();
-    assert!(index.contains("\"prompt_versions\":[\"rh-prompt-test-7\"]"), "prompt version on the board");
-    let scene_js = std::fs::read_to_string(site.join(format!("data/{}", scene.replace("scene.html#", "scenes/") + ".js"))).unwrap();
-    assert!(scene_js.contains("rh-prompt-test-7"), "prompt version on the scene page");
+    assert!(
+        index.contains("\"prompt_versions\":[\"rh-prompt-test-7\"]"),
+        "prompt version on the board"
+    );
+    let scene_js = std::fs::read_to_string(site.join(format!(
+        "data/{}",
+        scene.replace("scene.html#", "scenes/") + ".js"
+    )))
+    .unwrap();
+    assert!(
+        scene_js.contains("rh-prompt-test-7"),
+        "prompt version on the scene page"
+    );
     let refused = rh_e2e::run(
         "rh-score",
-        &[preds_file.to_str().unwrap(), "--dataset", ds, "--quiet", "--html", dataset.to_str().unwrap()],
+        &[
+            preds_file.to_str().unwrap(),
+            "--dataset",
+            ds,
+            "--quiet",
+            "--html",
+            dataset.to_str().unwrap(),
+        ],
     );
-    assert_eq!(refused.status.code(), Some(2), "a non-site directory is not replaced");
+    assert_eq!(
+        refused.status.code(),
+        Some(2),
+        "a non-site directory is not replaced"
+    );
     assert!(dataset.join("README.md").exists());
 
     let shots = Path::new(env!("CARGO_TARGET_TMPDIR")).join("screenshots");

@@ -106,7 +106,10 @@ fn rendered_build_has_probed_videos_frames_columns_and_merges_byte_equal() {
     let rerun = run("rh-pipeline", &args);
     let err = String::from_utf8_lossy(&rerun.stderr);
     assert!(rerun.status.success(), "{err}");
-    assert!(err.contains("nothing to do") && !err.contains("rendering on"), "{err}");
+    assert!(
+        err.contains("nothing to do") && !err.contains("rendering on"),
+        "{err}"
+    );
 
     // Per row: scene id, validity, the four video columns (pyarrow reads the table).
     let rows = python(&format!(

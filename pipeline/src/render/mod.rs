@@ -1535,7 +1535,11 @@ pub fn contact_sheet(dataset_dir: &Path, out_png: &Path) -> Result<ContactSheet,
         let tile = image::imageops::resize(&img, tw, th, image::imageops::FilterType::Triangle);
         // A short last row is centred rather than leaving empty tiles at its end.
         let (row, col) = (i as u32 / cols, i as u32 % cols);
-        let in_row = if row + 1 == rows { n - row * cols } else { cols };
+        let in_row = if row + 1 == rows {
+            n - row * cols
+        } else {
+            cols
+        };
         let x = col * tw + (cols - in_row) * tw / 2;
         let y = row * (th + label);
         image::imageops::replace(&mut sheet, &tile, x as i64, (y + label) as i64);

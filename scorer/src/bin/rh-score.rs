@@ -240,7 +240,11 @@ fn score(cli: Cli) -> Result<()> {
         print_out(&rh_score::render::terminal(&report))?;
     }
     if let Some(site) = site {
-        let index = site.dir.canonicalize().unwrap_or(site.dir.clone()).join("index.html");
+        let index = site
+            .dir
+            .canonicalize()
+            .unwrap_or(site.dir.clone())
+            .join("index.html");
         eprintln!(
             "rh-score: site with {} models and {} scenes ({} video files) in {}; open file://{}",
             site.models,

@@ -90,7 +90,13 @@ fn is_error(v: Option<&Value>) -> bool {
     }
 }
 
-fn decide(obj: &serde_json::Map<String, Value>, ds: &Dataset, cfg: &Config, aia: &AiaMatcher, scene: u32) -> Decision {
+fn decide(
+    obj: &serde_json::Map<String, Value>,
+    ds: &Dataset,
+    cfg: &Config,
+    aia: &AiaMatcher,
+    scene: u32,
+) -> Decision {
     let sc = &ds.scenes[scene as usize];
     let prompt_version = text_field(obj, "prompt_version");
     if is_error(obj.get("error")) {
@@ -156,18 +162,27 @@ pub fn collect(path: &Path, ds: &Dataset, cfg: &Config, models: &[String]) -> Re
     let f = std::fs::File::open(path)
         .map_err(|e| InputError(format!("cannot read predictions {}: {e}", path.display())))?;
     let aia = AiaMatcher::new(&cfg.aia);
-    let index: BTreeMap<&str, usize> = models.iter().enumerate().map(|(i, m)| (m.as_str(), i)).collect();
+    let index: BTreeMap<&str, usize> = models
+        .iter()
+        .enumerate()
+        .map(|(i, m)| (m.as_str(), i))
+        .collect();
     let mut out = Collected {
         prompt_versions: vec![BTreeSet::new(); models.len()],
         decisions: BTreeMap::new(),
     };
-    let mut reader = LineReader::new(BufReader::with_capacity(1 << 20, f), cfg.sanity.max_line_bytes);
+    let mut reader = LineReader::new(
+        BufReader::with_capacity(1 << 20, f),
+        cfg.sanity.max_line_bytes,
+    );
     while let Some((_, line)) = reader.next_line()? {
         let RawLine::Line(bytes) = line else { continue };
         let Ok(Value::Object(obj)) = serde_json::from_slice::<Value>(&bytes) else {
             continue;
         };
-        let (Some(scene_id), Some(model)) = (text_field(&obj, "scene_id"), text_field(&obj, "model")) else {
+        let (Some(scene_id), Some(model)) =
+            (text_field(&obj, "scene_id"), text_field(&obj, "model"))
+        else {
             continue;
         };
         let (Some(&mi), Some((si, sc))) = (index.get(model.as_str()), ds.get(&scene_id)) else {
@@ -206,7 +221,10 @@ mod tests {
             .map(|r| r.scene.scene_id.as_str())
             .collect();
         let (a, b) = (valid[0], valid[1]);
-        let ds = Dataset::from_scenes("fixture".into(), rows.iter().map(|r| r.scene.clone()).collect());
+        let ds = Dataset::from_scenes(
+            "fixture".into(),
+            rows.iter().map(|r| r.scene.clone()).collect(),
+        );
         let cfg = Config::default();
         let plan = |intent: &str| {
             serde_json::json!({"intent": intent, "walking_cmd": [0.0, 0.0, 0.0], "walking_duration": 0.0,
@@ -229,7 +247,10 @@ mod tests {
         let (ia, ib) = (ds.get(a).unwrap().0, ds.get(b).unwrap().0);
         assert_eq!(c.decisions.len(), 2);
         let da = &c.decisions[&ia][&0];
-        assert_eq!((da.status, da.intent.as_deref()), ("scored", Some("catch it")));
+        assert_eq!(
+            (da.status, da.intent.as_deref()),
+            ("scored", Some("catch it"))
+        );
         assert_eq!(da.action, Some("CATCH"));
         assert_eq!(da.hands.len(), 1);
         assert!((da.hands[0][0] - 0.2).abs() < 1e-12);

@@ -93,7 +93,9 @@ pub fn write_site(
     out: &Path,
 ) -> Result<SiteSummary> {
     if out.exists() && !out.join(MARKER).exists() {
-        let empty = std::fs::read_dir(out).map(|mut d| d.next().is_none()).unwrap_or(false);
+        let empty = std::fs::read_dir(out)
+            .map(|mut d| d.next().is_none())
+            .unwrap_or(false);
         if !empty {
             return Err(InputError(format!(
                 "--html {}: the directory exists and is not a site written by rh-score; give a new or empty directory",
@@ -102,7 +104,10 @@ pub fn write_site(
             .into());
         }
     }
-    let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     std::fs::create_dir_all(parent)
         .map_err(|e| InputError(format!("cannot create {}: {e}", parent.display())))?;
     let name = out.file_name().and_then(|n| n.to_str()).unwrap_or("site");
@@ -111,10 +116,12 @@ pub fn write_site(
     let result = write_into(report, ds, cfg, preds, &tmp).and_then(|summary| {
         if out.exists() {
             let old = parent.join(format!(".{name}.{}.old", std::process::id()));
-            std::fs::rename(out, &old).with_context(|| format!("moving the old {} away", out.display()))?;
+            std::fs::rename(out, &old)
+                .with_context(|| format!("moving the old {} away", out.display()))?;
             let _ = std::fs::remove_dir_all(&old);
         }
-        std::fs::rename(&tmp, out).with_context(|| format!("renaming the site into {}", out.display()))?;
+        std::fs::rename(&tmp, out)
+            .with_context(|| format!("renaming the site into {}", out.display()))?;
         Ok(SiteSummary {
             dir: out.to_path_buf(),
             ..summary
@@ -164,9 +171,18 @@ fn page(title: &str, body_id: &str, body: &str, scripts: &[&str]) -> String {
     s
 }
 
-fn write_into(report: &Report, ds: &Dataset, cfg: &Config, preds: &Path, dir: &Path) -> Result<SiteSummary> {
+fn write_into(
+    report: &Report,
+    ds: &Dataset,
+    cfg: &Config,
+    preds: &Path,
+    dir: &Path,
+) -> Result<SiteSummary> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    write(&dir.join(MARKER), "written by rh-score --html; rerunning replaces this directory\n")?;
+    write(
+        &dir.join(MARKER),
+        "written by rh-score --html; rerunning replaces this directory\n",
+    )?;
     write(&dir.join("assets/site.css"), CSS)?;
     write(&dir.join("assets/site.js"), JS)?;
 
@@ -177,7 +193,10 @@ fn write_into(report: &Report, ds: &Dataset, cfg: &Config, preds: &Path, dir: &P
     let fig_dir = dir.join("figures");
     let figs = crate::figures::write_figures(report, &fig_dir)?;
     let mut figures_html = String::new();
-    for svg in figs.iter().filter(|p| p.extension().is_some_and(|e| e == "svg")) {
+    for svg in figs
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "svg"))
+    {
         let text = std::fs::read_to_string(svg)?;
         let body = text.find("<svg").map_or(text.as_str(), |i| &text[i..]);
         let stem = svg.file_stem().and_then(|s| s.to_str()).unwrap_or("figure");
@@ -234,7 +253,10 @@ fn write_into(report: &Report, ds: &Dataset, cfg: &Config, preds: &Path, dir: &P
          <script>window.RH_BOARD = {};</script>",
         script_json(&board)?
     );
-    write(&dir.join("index.html"), &page("ReactHuman — leaderboard", "page-board", &body, &[]))?;
+    write(
+        &dir.join("index.html"),
+        &page("ReactHuman — leaderboard", "page-board", &body, &[]),
+    )?;
 
     // Scenes: index, per-scene files, media.
     let ds_rows = rows::read_rows(&ds.dir)?;
@@ -247,13 +269,22 @@ fn write_into(report: &Report, ds: &Dataset, cfg: &Config, preds: &Path, dir: &P
         if !sc.valid {
             continue;
         }
-        let Some(row) = ds_rows.get(&sc.scene_id) else { continue };
+        let Some(row) = ds_rows.get(&sc.scene_id) else {
+            continue;
+        };
         scenes += 1;
         let decisions = collected.decisions.get(&(si as u32)).unwrap_or(&empty);
         let codes: Vec<u32> = (0..models.len())
-            .map(|mi| decisions.get(&mi).map_or(5 * 16, |d| d.action_code() * 16 + d.rule_bits()))
+            .map(|mi| {
+                decisions
+                    .get(&mi)
+                    .map_or(5 * 16, |d| d.action_code() * 16 + d.rule_bits())
+            })
             .collect();
-        let gt = Action::ALL.iter().position(|a| *a == sc.gt_action).unwrap_or(0);
+        let gt = Action::ALL
+            .iter()
+            .position(|a| *a == sc.gt_action)
+            .unwrap_or(0);
         index_rows.push(json!([
             sc.scene_id,
             sc.family,
@@ -267,7 +298,10 @@ fn write_into(report: &Report, ds: &Dataset, cfg: &Config, preds: &Path, dir: &P
             if let Some(Value::String(rel)) = row.get(col) {
                 if link_media(&ds.dir, rel, &dir.join("media"))? {
                     media_files += 1;
-                    media.insert(col.trim_end_matches("_file_name").to_string(), json!(format!("media/{rel}")));
+                    media.insert(
+                        col.trim_end_matches("_file_name").to_string(),
+                        json!(format!("media/{rel}")),
+                    );
                 }
             }
         }
@@ -305,14 +339,22 @@ fn write_into(report: &Report, ds: &Dataset, cfg: &Config, preds: &Path, dir: &P
         "rules": Rule::ALL.map(|r| r.as_str()),
         "scenes": index_rows,
     });
-    write(&dir.join("data/index.js"), &format!("RH.index({});\n", script_json(&index)?))?;
+    write(
+        &dir.join("data/index.js"),
+        &format!("RH.index({});\n", script_json(&index)?),
+    )?;
 
     let browser = "<h1>Scenes</h1>\n<form id=\"filters\" class=\"filters\"></form>\n\
         <p id=\"count\"></p>\n<nav class=\"pager\" id=\"pager\"></nav>\n\
         <table id=\"scene-list\"><thead></thead><tbody></tbody></table>";
     write(
         &dir.join("scenes.html"),
-        &page("ReactHuman — scenes", "page-scenes", browser, &["data/index.js"]),
+        &page(
+            "ReactHuman — scenes",
+            "page-scenes",
+            browser,
+            &["data/index.js"],
+        ),
     )?;
     let scene_page = "<h1 id=\"scene-title\">Scene</h1>\n<p id=\"scene-nav\"></p>\n\
         <section class=\"videos\"><div class=\"cams\" id=\"cams\"></div>\n\
@@ -323,7 +365,10 @@ fn write_into(report: &Report, ds: &Dataset, cfg: &Config, preds: &Path, dir: &P
         <div class=\"pair\"><section class=\"facts\"><h2>Labels and physics</h2><table id=\"labels\"></table></section>\n\
         <section><h2>Full event</h2><div id=\"full\"></div></section></div>\n\
         <details><summary>Every column of this row</summary><pre id=\"raw\"></pre></details>";
-    write(&dir.join("scene.html"), &page("ReactHuman — scene", "page-scene", scene_page, &[]))?;
+    write(
+        &dir.join("scene.html"),
+        &page("ReactHuman — scene", "page-scene", scene_page, &[]),
+    )?;
 
     Ok(SiteSummary {
         dir: dir.to_path_buf(),

@@ -52,17 +52,28 @@ fn value(a: &ArrayRef, i: usize) -> Value {
 /// `scene_id` (the first row of a duplicated id wins, as in [`crate::dataset`]).
 pub fn read_rows(dir: &Path) -> Result<BTreeMap<String, Map<String, Value>>> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir.join("data"))
-        .map_err(|e| InputError(format!("dataset {} has no readable data/ folder: {e}", dir.display())))?
+        .map_err(|e| {
+            InputError(format!(
+                "dataset {} has no readable data/ folder: {e}",
+                dir.display()
+            ))
+        })?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
         .collect();
     files.sort();
     let mut rows = BTreeMap::new();
     for file in files {
-        let f = std::fs::File::open(&file).with_context(|| format!("opening {}", file.display()))?;
+        let f =
+            std::fs::File::open(&file).with_context(|| format!("opening {}", file.display()))?;
         let reader = ParquetRecordBatchReaderBuilder::try_new(f)
             .and_then(|b| b.build())
-            .map_err(|e| InputError(format!("{}: not a readable Parquet file: {e}", file.display())))?;
+            .map_err(|e| {
+                InputError(format!(
+                    "{}: not a readable Parquet file: {e}",
+                    file.display()
+                ))
+            })?;
         for batch in reader {
             let batch = batch.map_err(|e| InputError(format!("{}: {e}", file.display())))?;
             let schema = batch.schema();
