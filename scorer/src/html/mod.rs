@@ -189,7 +189,22 @@ fn write_into(
     let models: Vec<String> = report.models.iter().map(|m| m.model.clone()).collect();
     let collected = collect::collect(preds, ds, cfg, &models)?;
 
-    // Figures, SVG inlined into the leaderboard page (the PNGs stay beside them).
+    let figures_html = figures_html(report, dir)?;
+    write_board(report, &collected, &figures_html, dir)?;
+    let (scenes, media_files) = write_scenes(ds, &models, &collected, dir)?;
+    write_static_pages(dir)?;
+
+    Ok(SiteSummary {
+        dir: dir.to_path_buf(),
+        models: models.len(),
+        scenes,
+        media_files,
+    })
+}
+
+/// Writes the figures into `dir/figures/` and returns their SVG markup, inlined into the
+/// leaderboard page (the PNGs stay beside them).
+fn figures_html(report: &Report, dir: &Path) -> Result<String> {
     let fig_dir = dir.join("figures");
     let figs = crate::figures::write_figures(report, &fig_dir)?;
     let mut figures_html = String::new();
@@ -207,7 +222,16 @@ fn write_into(
         );
     }
 
-    // Leaderboard.
+    Ok(figures_html)
+}
+
+/// `index.html`: the leaderboard and the figures.
+fn write_board(
+    report: &Report,
+    collected: &collect::Collected,
+    figures_html: &str,
+    dir: &Path,
+) -> Result<()> {
     let rows: Vec<LeaderRow> = report
         .models
         .iter()
@@ -258,7 +282,16 @@ fn write_into(
         &page("ReactHuman — leaderboard", "page-board", &body, &[]),
     )?;
 
-    // Scenes: index, per-scene files, media.
+    Ok(())
+}
+
+/// `data/index.js`, `data/scenes/<id>.js` and `media/`: returns (scenes, media files).
+fn write_scenes(
+    ds: &Dataset,
+    models: &[String],
+    collected: &collect::Collected,
+    dir: &Path,
+) -> Result<(usize, usize)> {
     let ds_rows = rows::read_rows(&ds.dir)?;
     let families = &ds.families;
     let mut index_rows = Vec::new();
@@ -344,6 +377,11 @@ fn write_into(
         &format!("RH.index({});\n", script_json(&index)?),
     )?;
 
+    Ok((scenes, media_files))
+}
+
+/// `scenes.html` and `scene.html` (their content comes from the data files).
+fn write_static_pages(dir: &Path) -> Result<()> {
     let browser = "<h1>Scenes</h1>\n<form id=\"filters\" class=\"filters\"></form>\n\
         <p id=\"count\"></p>\n<nav class=\"pager\" id=\"pager\"></nav>\n\
         <table id=\"scene-list\"><thead></thead><tbody></tbody></table>";
@@ -370,12 +408,7 @@ fn write_into(
         &page("ReactHuman — scene", "page-scene", scene_page, &[]),
     )?;
 
-    Ok(SiteSummary {
-        dir: dir.to_path_buf(),
-        models: models.len(),
-        scenes,
-        media_files,
-    })
+    Ok(())
 }
 
 /// Puts the dataset file `rel` under `media/rel`: a hard link when the file system
