@@ -8,6 +8,7 @@ apt_packages=(
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   libavfilter-dev libavdevice-dev libswresample-dev
   clang libclang-dev pkg-config ffmpeg
+  chromium
   slurm-wlm munge
 )
 python_packages=(pyarrow datasets)

@@ -423,7 +423,7 @@ pub const COLUMNS: &[Column] = &[
         col::TRAJECTORY,
         Vec4F32List,
         false,
-        "Hazard centre of mass [t (s), x, y, z (m)] at the video rate (frame k at t = k / fps) from t = 0 until the simulation ends (float32)",
+        "Hazard centre of mass [t (s), x, y, z (m)] over the whole simulation (t = 0 to its last step), sampled at the video rate (every 1/fps s, physics step round(t / dt)); the first entries, t ≤ the observation window, match the camera videos' frames (float32)",
     ),
 ];
 

@@ -344,9 +344,9 @@ pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError
 
 /// Fails before any work when rendering is requested but impossible: no GPU, no
 /// encoder, or a program built without the `render` feature.
-fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<(), BuildError> {
+fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<Option<String>, BuildError> {
     if !opts.render {
-        return Ok(());
+        return Ok(None);
     }
     #[cfg(not(feature = "render"))]
     {
@@ -365,14 +365,11 @@ fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<(), BuildE
                 .map_err(|e| {
                     BuildError::Input(format!("render stage: {e} (or build with --no-render)"))
                 })?;
-        if opts.progress {
-            eprintln!(
-                "rendering on {} ({} MSAA samples)",
-                renderer.adapter_name(),
-                renderer.samples()
-            );
-        }
-        Ok(())
+        Ok(Some(format!(
+            "rendering on {} ({} MSAA samples)",
+            renderer.adapter_name(),
+            renderer.samples()
+        )))
     }
 }
 
@@ -402,7 +399,9 @@ pub fn build(
     config: &Config,
 ) -> Result<BuildSummary, BuildError> {
     check_options(opts, catalog, config)?;
-    check_render_stage(opts, config)?;
+    // Fail before any work when there is nothing to render with; say what renders only
+    // once there is something to render (not before "nothing to do").
+    let render_banner = check_render_stage(opts, config)?;
     let manifest = Manifest::new(
         opts.seed,
         opts.n,
@@ -466,6 +465,9 @@ pub fn build(
     let render: Option<&RenderStage> = None;
 
     let scenes_todo: u64 = todo.iter().map(|&g| manifest.group_size(g)).sum();
+    if let (Some(banner), true) = (&render_banner, opts.progress && scenes_todo > 0) {
+        eprintln!("{banner}");
+    }
     let progress = Progress::new(scenes_todo, opts.progress);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs)
