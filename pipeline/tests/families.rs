@@ -404,7 +404,7 @@ fn surface_cascade_touches_the_stool_between_table_and_floor() {
             table_last.is_none_or(|t| t <= stool),
             "{id}: back on the table after the stool"
         );
-        assert!(families::surface_cascade::touched_stool_before_floor(&sim));
+        assert!(families::surface_cascade::touched_stool_before_floor(&r.spec, &sim));
     }
 }
 
