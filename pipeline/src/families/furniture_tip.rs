@@ -6,7 +6,7 @@
 //! (the push that rocked it), as a rotation about the front edge, which rests on the
 //! floor. Gravity sets the pace of the fall (`speed_sweep = false`).
 //!
-//! Timing (label rule v2): the piece starts only 0.01–0.03 rad past balance with a gentle
+//! Timing (label rule v2): the piece starts only 0.006–0.02 rad past balance with a gentle
 //! push, so its fall starts slowly (an inverted pendulum grows like `e^{λt}`), and the
 //! observer stands where only the late part of the fall reaches: beyond the front face's
 //! reach at the angle the fastest band's piece has fallen to 1 s after t0 (integrated from
@@ -114,7 +114,7 @@ impl Family for FurnitureTip {
         let object = input.object;
         let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
         let dir = heading(heading_angle);
-        let past_balance = uniform(rng, 0.01, 0.03);
+        let past_balance = uniform(rng, 0.006, 0.02);
         let origin = event_origin(rng, input.room, dir, 0.9 + far_shift(input));
 
         let (edge, balance) = front_edge(object);
@@ -150,7 +150,9 @@ impl Family for FurnitureTip {
             dir,
             (clear + 0.05, clear + 0.3),
             (height / 2.0 + 2.0, height / 2.0 + 2.4),
-            0.35,
+            // Sideways offset within half the piece's width, so a thin one (a coat
+            // stand's pole) still falls onto the observer rather than past them.
+            (0.5 * object.half_extents()[0]).min(0.35),
             input.far_observer,
             [com_world[0], com_world[1]],
         );
