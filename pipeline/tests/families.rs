@@ -132,6 +132,36 @@ fn furniture_tips_past_45_degrees() {
     }
 }
 
+/// The fall follows the rigid body's equation of motion about its front edge, which the
+/// sampler integrates to place the observer: the time the simulated piece reaches a tilt
+/// of 0.6 rad past its balance angle matches `tilt_after`.
+#[test]
+fn furniture_fall_follows_the_edge_pendulum() {
+    let catalog = Catalog::embedded().unwrap();
+    for r in scenes("furniture_tip", 3) {
+        let sim = plain(&r.spec);
+        let object = catalog.object(&r.spec.selection.object_id).unwrap();
+        let p = &r.spec.family_params;
+        let (tilt0, balance) = (p["initial_tilt_rad"], p["balance_angle_rad"]);
+        let omega0 = r.spec.speed_value / p["height_m"];
+        let target = balance + 0.6;
+        let tilt = |k: u32| families::up_z(sim.hazard_state(k).rotation).clamp(-1.0, 1.0).acos();
+        let k = (0..=sim.steps()).find(|&k| tilt(k) >= target).expect("it tips");
+        let measured = k as f64 * sim.dt;
+        // The predicted time: the first millisecond `tilt_after` passes the target.
+        let predicted = (1..4000)
+            .map(|ms| ms as f64 * 1e-3)
+            .find(|&t| families::furniture_tip::tilt_after(object, tilt0 - balance, omega0, t) >= target)
+            .unwrap();
+        assert!(
+            (measured - predicted).abs() <= 0.05 * predicted,
+            "{} {}: {measured:.3} s vs {predicted:.3} s",
+            r.spec.selection.object_id,
+            r.spec.speed_band.name()
+        );
+    }
+}
+
 #[test]
 fn stack_top_item_ends_at_least_one_item_lower() {
     for r in scenes("stack_collapse", 3) {

@@ -6,6 +6,12 @@
 //! (the push that rocked it), as a rotation about the front edge, which rests on the
 //! floor. Gravity sets the pace of the fall (`speed_sweep = false`).
 //!
+//! Timing (label rule v2): the piece starts only 0.006–0.02 rad past balance with a gentle
+//! push, so its fall starts slowly (an inverted pendulum grows like `e^{λt}`), and the
+//! observer stands where only the late part of the fall reaches: beyond the front face's
+//! reach at the angle the fastest band's piece has fallen to 1 s after t0 (integrated from
+//! the rigid body's equation of motion about its edge, `φ'' = (g r_c / k²) sin φ`).
+//!
 //! Labels: nearly always DODGE. Every catalog piece but the styrofoam TV is heavy
 //! (bookcases, wardrobes, fridges, mirrors: 5–80 kg), and a toppling one must be dodged;
 //! only the styrofoam TV gives CATCH.
@@ -29,6 +35,69 @@ pub fn front_edge(object: &Object) -> (Vec3, f64) {
     ([0.0, front, -bottom], balance)
 }
 
+/// The observer's torso: radius and the height of the top of the capsule's straight part.
+const TORSO_RADIUS: f64 = 0.18;
+const TORSO_STRAIGHT_TOP: f64 = 1.14;
+/// The fastest band's piece may strike no earlier than this after t0 (Δ + 0.2 s and a margin).
+const LATEST_REACH_S: f64 = 1.0;
+
+/// Tipping about the front edge: the distance from the edge to the centre of mass `r_c`
+/// and the squared radius of gyration `k²` about the edge (I = m k²), from the parts
+/// (mass spread by volume, as the simulator does).
+pub fn edge_pendulum(object: &Object) -> (f64, f64) {
+    let (edge, _) = front_edge(object);
+    let com = com_offset(object);
+    let total: f64 = object.parts.iter().map(|p| p.volume()).sum();
+    let mut k2 = 0.0;
+    for p in &object.parts {
+        let w = p.volume() / total;
+        let h = p.half_extents();
+        // Moment about the part's own x axis through its centre, per unit mass.
+        let own = match p.shape {
+            ShapeKind::Cylinder => (3.0 * h[0] * h[0] + 4.0 * h[2] * h[2]) / 12.0,
+            ShapeKind::Sphere => 0.4 * h[0] * h[0],
+            _ => (h[1] * h[1] + h[2] * h[2]) / 3.0,
+        };
+        let dy = p.offset[1] - edge[1];
+        let dz = p.offset[2] - edge[2];
+        k2 += w * (own + dy * dy + dz * dz);
+    }
+    let r_c = ((com[1] - edge[1]).powi(2) + (com[2] - edge[2]).powi(2)).sqrt();
+    (r_c, k2)
+}
+
+/// The tilt from upright (rad) a piece reaches `t` seconds after starting `past` rad past
+/// its balance angle with angular speed `omega0`, rocking on its edge: `φ'' = (g r_c / k²)
+/// sin φ` (RK4, 1 ms steps), stopped at lying flat.
+pub fn tilt_after(object: &Object, past: f64, omega0: f64, t: f64) -> f64 {
+    let (_, balance) = front_edge(object);
+    let (r_c, k2) = edge_pendulum(object);
+    let lambda2 = GRAVITY * r_c / k2;
+    let f = |phi: f64| lambda2 * phi.sin();
+    let (mut phi, mut w) = (past, omega0);
+    let h = 1e-3;
+    let flat = std::f64::consts::FRAC_PI_2;
+    for _ in 0..(t / h).round() as usize {
+        let (k1p, k1w) = (w, f(phi));
+        let (k2p, k2w) = (w + 0.5 * h * k1w, f(phi + 0.5 * h * k1p));
+        let (k3p, k3w) = (w + 0.5 * h * k2w, f(phi + 0.5 * h * k2p));
+        let (k4p, k4w) = (w + h * k3w, f(phi + h * k3p));
+        phi += h / 6.0 * (k1p + 2.0 * k2p + 2.0 * k3p + k4p);
+        w += h / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
+        if balance + phi >= flat {
+            return flat;
+        }
+    }
+    balance + phi
+}
+
+/// How far in front of the edge (horizontally) the front face of a piece of height
+/// `height` tilted `tilt` from upright reaches at torso heights (up to the top of the
+/// torso capsule's straight part).
+pub fn face_reach(height: f64, tilt: f64) -> f64 {
+    (height * tilt.sin()).min(TORSO_STRAIGHT_TOP * tilt.tan())
+}
+
 impl Family for FurnitureTip {
     fn name(&self) -> &'static str {
         "furniture_tip"
@@ -45,11 +114,17 @@ impl Family for FurnitureTip {
         let object = input.object;
         let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
         let dir = heading(heading_angle);
-        let past_balance = uniform(rng, 0.03, 0.08);
+        let past_balance = uniform(rng, 0.006, 0.02);
         let origin = event_origin(rng, input.room, dir, 0.9 + far_shift(input));
 
         let (edge, balance) = front_edge(object);
         let tilt = balance + past_balance;
+        let height = top_offset(object) + bottom_offset(object);
+        // The observer stands just beyond what the fastest band's piece reaches by
+        // LATEST_REACH_S: only the rest of the fall reaches them.
+        let fastest = input.band_speeds.iter().fold(0.0, |a: f64, &b| a.max(b));
+        let tilt_late = tilt_after(object, past_balance, fastest / height, LATEST_REACH_S);
+        let clear = face_reach(height, tilt_late) + TORSO_RADIUS;
         // Local +y faces the fall; tilting about local x by −tilt brings the top forward.
         let rotation = quat::mul(
             yaw_quat(heading_angle - std::f64::consts::FRAC_PI_2),
@@ -58,7 +133,6 @@ impl Family for FurnitureTip {
         let pivot = [origin[0], origin[1], 0.0005];
         let e = quat::rotate(rotation, edge);
         let position = [pivot[0] - e[0], pivot[1] - e[1], pivot[2] - e[2]];
-        let height = top_offset(object) + bottom_offset(object);
         // Spin about the edge axis (ẑ × dir) so that the top moves forward at `speed`.
         let axis = left_of(dir);
         let omega = [axis[0], axis[1], 0.0].map(|c| c * input.speed / height);
@@ -74,9 +148,11 @@ impl Family for FurnitureTip {
             rng,
             [pivot[0], pivot[1]],
             dir,
-            (0.6, 1.3),
-            (2.5, 2.9),
-            0.35,
+            (clear + 0.05, clear + 0.3),
+            (height / 2.0 + 2.0, height / 2.0 + 2.4),
+            // Sideways offset within half the piece's width, so a thin one (a coat
+            // stand's pole) still falls onto the observer rather than past them.
+            (0.5 * object.half_extents()[0]).min(0.35),
             input.far_observer,
             [com_world[0], com_world[1]],
         );
@@ -90,6 +166,7 @@ impl Family for FurnitureTip {
                 ("balance_angle_rad".into(), balance),
                 ("initial_tilt_rad".into(), tilt),
                 ("height_m".into(), height),
+                ("observer_clear_m".into(), clear),
             ]),
         }
     }

@@ -23,10 +23,18 @@
 //!   ≥ 1.3 × the potential barrier): the ladder tips over backwards into the room.
 //!
 //! Gravity sets the pace (`speed_sweep = false`).
+//!
+//! Timing (label rule v2): the observer stands beyond the foot (never on it, which would
+//! strike them at t0), so the falling ladder reaches them late in its fall, after
+//! Δ + 0.2 s (measured medians 1.1–1.8 s).
 
 use super::*;
 
 pub struct LadderSlip;
+
+/// How far beyond the ladder's foot the observer's standing point starts: the torso
+/// radius and a margin (m).
+const TORSO_CLEARANCE: f64 = 0.3;
 
 /// Floor friction a ladder leaning at `alpha` (from vertical) needs to stand (see above).
 pub fn required_floor_friction(alpha: f64, length: f64, thickness: f64, mu_wall: f64) -> f64 {
@@ -158,7 +166,11 @@ impl Family for LadderSlip {
             mat_friction,
             0.1,
         );
-        let middle = ahead(site.base, n, length / 2.0);
+        // The observer stands beyond the ladder's foot (its torso clear of the foot's
+        // corners): a steep slide-regime lean puts the foot well past the ladder's middle,
+        // and an observer standing on it would be struck at t0.
+        let clear = (length / 2.0).max(length * alpha.sin() + thickness + TORSO_CLEARANCE);
+        let middle = ahead(site.base, n, clear);
         let observer = observer_beyond(
             rng,
             middle,

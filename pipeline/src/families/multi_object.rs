@@ -4,6 +4,12 @@
 //! the last one (the hazard) near the edge — all placed exactly on the table, at rest.
 //! The first is shoved toward the others at the band's speed; each collision passes the
 //! momentum on, and the last object is pushed toward (and usually off) the edge.
+//!
+//! Timing (label rule v2): the first object starts 0.3–0.5 m back from the rest of the
+//! row on a long, polished table (a run-up), the last one rests with its centre of mass
+//! just behind the edge, and the observer stands 1.5–1.9 m beyond the edge, clear of the
+//! table and of the fall: the hazard reaches them only on the floor, after the run-up,
+//! the collisions down the row and the fall.
 
 use super::*;
 
@@ -27,12 +33,14 @@ impl Family for MultiObject {
         let side = left_of(dir);
         let height = uniform(rng, input.room.table_height[0], input.room.table_height[1]);
         let half_width = uniform(rng, 0.35, 0.6);
-        let friction = uniform(rng, 0.1, 0.25);
+        let friction = uniform(rng, 0.03, 0.1);
         let count = if uniform(rng, 0.0, 1.0) < 0.5 { 3 } else { 4 };
-        let gaps = [0, 1, 2].map(|_| uniform(rng, 0.005, 0.03));
-        let behind = uniform(rng, 0.2, 0.5);
+        let mut gaps = [0, 1, 2].map(|_| uniform(rng, 0.005, 0.03));
+        // The run-up: the shoved object starts well back from the rest of the row.
+        gaps[0] += uniform(rng, 0.3, 0.5);
+        let behind = uniform(rng, 0.15, 0.4);
         let lateral = uniform(rng, -0.12, 0.12);
-        let origin = event_origin(rng, input.room, dir, 0.7 + far_shift(input));
+        let origin = event_origin(rng, input.room, dir, 0.5 + far_shift(input));
 
         let (pose, bottom, _) = resting_pose(object);
         let rotation = quat::mul(yaw_quat(heading_angle), pose);
@@ -72,13 +80,12 @@ impl Family for MultiObject {
                 ));
             }
         }
-        let landing = ahead(edge, dir, 0.25);
         let observer = observer_beyond(
             rng,
-            landing,
+            edge,
             dir,
-            (0.35, 0.9),
-            (2.3, 2.8),
+            (1.5, 1.9),
+            (2.8, 3.2),
             0.35,
             input.far_observer,
             last,

@@ -3,8 +3,14 @@
 //! The object hangs from a ceiling anchor on a real spherical joint: a rigid, massless
 //! suspension rod from the anchor to the top of the object (a physical pendulum). It
 //! starts hanging straight down and moving: the band's value is the speed of its centre
-//! of mass through the lowest point, toward the observer (amplitude follows from it:
-//! `v² = 2 g d (1 − cos θ)`), with the matching spin about the anchor.
+//! of mass through the lowest point (amplitude follows from it: `v² = 2 g d (1 − cos θ)`),
+//! with the matching spin about the anchor.
+//!
+//! Timing (label rule v2): it starts swinging *away* from the observer, who stands just
+//! beyond its reach on the other side, so it comes back through the lowest point (with
+//! the band's speed again, toward the observer) only after half a period — over a second
+//! for any arm of 1 m or more — and the decision moment Δ falls near the far end of the
+//! first swing, before the return that decides the outcome.
 
 use super::*;
 
@@ -28,7 +34,8 @@ impl Family for PendulumSwing {
         let dir = heading(heading_angle);
         let com_height = uniform(rng, 1.0, 1.45);
         let yaw = uniform(rng, 0.0, std::f64::consts::TAU);
-        let origin = event_origin(rng, room, dir, 0.5 + far_shift(input));
+        // Centred between the far end of the first swing (behind) and the observer.
+        let origin = event_origin(rng, room, dir, 0.1 + far_shift(input));
 
         let com = com_offset(object);
         let top = top_offset(object);
@@ -39,9 +46,10 @@ impl Family for PendulumSwing {
         let anchor = [origin[0], origin[1], ceiling];
         let com_world = [origin[0], origin[1], z + com[2]];
         let arm = ceiling - com_world[2];
-        // Swing about the horizontal axis ŝ = ẑ × dir: ω = −(v/d) ŝ moves the mass along dir.
+        // Swing about the horizontal axis ŝ = ẑ × dir: ω = +(v/d) ŝ moves the mass along
+        // −dir, away from the observer.
         let s = left_of(dir);
-        let omega = [-s[0], -s[1], 0.0].map(|c| c * input.speed / arm);
+        let omega = [s[0], s[1], 0.0].map(|c| c * input.speed / arm);
         let linvel = velocity_about(omega, anchor, com_world);
         let hazard = hazard_body(
             object,
@@ -50,11 +58,16 @@ impl Family for PendulumSwing {
             linvel,
             omega,
         );
+        // The observer stands clear of the hanging object's side (its horizontal radius
+        // plus the torso's, plus a gap), so nothing touches them before it swings back.
+        let he = object.half_extents();
+        let radius = he[0].hypot(he[1]);
+        let near = radius + 0.18;
         let observer = observer_beyond(
             rng,
             origin,
             dir,
-            (0.45, 0.95),
+            (near + 0.1, near + 0.6),
             (2.5, 2.9),
             0.25,
             input.far_observer,
