@@ -458,7 +458,7 @@ mod tests {
         assert!(p[0].abs() < 0.01 && (p[1] - 0.4).abs() < 1e-6);
         assert!((l.closest_approach - 0.4).abs() < 1e-3);
         assert!((l.time_to_impact.unwrap() - 2.0).abs() <= s.physics.dt);
-        // Never within 1.5 m: no impact point at all.
+        // Never within reach: no impact point at all.
         let sim = synthetic(&s, 720, |t| [2.0 - 1.0 * t, 2.0, 0.04]);
         let l = label(&s, &sim, None);
         assert_eq!(l.impact_point, None);
