@@ -2,13 +2,20 @@
 //! (SPEC §4).
 //!
 //! Launched from hand height, pitched down by a drawn angle, at the band's speed, along the
-//! line to the observer. The observer stands beyond the fastest band's first bounce, so in
-//! every band the object reaches them bouncing (then rolling). In far-observer groups the
+//! line to the observer. Timing (label rule v2): the launch point and the observer lie
+//! along the room's diagonal, as far apart as the fastest band needs to cover in
+//! `FASTEST_ARRIVAL_S` at its launch's horizontal speed (bounces only slow it), so every
+//! band reaches the observer bouncing (then rolling) after Δ + 0.2 s; slow bands arrive
+//! seconds later or, if the run ends first, not at all. In far-observer groups the
 //! observer stands well off to the side of that line instead.
 
 use super::*;
 
 pub struct BouncingObject;
+
+/// The fastest band's horizontal launch speed covers the distance to the observer in
+/// this time (s).
+pub const FASTEST_ARRIVAL_S: f64 = 0.95;
 
 /// Horizontal distance to the first floor contact of a centre launched at height `h`
 /// (above its resting height) with speed `v`, pitched `pitch` below horizontal.
@@ -31,7 +38,7 @@ impl Family for BouncingObject {
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
         let object = input.object;
-        let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
+        let heading_angle = diagonal_heading(rng, input.room, 0.15);
         let dir = heading(heading_angle);
         let side = left_of(dir);
         let launch_height = uniform(rng, 0.9, 1.4);
@@ -46,8 +53,10 @@ impl Family for BouncingObject {
             };
         let fastest = input.band_speeds.iter().copied().fold(0.0, f64::max);
         let r = bottom_offset(object);
-        let distance = first_bounce_distance(fastest, pitch, launch_height - r) + beyond;
-        let origin = event_origin(rng, input.room, dir, distance / 2.0);
+        let distance = (first_bounce_distance(fastest, pitch, launch_height - r) + beyond)
+            .max(fastest * pitch.cos() * FASTEST_ARRIVAL_S)
+            .min(room_span(input.room, dir, 0.35));
+        let origin = span_start(rng, input.room, dir, distance, 0.35);
 
         let start = [origin[0], origin[1], launch_height];
         let v = input.speed;

@@ -67,7 +67,7 @@ impl Family for SlidingObject {
             rng,
             [bottom[0], bottom[1]],
             dir,
-            (0.5, 1.3),
+            (0.9, 1.6),
             (2.4, 3.0),
             0.3,
             input.far_observer,
