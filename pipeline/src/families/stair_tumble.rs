@@ -17,7 +17,7 @@ pub struct StairTumble;
 /// The slowest band still moves this fast as it goes over the top edge (m/s).
 const LEAVE_SPEED: f64 = 0.8;
 /// Least floor distance between the bottom step and the observer (m).
-pub const OBSERVER_GAP_M: f64 = 1.9;
+pub const OBSERVER_GAP_M: f64 = 2.1;
 
 impl Family for StairTumble {
     fn name(&self) -> &'static str {
