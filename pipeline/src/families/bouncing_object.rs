@@ -66,12 +66,23 @@ impl Family for BouncingObject {
             -v * pitch.sin(),
         ];
         let hazard = hazard_body(object, start, yaw_quat(heading_angle), linvel, [0.0; 3]);
+        // A far observer steps off the line toward the room's centre (the line ends near a
+        // corner), so they stay inside the room.
+        let end = ahead(origin, dir, distance);
+        let inward = if side[0] * end[0] + side[1] * end[1] <= 0.0 {
+            1.0
+        } else {
+            -1.0
+        };
         let lateral = if input.far_observer {
-            far_lateral
+            far_lateral.abs() * inward
         } else {
             near_lateral
         };
         let obs = ahead(ahead(origin, dir, distance), side, lateral);
+        // (Kept inside the room, clear of the walls.)
+        let limit = [0, 1].map(|k| (input.room.size[k] / 2.0 - 0.4).max(0.0));
+        let obs = [0, 1].map(|k| obs[k].clamp(-limit[k], limit[k]));
         Layout {
             bodies: vec![hazard],
             joints: vec![],

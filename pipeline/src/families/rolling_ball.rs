@@ -40,9 +40,14 @@ impl Family for RollingBall {
         let fastest = input.band_speeds.iter().copied().fold(0.0, f64::max);
         let r = bottom_offset(input.object);
         let landing = fastest * (2.0 * height / GRAVITY).sqrt() + r;
-        let beyond = landing + if input.far_observer { gap_far } else { gap_near };
-        let length = (surface_half[0] * 2.0 + beyond).min(room_span(room, dir, 0.35));
-        let back = span_start(rng, room, dir, length, 0.35);
+        let beyond = landing
+            + if input.far_observer {
+                gap_far
+            } else {
+                gap_near
+            };
+        let length = (surface_half[0] * 2.0 + beyond).min(room_span(room, dir, 0.55));
+        let back = span_start(rng, room, dir, length, 0.55);
         let origin = ahead(back, dir, surface_half[0]);
         let launch = EdgeLaunch {
             surface_name: "table",

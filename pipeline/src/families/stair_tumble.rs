@@ -64,9 +64,13 @@ impl Family for StairTumble {
         let gap_near = uniform(rng, OBSERVER_GAP_M, OBSERVER_GAP_M + 0.4);
         let gap_far = uniform(rng, OBSERVER_GAP_M + 1.4, OBSERVER_GAP_M + 1.8);
         let side = uniform(rng, -0.3, 0.3);
-        let gap = if input.far_observer { gap_far } else { gap_near };
-        let length = (0.7 + flight + gap).min(room_span(room, dir, 0.35));
-        let origin = ahead(span_start(rng, room, dir, length, 0.35), dir, 0.35);
+        let gap = if input.far_observer {
+            gap_far
+        } else {
+            gap_near
+        };
+        let length = (0.7 + flight + gap).min(room_span(room, dir, 0.55));
+        let origin = ahead(span_start(rng, room, dir, length, 0.55), dir, 0.35);
 
         let top_height = steps as f64 * rise;
         let landing = EdgeLaunch {

@@ -60,9 +60,14 @@ impl Family for SurfaceCascade {
         // lands this far beyond it.
         let landing = fastest * (2.0 * seat_height / GRAVITY).sqrt() + half_len;
         let table_half = [0.35, 0.45];
-        let beyond = landing + if input.far_observer { gap_far } else { gap_near };
-        let length = (2.0 * table_half[0] + seat_depth + beyond).min(room_span(room, dir, 0.35));
-        let origin = ahead(span_start(rng, room, dir, length, 0.35), dir, table_half[0]);
+        let beyond = landing
+            + if input.far_observer {
+                gap_far
+            } else {
+                gap_near
+            };
+        let length = (2.0 * table_half[0] + seat_depth + beyond).min(room_span(room, dir, 0.6));
+        let origin = ahead(span_start(rng, room, dir, length, 0.6), dir, table_half[0]);
         let launch = EdgeLaunch {
             surface_name: "table",
             surface_height: height,

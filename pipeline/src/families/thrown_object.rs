@@ -27,7 +27,9 @@ pub fn indoor_elevation(speed: f64, dx: f64, dy: f64, rise: f64) -> f64 {
     let fits = |e: f64| (speed * e.sin()).max(0.0).powi(2) / (2.0 * GRAVITY) <= rise;
     let disc = v2 * v2 - GRAVITY * (GRAVITY * dx * dx + 2.0 * dy * v2);
     if disc < 0.0 || dx <= 0.0 {
-        let ceiling = ((2.0 * GRAVITY * rise.max(0.0)).sqrt() / speed).min(1.0).asin();
+        let ceiling = ((2.0 * GRAVITY * rise.max(0.0)).sqrt() / speed)
+            .min(1.0)
+            .asin();
         return ceiling.min(std::f64::consts::FRAC_PI_4);
     }
     let high = ((v2 + disc.sqrt()) / (GRAVITY * dx)).atan();
