@@ -2,13 +2,20 @@
 //! (SPEC §4).
 //!
 //! Launched from hand height, pitched down by a drawn angle, at the band's speed, along the
-//! line to the observer. The observer stands beyond the fastest band's first bounce, so in
-//! every band the object reaches them bouncing (then rolling). In far-observer groups the
+//! line to the observer. Timing (label rule v2): the launch point and the observer lie
+//! along the room's diagonal, as far apart as the fastest band needs to cover in
+//! `FASTEST_ARRIVAL_S` at its launch's horizontal speed (bounces only slow it), so every
+//! band reaches the observer bouncing (then rolling) after Δ + 0.2 s; slow bands arrive
+//! seconds later or, if the run ends first, not at all. In far-observer groups the
 //! observer stands well off to the side of that line instead.
 
 use super::*;
 
 pub struct BouncingObject;
+
+/// The fastest band's horizontal launch speed covers the distance to the observer in
+/// this time (s).
+pub const FASTEST_ARRIVAL_S: f64 = 0.95;
 
 /// Horizontal distance to the first floor contact of a centre launched at height `h`
 /// (above its resting height) with speed `v`, pitched `pitch` below horizontal.
@@ -31,7 +38,7 @@ impl Family for BouncingObject {
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
         let object = input.object;
-        let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
+        let heading_angle = diagonal_heading(rng, input.room, 0.15);
         let dir = heading(heading_angle);
         let side = left_of(dir);
         let launch_height = uniform(rng, 0.9, 1.4);
@@ -46,8 +53,10 @@ impl Family for BouncingObject {
             };
         let fastest = input.band_speeds.iter().copied().fold(0.0, f64::max);
         let r = bottom_offset(object);
-        let distance = first_bounce_distance(fastest, pitch, launch_height - r) + beyond;
-        let origin = event_origin(rng, input.room, dir, distance / 2.0);
+        let distance = (first_bounce_distance(fastest, pitch, launch_height - r) + beyond)
+            .max(fastest * pitch.cos() * FASTEST_ARRIVAL_S)
+            .min(room_span(input.room, dir, 0.35));
+        let origin = span_start(rng, input.room, dir, distance, 0.35);
 
         let start = [origin[0], origin[1], launch_height];
         let v = input.speed;
@@ -57,12 +66,23 @@ impl Family for BouncingObject {
             -v * pitch.sin(),
         ];
         let hazard = hazard_body(object, start, yaw_quat(heading_angle), linvel, [0.0; 3]);
+        // A far observer steps off the line toward the room's centre (the line ends near a
+        // corner), so they stay inside the room.
+        let end = ahead(origin, dir, distance);
+        let inward = if side[0] * end[0] + side[1] * end[1] <= 0.0 {
+            1.0
+        } else {
+            -1.0
+        };
         let lateral = if input.far_observer {
-            far_lateral
+            far_lateral.abs() * inward
         } else {
             near_lateral
         };
         let obs = ahead(ahead(origin, dir, distance), side, lateral);
+        // (Kept inside the room, clear of the walls.)
+        let limit = [0, 1].map(|k| (input.room.size[k] / 2.0 - 0.4).max(0.0));
+        let obs = [0, 1].map(|k| obs[k].clamp(-limit[k], limit[k]));
         Layout {
             bodies: vec![hazard],
             joints: vec![],

@@ -576,6 +576,50 @@ impl EdgeLaunch {
     }
 }
 
+/// A heading along one of the room's four diagonal directions (drawn uniformly), turned by
+/// up to `jitter` rad: the longest straight run the room offers, for hazards that travel
+/// toward the observer from afar. Always makes two draws.
+pub fn diagonal_heading(rng: &mut ChaCha8Rng, room: &Room, jitter: f64) -> f64 {
+    let which = uniform(rng, 0.0, 4.0).floor().min(3.0) as usize;
+    let turn = uniform(rng, -jitter, jitter);
+    let base = room.size[1].atan2(room.size[0]);
+    let pi = std::f64::consts::PI;
+    [base, pi - base, pi + base, -base][which] + turn
+}
+
+/// Length of the longest segment along `dir` through the room's centre that keeps
+/// `margin` from every wall (the room is centred on the origin).
+pub fn room_span(room: &Room, dir: [f64; 2], margin: f64) -> f64 {
+    let half = [
+        (room.size[0] / 2.0 - margin).max(0.0),
+        (room.size[1] / 2.0 - margin).max(0.0),
+    ];
+    (0..2)
+        .map(|k| {
+            if dir[k].abs() < 1e-9 {
+                f64::INFINITY
+            } else {
+                2.0 * half[k] / dir[k].abs()
+            }
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Start of a segment of `length` along `dir` centred in the room, slid along `dir` by a
+/// drawn share of whatever room is left over (`room_span` with `margin`). Always makes
+/// one draw.
+pub fn span_start(
+    rng: &mut ChaCha8Rng,
+    room: &Room,
+    dir: [f64; 2],
+    length: f64,
+    margin: f64,
+) -> [f64; 2] {
+    let slack = (room_span(room, dir, margin) - length).max(0.0);
+    let s = uniform(rng, -0.5, 0.5) * slack - length / 2.0;
+    [dir[0] * s, dir[1] * s]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

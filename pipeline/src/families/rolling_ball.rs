@@ -1,8 +1,16 @@
 //! rolling_ball: a ball rolls off a table and on across the floor (SPEC §4).
+//!
+//! Timing (label rule v2): the observer stands along the room's diagonal, beyond where
+//! the fastest band's ball lands by `OBSERVER_GAP_M` or more, so no band's fall passes
+//! through their reach envelope and every ball meets them only after rolling that gap on
+//! the floor, after Δ + 0.2 s.
 
 use super::*;
 
 pub struct RollingBall;
+
+/// Least floor distance between the fastest band's landing point and the observer (m).
+pub const OBSERVER_GAP_M: f64 = 1.3;
 
 impl Family for RollingBall {
     fn name(&self) -> &'static str {
@@ -16,15 +24,31 @@ impl Family for RollingBall {
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
-        let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
+        let room = input.room;
+        let heading_angle = diagonal_heading(rng, room, 0.2);
         let dir = heading(heading_angle);
-        let height = uniform(rng, input.room.table_height[0], input.room.table_height[1]);
+        let height = uniform(rng, room.table_height[0], room.table_height[1]);
         let surface_half = [uniform(rng, 0.35, 0.5), uniform(rng, 0.35, 0.7)];
         let surface_friction = uniform(rng, 0.4, 0.7);
         let lateral = uniform(rng, -0.2, 0.2);
         // A rolling ball keeps its speed, so it may start well behind the edge.
         let com_to_edge = uniform(rng, 0.08, 0.3);
-        let origin = event_origin(rng, input.room, dir, 1.0);
+        let gap_near = uniform(rng, OBSERVER_GAP_M, OBSERVER_GAP_M + 0.6);
+        let gap_far = uniform(rng, OBSERVER_GAP_M + 1.5, OBSERVER_GAP_M + 2.0);
+        let side = uniform(rng, -0.3, 0.3);
+        // Where the fastest band's ball lands, beyond the table edge.
+        let fastest = input.band_speeds.iter().copied().fold(0.0, f64::max);
+        let r = bottom_offset(input.object);
+        let landing = fastest * (2.0 * height / GRAVITY).sqrt() + r;
+        let beyond = landing
+            + if input.far_observer {
+                gap_far
+            } else {
+                gap_near
+            };
+        let length = (surface_half[0] * 2.0 + beyond).min(room_span(room, dir, 0.55));
+        let back = span_start(rng, room, dir, length, 0.55);
+        let origin = ahead(back, dir, surface_half[0]);
         let launch = EdgeLaunch {
             surface_name: "table",
             surface_height: height,
@@ -39,16 +63,13 @@ impl Family for RollingBall {
             rolling: true,
         };
         let (bodies, edge, start) = launch.build(input.object, input.speed);
-        let observer = observer_beyond(
-            rng,
-            edge,
-            dir,
-            (0.9, 2.0),
-            (3.0, 3.6),
-            0.3,
-            input.far_observer,
-            [start[0], start[1]],
-        );
+        let d = length - surface_half[0] * 2.0;
+        let obs = ahead(ahead(edge, dir, d), left_of(dir), side);
+        let observer = ObserverPose {
+            x: obs[0],
+            y: obs[1],
+            yaw: (start[1] - obs[1]).atan2(start[0] - obs[0]),
+        };
         Layout {
             bodies,
             joints: vec![],

@@ -1,4 +1,8 @@
 //! sliding_object: an object slides down a ramp steeper than its friction cone (SPEC §4).
+//!
+//! Timing (label rule v2): the observer stands 0.9–1.6 m beyond the ramp's lower end, so
+//! the lower ramp lies outside their reach envelope and the object, accelerating from the
+//! band's initial speed down a 1.2–2 m slope, meets them after Δ + 0.2 s.
 
 use super::*;
 
@@ -67,7 +71,7 @@ impl Family for SlidingObject {
             rng,
             [bottom[0], bottom[1]],
             dir,
-            (0.5, 1.3),
+            (0.9, 1.6),
             (2.4, 3.0),
             0.3,
             input.far_observer,

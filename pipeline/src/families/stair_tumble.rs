@@ -4,6 +4,11 @@
 //! run drawn), descending toward the observer who stands beyond the bottom step. The
 //! object is pushed (a ball: rolled) toward the top edge at the band's speed, from where
 //! even the slowest band goes over the edge still sliding at 0.8 m/s.
+//!
+//! Timing (label rule v2): the stairs descend along the room's diagonal and the observer
+//! stands `OBSERVER_GAP_M` or more beyond the bottom step, outside the reach of anything
+//! still on the stairs: what reaches them rolls or slides that gap across the floor after
+//! Δ + 0.2 s, and what the floor's friction stops first never does.
 
 use super::*;
 
@@ -11,6 +16,8 @@ pub struct StairTumble;
 
 /// The slowest band still moves this fast as it goes over the top edge (m/s).
 const LEAVE_SPEED: f64 = 0.8;
+/// Least floor distance between the bottom step and the observer (m).
+pub const OBSERVER_GAP_M: f64 = 2.1;
 
 impl Family for StairTumble {
     fn name(&self) -> &'static str {
@@ -25,7 +32,8 @@ impl Family for StairTumble {
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
         let object = input.object;
-        let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
+        let room = input.room;
+        let heading_angle = diagonal_heading(rng, room, 0.2);
         let dir = heading(heading_angle);
         let steps = uniform(rng, 3.0, 6.0).floor().min(5.0) as usize;
         let rise = uniform(rng, 0.16, 0.2);
@@ -53,7 +61,16 @@ impl Family for StairTumble {
             (run_up - overshoot * half_len).clamp(-0.4 * half_len, 0.25)
         };
         let flight = (steps - 1) as f64 * run;
-        let origin = event_origin(rng, input.room, dir, flight / 2.0 + 0.8 + far_shift(input));
+        let gap_near = uniform(rng, OBSERVER_GAP_M, OBSERVER_GAP_M + 0.4);
+        let gap_far = uniform(rng, OBSERVER_GAP_M + 1.4, OBSERVER_GAP_M + 1.8);
+        let side = uniform(rng, -0.3, 0.3);
+        let gap = if input.far_observer {
+            gap_far
+        } else {
+            gap_near
+        };
+        let length = (0.7 + flight + gap).min(room_span(room, dir, 0.55));
+        let origin = ahead(span_start(rng, room, dir, length, 0.55), dir, 0.35);
 
         let top_height = steps as f64 * rise;
         let landing = EdgeLaunch {
@@ -87,16 +104,12 @@ impl Family for StairTumble {
         }
         let hazard = bodies.len() - 1;
         let foot = ahead(edge, dir, flight);
-        let observer = observer_beyond(
-            rng,
-            foot,
-            dir,
-            (0.2, 0.7),
-            (2.6, 3.0),
-            0.3,
-            input.far_observer,
-            [start[0], start[1]],
-        );
+        let obs = ahead(ahead(foot, dir, length - 0.7 - flight), left_of(dir), side);
+        let observer = ObserverPose {
+            x: obs[0],
+            y: obs[1],
+            yaw: (start[1] - obs[1]).atan2(start[0] - obs[0]),
+        };
         Layout {
             bodies,
             joints: vec![],

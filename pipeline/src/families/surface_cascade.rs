@@ -8,10 +8,20 @@
 //! after the landing's friction impulse, still slides across it. The object starts with
 //! its centre of mass 30–60% of its half-length behind the table edge (resting there,
 //! were it not moving), so it leaves the table at nearly the band's speed.
+//!
+//! Timing (label rule v2): the observer stands along the room's diagonal, at least
+//! `OBSERVER_GAP_M` beyond where the fastest band's object would land off the stool, so
+//! no band's drop passes through their reach envelope; what reaches them slides or rolls
+//! that gap across the floor after Δ + 0.2 s, and what the floor's friction stops first
+//! never reaches them at all.
 
 use super::*;
 
 pub struct SurfaceCascade;
+
+/// Least floor distance between the fastest band's landing off the stool and the
+/// observer (m).
+pub const OBSERVER_GAP_M: f64 = 1.3;
 
 impl Family for SurfaceCascade {
     fn name(&self) -> &'static str {
@@ -26,7 +36,8 @@ impl Family for SurfaceCascade {
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
         let object = input.object;
-        let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
+        let room = input.room;
+        let heading_angle = diagonal_heading(rng, room, 0.2);
         let dir = heading(heading_angle);
         let height = uniform(rng, input.room.table_height[0], input.room.table_height[1]);
         let step = uniform(rng, 0.08, 0.14);
@@ -34,7 +45,9 @@ impl Family for SurfaceCascade {
         let com_back = uniform(rng, 0.3, 0.6);
         let lateral = uniform(rng, -0.1, 0.1);
         let stool_half_width = uniform(rng, 0.17, 0.22);
-        let origin = event_origin(rng, input.room, dir, 0.7 + far_shift(input));
+        let gap_near = uniform(rng, OBSERVER_GAP_M, OBSERVER_GAP_M + 0.5);
+        let gap_far = uniform(rng, OBSERVER_GAP_M + 1.5, OBSERVER_GAP_M + 2.0);
+        let side = uniform(rng, -0.35, 0.35);
         let rolling = is_single_sphere(object);
 
         let half_len = footprint_half_length(object, 0.0);
@@ -43,10 +56,22 @@ impl Family for SurfaceCascade {
         // The fastest band's object still lands with its rear part on the seat.
         let seat_depth = (flight - 0.6 * half_len + 0.06).max(0.25);
         let seat_height = height - step;
+        // The fastest band's object, leaving the seat's far edge at the band's speed,
+        // lands this far beyond it.
+        let landing = fastest * (2.0 * seat_height / GRAVITY).sqrt() + half_len;
+        let table_half = [0.35, 0.45];
+        let beyond = landing
+            + if input.far_observer {
+                gap_far
+            } else {
+                gap_near
+            };
+        let length = (2.0 * table_half[0] + seat_depth + beyond).min(room_span(room, dir, 0.6));
+        let origin = ahead(span_start(rng, room, dir, length, 0.6), dir, table_half[0]);
         let launch = EdgeLaunch {
             surface_name: "table",
             surface_height: height,
-            surface_half: [0.35, 0.45],
+            surface_half: table_half,
             surface_friction,
             heading_angle,
             com_to_edge: half_len * com_back,
@@ -74,16 +99,13 @@ impl Family for SurfaceCascade {
             ),
         );
         let far_edge = ahead(edge, dir, seat_depth);
-        let observer = observer_beyond(
-            rng,
-            far_edge,
-            dir,
-            (0.35, 0.9),
-            (2.3, 2.8),
-            0.35,
-            input.far_observer,
-            [start[0], start[1]],
-        );
+        let d = length - 2.0 * table_half[0] - seat_depth;
+        let obs = ahead(ahead(far_edge, dir, d), left_of(dir), side);
+        let observer = ObserverPose {
+            x: obs[0],
+            y: obs[1],
+            yaw: (start[1] - obs[1]).atan2(start[0] - obs[0]),
+        };
         Layout {
             bodies,
             joints: vec![],
