@@ -77,29 +77,69 @@ fn every_family_is_valid_and_replays_bit_for_bit_in_all_bands() {
     }
 }
 
+/// Distance the hazard's centre of mass has moved from its start by step `k`.
+fn travelled(sim: &Simulation, k: u32) -> f64 {
+    let (a, b) = (sim.hazard_com(0), sim.hazard_com(k));
+    ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt()
+}
+
+/// A hazard that creeps down a tilted board (`families::TiltedLaunch`) travels
+/// `v0 t + a t²/2` in its first `t` seconds, `a` the creep acceleration its tilt was
+/// chosen for (`families::creep_tilt`: sliding against the combined friction, or a ball
+/// rolling).
+fn assert_creeps_at_the_designed_acceleration(r: &SceneResult, t: f64) {
+    let sim = plain(&r.spec);
+    let accel = r.spec.family_params["creep_accel_mps2"];
+    let v0 = r.spec.speed_value;
+    let k = (t / sim.dt).round() as u32;
+    let expected = v0 * t + accel * t * t / 2.0;
+    let measured = travelled(&sim, k);
+    assert!(
+        (measured - expected).abs() <= 0.25 * expected + 0.004,
+        "{} {} {}: crept {measured:.4} m in {t} s, expected {expected:.4} m",
+        r.spec.family,
+        r.spec.selection.object_id,
+        r.spec.speed_band.name(),
+    );
+}
+
 #[test]
-fn hanging_fall_falls_freely_once_detached() {
+fn hanging_fall_creeps_down_the_ledge_then_falls_freely() {
     for r in scenes("hanging_fall", 3) {
+        assert_creeps_at_the_designed_acceleration(&r, 0.25);
         let sim = plain(&r.spec);
-        // Until it meets the floor (its first contact with anything but the wall it slides
-        // down) nothing but gravity acts on it: neither the wall nor the mount it left.
-        let first = (1..=sim.steps())
-            .find(|&k| sim.hazard_contacts[k as usize] & !rh_pipeline::simulate::TOUCH_SOURCE != 0)
-            .unwrap();
+        // Once it has left the ledge, nothing but gravity acts on it until it meets the
+        // floor: the wall it may brush on its way down holds nothing up.
+        use rh_pipeline::simulate::{TOUCH_FLOOR, TOUCH_SOURCE};
+        let contacts = &sim.hazard_contacts;
+        let left = (1..=sim.steps())
+            .rev()
+            .find(|&k| contacts[k as usize] & TOUCH_SOURCE != 0)
+            .expect("it stood on the ledge")
+            + 1;
+        let next = (left..=sim.steps())
+            .find(|&k| contacts[k as usize] & TOUCH_FLOOR != 0)
+            .unwrap_or(sim.steps());
         assert!(
-            first > 60,
-            "the fixture falls clear for a while ({first} steps)"
+            next > left + 20,
+            "{}: falls clear for a while ({} steps)",
+            r.spec.selection.object_id,
+            next - left
         );
-        let (z0, vz0, dt) = (sim.hazard_position(0)[2], sim.hazard_velocity(0)[2], sim.dt);
+        let (z0, vz0, dt) = (
+            sim.hazard_com(left)[2],
+            sim.hazard_velocity(left)[2],
+            sim.dt,
+        );
         // rapier integrates each step in `solver_iterations` semi-implicit Euler substeps:
         // free fall gives z_k = z0 + v0 k dt − g dt² k (k + 1/n) / 2.
         let n = r.spec.physics.solver_iterations as f64;
         // (Within a step's travel of the floor, the solver's speculative floor contact
         // already acts: stop 3 cm above it.)
-        for k in (1..first).take_while(|&k| sim.hazard_lowest_z[k as usize] > 0.03) {
-            let kf = k as f64;
+        for k in (left + 1..next).take_while(|&k| sim.hazard_lowest_z[k as usize] > 0.03) {
+            let kf = (k - left) as f64;
             let expected = z0 + vz0 * kf * dt - GRAVITY * dt * dt * kf * (kf + 1.0 / n) / 2.0;
-            let z = sim.hazard_position(k)[2];
+            let z = sim.hazard_com(k)[2];
             assert!(
                 (z - expected).abs() < 5e-4,
                 "{} {} step {k}: z {z} vs free fall {expected}",
@@ -111,6 +151,15 @@ fn hanging_fall_falls_freely_once_detached() {
             sim.time_to_floor_step(0.01).is_some(),
             "it reached the floor"
         );
+    }
+}
+
+#[test]
+fn drops_creep_down_their_tilted_boards_at_the_designed_acceleration() {
+    for family in ["object_drop", "shelf_slide", "ceiling_drop"] {
+        for r in scenes(family, 2) {
+            assert_creeps_at_the_designed_acceleration(&r, 0.25);
+        }
     }
 }
 

@@ -1,34 +1,15 @@
-//! object_drop: an object on a table is nudged past the edge and tips off (SPEC §4).
+//! object_drop: an object on a table creeps off the edge and falls (SPEC §4).
+//!
+//! Timing (label rule v2): the object rests on a smooth board propped on the table (a tray,
+//! a drawing board) that slopes gently toward the table's front edge, just steeper than
+//! the friction angle (a rolling ball: a few degrees). Nudged down the slope at the band's
+//! speed it creeps 0.24–0.32 m, accelerating at 0.35–0.6 m/s², before it tips over the
+//! edge: even the fastest nudge takes about 0.55 s to get there, so the fall reaches the
+//! observer standing beyond the edge after Δ + 0.2 s = 0.8 s.
 
 use super::*;
 
 pub struct ObjectDrop;
-
-/// Where the centre of mass starts relative to a surface edge (positive: behind it).
-///
-/// Sized so that even the slowest band would slide on until its centre is `overshoot`
-/// half-lengths past the edge (`stop − c`, with the sliding distance `v²/(2μg)`): an
-/// object that comes to rest just past an edge can stay balanced there in the solver,
-/// and one that overshoots by a good fraction of its length reliably tips off. The
-/// start overhang is capped at 40% of the half-length, so the object always begins
-/// mostly on the surface. The draw does not depend on the band's speed.
-pub(super) fn com_behind_edge(
-    rng: &mut ChaCha8Rng,
-    input: &FamilyInput,
-    surface_friction: f64,
-    overshoot: (f64, f64),
-) -> f64 {
-    let mu = combined_friction(input.object.friction, surface_friction);
-    let slowest = input
-        .band_speeds
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
-    let stop_distance = slowest * slowest / (2.0 * mu * GRAVITY);
-    let half_len = footprint_half_length(input.object, 0.0);
-    let c = stop_distance - uniform(rng, overshoot.0, overshoot.1) * half_len;
-    c.clamp(-0.4 * half_len, 0.25)
-}
 
 impl Family for ObjectDrop {
     fn name(&self) -> &'static str {
@@ -42,30 +23,44 @@ impl Family for ObjectDrop {
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
+        let object = input.object;
         let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
         let dir = heading(heading_angle);
         let height = uniform(rng, input.room.table_height[0], input.room.table_height[1]);
-        let surface_half = [uniform(rng, 0.3, 0.45), uniform(rng, 0.35, 0.7)];
-        let surface_friction = uniform(rng, 0.35, 0.6);
-        let lateral = uniform(rng, -0.15, 0.15);
+        let table_half = [uniform(rng, 0.3, 0.45), uniform(rng, 0.35, 0.7)];
+        let board_friction = uniform(rng, 0.1, 0.3);
+        let lateral = uniform(rng, -0.12, 0.12);
         let relative_yaw = uniform(rng, -0.25, 0.25);
-        let com_to_edge = com_behind_edge(rng, input, surface_friction, (0.8, 1.2));
+        let accel = uniform(rng, 0.35, 0.6);
+        let com_to_edge = uniform(rng, 0.24, 0.32);
         let origin = event_origin(rng, input.room, dir, 0.6);
-        let launch = EdgeLaunch {
-            surface_name: "table",
-            surface_height: height,
-            surface_half,
-            surface_friction,
+
+        let mu = combined_friction(object.friction, board_friction);
+        let tilt = creep_tilt(object, mu, accel);
+        let lying = lies_on_slope(object, tilt);
+        let (_, half_len) = slope_pose_extents(object, lying, relative_yaw);
+        let board_half_len = (com_to_edge + half_len + 0.05) / 2.0;
+        // The table's front edge, and the board's lower edge on it.
+        let edge_xy = ahead(origin, dir, table_half[0]);
+        let launch = TiltedLaunch {
+            surface_name: "board",
+            edge: [edge_xy[0], edge_xy[1], height],
             heading_angle,
+            tilt,
+            board_half: [board_half_len, table_half[1].min(0.35)],
+            thickness: 0.02,
+            friction: board_friction,
             com_to_edge,
             lateral,
             relative_yaw,
-            origin,
-            board_thickness: None,
-            rolling: false,
+            lying,
         };
-        let (bodies, edge, start) = launch.build(input.object, input.speed);
-        let landing = [edge[0] + dir[0] * 0.15, edge[1] + dir[1] * 0.15];
+        let (board, hazard) = launch.build(object, input.speed);
+        // The table block under the board (its top just below the board's lower edge).
+        let table_top = height - 0.025;
+        let table = table_block("table", origin, table_half, table_top, heading_angle, 0.5);
+        let start = hazard.position;
+        let landing = ahead(edge_xy, dir, 0.15);
         let observer = observer_beyond(
             rng,
             landing,
@@ -77,7 +72,7 @@ impl Family for ObjectDrop {
             [start[0], start[1]],
         );
         Layout {
-            bodies,
+            bodies: vec![board, hazard, table],
             joints: vec![],
             hazard: 1,
             source_support: Some(0),
@@ -86,7 +81,10 @@ impl Family for ObjectDrop {
                 ("table_height_m".into(), height),
                 ("com_behind_edge_m".into(), com_to_edge),
                 ("drop_height_m".into(), height),
-                ("table_friction".into(), surface_friction),
+                ("board_friction".into(), board_friction),
+                ("board_tilt_rad".into(), tilt),
+                ("creep_accel_mps2".into(), accel),
+                ("lying".into(), if lying { 1.0 } else { 0.0 }),
             ]),
         }
     }

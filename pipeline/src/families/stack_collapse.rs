@@ -1,12 +1,20 @@
 //! stack_collapse: a leaning stack of items on a table collapses (SPEC §4).
 //!
 //! N copies of the object are stacked near a table edge, each shifted toward the edge by
-//! the same step. The step is drawn above `2L/N` (L: the item's half-length along the
-//! lean), so the centre of mass of the items above the bottom one lies beyond the bottom
-//! item's front edge: the stack cannot stand, and its upper part falls off the table. The
-//! items are placed exactly on one another (no overlap). The band's value is a nudge: the
-//! items above the bottom one start moving toward the edge at up to that speed (top item).
+//! the same step `2(L + e)/N` (L: the item's half-length along the lean, e: a millimetre
+//! or few), so the centre of mass of the items above the bottom one lies e beyond the
+//! bottom item's front edge while every smaller sub-stack is still supported: the stack
+//! cannot stand, and its upper part topples over that edge and off the table. The items
+//! are placed exactly on one another (no overlap). The band's value is a nudge: the items
+//! above the bottom one start moving toward the edge at up to that speed (top item).
 //! Gravity sets the pace (`speed_sweep = false`). The hazard is the top item.
+//!
+//! Timing (label rule v2): e is only 1–3 mm past the tipping point and the nudges are a
+//! few centimetres per second, so the tall stack leans over slowly (an inverted
+//! pendulum starting near balance) before it buckles and its top item falls toward the
+//! observer, who stands 0.7–1.2 m beyond where it lands (its path leaves the reach
+//! envelope low and late), after Δ + 0.2 s = 0.8 s. Stacks of wide flat pans still
+//! buckle in about 0.7 s.
 
 use super::*;
 
@@ -35,7 +43,7 @@ impl Family for StackCollapse {
         let height = uniform(rng, input.room.table_height[0], input.room.table_height[1]);
         let surface_half = [uniform(rng, 0.3, 0.45), uniform(rng, 0.35, 0.6)];
         let surface_friction = uniform(rng, 0.35, 0.6);
-        let lean_factor = uniform(rng, 1.2, 1.6);
+        let overhang = uniform(rng, 0.001, 0.003);
         let base_back = uniform(rng, 0.0, 0.05);
         let lateral = uniform(rng, -0.15, 0.15);
         let origin = event_origin(rng, input.room, dir, 0.6 + far_shift(input));
@@ -43,7 +51,9 @@ impl Family for StackCollapse {
         let item_h = top_offset(object) + bottom_offset(object);
         let count = (0.45 / item_h).round().clamp(3.0, 7.0) as usize;
         let half_len = footprint_half_length(object, 0.0);
-        let step = (lean_factor * 2.0 * half_len / count as f64).min(0.95 * half_len);
+        // The upper items' mean offset from the bottom one is `step·N/2`: `overhang` past
+        // the bottom item's front edge.
+        let step = (2.0 * (half_len + overhang) / count as f64).min(0.95 * half_len);
 
         let table = fixed_box(
             "table",
@@ -91,7 +101,7 @@ impl Family for StackCollapse {
             rng,
             landing,
             dir,
-            (0.35, 0.9),
+            (0.7, 1.2),
             (2.3, 2.8),
             0.35,
             input.far_observer,
