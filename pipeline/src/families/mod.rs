@@ -618,6 +618,7 @@ pub fn span_start(
     let slack = (room_span(room, dir, margin) - length).max(0.0);
     let s = uniform(rng, -0.5, 0.5) * slack - length / 2.0;
     [dir[0] * s, dir[1] * s]
+}
 
 /// Tilt (rad) of a board on which `object` accelerates down the slope at `accel` (m/s²)
 /// from rest: an object resting on a ball (a single sphere, a kettlebell) rolls without
