@@ -455,7 +455,7 @@ fn label_rule(m: &Manifest, labels: &crate::config::LabelConfig) -> String {
         .and_then(|x| x.as_f64())
         .unwrap_or(1.10);
     format!(
-            "* **Decision moment** Δ = the end of the observation window ({window} s): the model \
+        "* **Decision moment** Δ = the end of the observation window ({window} s): the model \
 commits its plan then, so every label about reaching the observer looks at t ≥ Δ.
 * **Reach envelope**: every point within {arm} m (arm reach) of the *shoulder region* — the \
 horizontal discs around the observer's torso axis of radius {offset} m (half the shoulder \
@@ -487,43 +487,43 @@ door or wardrobe pressing into the body).
 danger is present.
 * **gt_action**: `NO_ACTION` when not reachable; else `DODGE` when dangerous, or the impact \
 speed is > {fast} m/s, or the impact kinetic energy is > {energy} J; else `CATCH`.",
-            window = m
-                .config
-                .pointer("/observation/window_s")
-                .and_then(|x| x.as_f64())
-                .unwrap_or(0.6),
-            arm = l.envelope_arm_reach,
-            offset = l.envelope_shoulder_offset,
-            step = l.envelope_step,
-            crouch = l.envelope_crouch,
-            shoulder = shoulder,
-            reach_out = l.envelope_shoulder_offset + l.envelope_step + l.envelope_arm_reach,
-            lo = shoulder - l.envelope_crouch - l.envelope_arm_reach,
-            hi = shoulder + l.envelope_arm_reach,
-            tol = l.interception_tolerance,
-            closest = l.closest_approach_max,
-            reach = l.reach_radius,
-            reaction = l.reaction_time_min,
-            eps = l.floor_contact_eps,
-            heavy = l.heavy_mass_kg,
-            momentum = l.heavy_momentum,
-            torso = m
-                .config
-                .pointer("/observer/torso_radius")
-                .and_then(|x| x.as_f64())
-                .unwrap_or(0.18),
-            height = m
-                .config
-                .pointer("/observer/height")
-                .and_then(|x| x.as_f64())
-                .unwrap_or(1.32),
-            strike = l.strike_speed_min,
-            impulse = l.strike_impulse_min,
-            heavy_push = l.strike_impulse_heavy,
-            window_strike = l.strike_window_s,
-            fast = l.catch_speed_max,
-            energy = l.catch_energy_max,
-        )
+        window = m
+            .config
+            .pointer("/observation/window_s")
+            .and_then(|x| x.as_f64())
+            .unwrap_or(0.6),
+        arm = l.envelope_arm_reach,
+        offset = l.envelope_shoulder_offset,
+        step = l.envelope_step,
+        crouch = l.envelope_crouch,
+        shoulder = shoulder,
+        reach_out = l.envelope_shoulder_offset + l.envelope_step + l.envelope_arm_reach,
+        lo = shoulder - l.envelope_crouch - l.envelope_arm_reach,
+        hi = shoulder + l.envelope_arm_reach,
+        tol = l.interception_tolerance,
+        closest = l.closest_approach_max,
+        reach = l.reach_radius,
+        reaction = l.reaction_time_min,
+        eps = l.floor_contact_eps,
+        heavy = l.heavy_mass_kg,
+        momentum = l.heavy_momentum,
+        torso = m
+            .config
+            .pointer("/observer/torso_radius")
+            .and_then(|x| x.as_f64())
+            .unwrap_or(0.18),
+        height = m
+            .config
+            .pointer("/observer/height")
+            .and_then(|x| x.as_f64())
+            .unwrap_or(1.32),
+        strike = l.strike_speed_min,
+        impulse = l.strike_impulse_min,
+        heavy_push = l.strike_impulse_heavy,
+        window_strike = l.strike_window_s,
+        fast = l.catch_speed_max,
+        energy = l.catch_energy_max,
+    )
 }
 
 #[cfg(test)]

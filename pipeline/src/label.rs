@@ -149,7 +149,23 @@ pub fn time_to_floor(spec: &SceneSpec, sim: &Simulation) -> Option<f64> {
     let h = sim.hazard_lowest_z[j as usize].max(0.0);
     let vz = sim.hazard_velocity(j)[2];
     let tau = (vz + (vz * vz + 2.0 * gravity * h).sqrt()) / gravity;
-    Some(j as f64 * sim.dt + tau.clamp(0.0, (k - j + 1) as f64 * sim.dt))
+    let span = (k - j + 1) as f64 * sim.dt;
+    if tau > 0.0 && tau < span {
+        return Some(j as f64 * sim.dt + tau);
+    }
+    // A spinning or grazing body whose lowest point does not follow its centre's fall:
+    // interpolate the lowest point's own crossing of the contact height in the step
+    // (the middle of the step when it was already that low before).
+    let (a, b) = (
+        sim.hazard_lowest_z[(k - 1) as usize],
+        sim.hazard_lowest_z[k as usize],
+    );
+    let f = if a > b {
+        ((a - eps) / (a - b)).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    Some((k - 1) as f64 * sim.dt + f * sim.dt)
 }
 
 /// Top corners of the hazard's parts' bounding box, in its body frame.

@@ -194,13 +194,21 @@ fn furniture_fall_follows_the_edge_pendulum() {
         let (tilt0, balance) = (p["initial_tilt_rad"], p["balance_angle_rad"]);
         let omega0 = r.spec.speed_value / p["height_m"];
         let target = balance + 0.6;
-        let tilt = |k: u32| families::up_z(sim.hazard_state(k).rotation).clamp(-1.0, 1.0).acos();
-        let k = (0..=sim.steps()).find(|&k| tilt(k) >= target).expect("it tips");
+        let tilt = |k: u32| {
+            families::up_z(sim.hazard_state(k).rotation)
+                .clamp(-1.0, 1.0)
+                .acos()
+        };
+        let k = (0..=sim.steps())
+            .find(|&k| tilt(k) >= target)
+            .expect("it tips");
         let measured = k as f64 * sim.dt;
         // The predicted time: the first millisecond `tilt_after` passes the target.
         let predicted = (1..4000)
             .map(|ms| ms as f64 * 1e-3)
-            .find(|&t| families::furniture_tip::tilt_after(object, tilt0 - balance, omega0, t) >= target)
+            .find(|&t| {
+                families::furniture_tip::tilt_after(object, tilt0 - balance, omega0, t) >= target
+            })
             .unwrap();
         assert!(
             (measured - predicted).abs() <= 0.05 * predicted,
@@ -382,7 +390,13 @@ fn thrown_object_fastest_band_arrives_after_its_designed_flight_time() {
     // In the simulation (a big room, so the room does not cut the distance short): the
     // fastest band's tennis ball (scene index 3: the very_fast band) crosses the aim
     // distance when its ballistic flight says, no earlier than FASTEST_FLIGHT_S.
-    let spec = custom_scene("thrown_object", "tennis_ball", "gym", [3.5, 4.8, 5.8, 6.7], 3);
+    let spec = custom_scene(
+        "thrown_object",
+        "tennis_ball",
+        "gym",
+        [3.5, 4.8, 5.8, 6.7],
+        3,
+    );
     let sim = plain(&spec);
     let v = sim.hazard_velocity(0);
     let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();

@@ -630,7 +630,9 @@ pub fn creep_tilt(object: &Object, mu: f64, accel: f64) -> f64 {
         (7.0 * accel / (5.0 * GRAVITY)).clamp(0.0, 1.0).asin()
     } else {
         let phi = mu.atan();
-        phi + (accel / (GRAVITY * (1.0 + mu * mu).sqrt())).clamp(0.0, 1.0).asin()
+        phi + (accel / (GRAVITY * (1.0 + mu * mu).sqrt()))
+            .clamp(0.0, 1.0)
+            .asin()
     }
 }
 
