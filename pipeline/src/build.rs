@@ -45,6 +45,9 @@ pub struct BuildOptions {
     pub out: PathBuf,
     pub seed: u64,
     pub families: Vec<String>,
+    /// Planned selections (from descriptions): group `g` takes `selections[g mod len]`
+    /// instead of the embedded round-robin planner.
+    pub selections: Option<Vec<crate::spec::Selection>>,
     pub jobs: usize,
     /// `(i, N)`: build only the groups `g` with `g mod N == i`.
     pub shard: (u64, u64),
@@ -351,7 +354,7 @@ pub fn build(
             );
         }
     }
-    let manifest = Manifest::new(
+    let mut manifest = Manifest::new(
         opts.seed,
         opts.n,
         &opts.families,
@@ -360,6 +363,7 @@ pub fn build(
         catalog,
         config,
     );
+    manifest.selections = opts.selections.clone();
     let out = &opts.out;
     std::fs::create_dir_all(out)
         .map_err(|e| BuildError::Input(format!("cannot write to --out {}: {e}", out.display())))?;
@@ -408,8 +412,11 @@ pub fn build(
     pool.install(|| {
         todo.par_iter()
             .try_for_each(|&g| -> Result<(), BuildError> {
-                let selection = plan_group(catalog, &opts.families, opts.seed, g)
-                    .map_err(|e| BuildError::Input(e.to_string()))?;
+                let selection = match &opts.selections {
+                    Some(s) => s[(g % s.len() as u64) as usize].clone(),
+                    None => plan_group(catalog, &opts.families, opts.seed, g)
+                        .map_err(|e| BuildError::Input(e.to_string()))?,
+                };
                 let count = manifest.group_size(g);
                 let mut results =
                     produce_group(&selection, opts.seed, g * 4, count, catalog, config)

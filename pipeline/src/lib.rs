@@ -15,6 +15,7 @@ pub mod config;
 pub mod dataset;
 pub mod families;
 pub mod label;
+pub mod llm_plan;
 pub mod manifest;
 pub mod merge;
 pub mod plan;

@@ -96,6 +96,7 @@ impl Table {
 fn main_table(r: &Report) -> Table {
     let mut t = Table::new(&[
         "Model",
+        "Prompt",
         "Decisions",
         "Lost",
         "SAA %",
@@ -110,9 +111,10 @@ fn main_table(r: &Report) -> Table {
         "R3",
         "R4",
     ]);
-    let mut add = |name: &str, lost: u64, m: &MetricsRow| {
+    let mut add = |name: &str, prompt: &str, lost: u64, m: &MetricsRow| {
         t.row(vec![
             name.to_string(),
+            prompt.to_string(),
             m.decisions.to_string(),
             lost.to_string(),
             pct(m.saa),
@@ -129,10 +131,10 @@ fn main_table(r: &Report) -> Table {
         ]);
     };
     for m in &r.models {
-        add(&m.model, m.lost, &m.overall);
+        add(&m.model, &m.prompt_version, m.lost, &m.overall);
     }
     if r.models.len() > 1 {
-        add("ALL (pooled)", r.pooled.lost, &r.pooled.overall);
+        add("ALL (pooled)", "", r.pooled.lost, &r.pooled.overall);
     }
     t
 }
