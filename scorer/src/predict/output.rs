@@ -23,6 +23,8 @@ pub struct Existing {
     pub errors: usize,
     /// Cost of the requests recorded in the file (answers from the cache excluded).
     pub paid_cost: f64,
+    /// How many answered lines that cost is over.
+    pub paid_lines: u64,
     /// A torn last line was dropped (bytes).
     pub torn_bytes: usize,
     /// Error lines removed for `--retry-errors`.
@@ -95,6 +97,7 @@ pub fn prepare(path: &Path, model: &str, retry_errors: bool) -> Result<Existing>
             continue;
         }
         if !v.get("cached").and_then(Value::as_bool).unwrap_or(false) {
+            ex.paid_lines += 1;
             ex.paid_cost += v
                 .pointer("/usage/cost")
                 .and_then(Value::as_f64)

@@ -199,13 +199,15 @@ fn error_line(
     })
 }
 
-/// The cost budget: `spent` over the whole output file, the mean over this run's
-/// requests.
+/// The cost budget: `spent` over the whole output file; the mean cost per request over
+/// the file's paid lines and this run's requests.
 struct Budget {
     max: Option<f64>,
     spent: f64,
     spent_run: f64,
     paid_requests: u64,
+    /// Paid lines already in the file when the run started.
+    paid_before: u64,
 }
 
 impl Budget {
@@ -214,10 +216,11 @@ impl Budget {
         if self.spent >= max {
             return false;
         }
-        if self.paid_requests == 0 {
+        let requests = self.paid_requests + self.paid_before;
+        if requests == 0 {
             return in_flight == 0;
         }
-        let mean = self.spent_run / self.paid_requests as f64;
+        let mean = self.spent / requests as f64;
         self.spent + (in_flight as f64 + 1.0) * mean <= max
     }
 }
@@ -265,6 +268,7 @@ pub fn run(opts: &PredictOptions, scenes: &[String]) -> Result<Summary> {
         spent: existing.paid_cost,
         spent_run: 0.0,
         paid_requests: 0,
+        paid_before: existing.paid_lines,
     };
     let rt = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
