@@ -23,10 +23,7 @@ use crate::config::Config;
 use crate::dataset;
 use crate::families;
 use crate::manifest::{Manifest, MANIFEST_FILE};
-use crate::plan::plan_group;
-use crate::render::{with_thread_renderer, RenderOptions, Renderer};
-use crate::scene::{produce_group, SceneMedia, SceneResult};
-use crate::simulate::{simulate, SimOptions};
+use crate::scene::{run_group, GroupError, RenderStage};
 use arrow::array::RecordBatch;
 use rayon::prelude::*;
 use rh_catalog::Catalog;
@@ -106,10 +103,10 @@ pub fn check_options(
         ));
     }
     for f in &opts.families {
-        if !rh_catalog::FAMILIES.contains(&f.as_str()) {
+        if !rh_contract::FAMILIES.contains(&f.as_str()) {
             return Err(BuildError::Input(format!(
                 "unknown family '{f}' (known: {})",
-                rh_catalog::FAMILIES.join(", ")
+                rh_contract::FAMILIES.join(", ")
             )));
         }
         if families::get(f).is_none() {
@@ -290,28 +287,38 @@ pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError
     Ok(!out.join(WORK_DIR).exists() && data.exists() && out.join("README.md").exists())
 }
 
-/// Renders a valid scene's videos and frames into `out` (stage 4). Invalid scenes are
-/// not rendered: their video columns stay null. The simulation is run again from the
-/// spec (milliseconds, and identical by construction) rather than kept per group.
-fn render_scene(
-    r: &SceneResult,
-    catalog: &Catalog,
-    opts: &RenderOptions,
-    out: &Path,
-) -> Result<Option<SceneMedia>, BuildError> {
-    if !r.verdicts.all() || r.spec.cameras.is_empty() {
-        return Ok(None);
+/// Fails before any work when rendering is requested but impossible: no GPU, no
+/// encoder, or a program built without the `render` feature.
+fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<(), BuildError> {
+    if !opts.render {
+        return Ok(());
     }
-    let sim = simulate(&r.spec, SimOptions::default());
-    let rendered = with_thread_renderer(opts, |renderer| {
-        renderer.render_scene(&r.spec, &sim, catalog, out)
-    })
-    .and_then(|x| x)
-    .map_err(|e| BuildError::Internal(format!("render {}: {e}", r.spec.scene_id)))?;
-    Ok(Some(SceneMedia {
-        videos: rendered.videos,
-        full_event: rendered.full_event,
-    }))
+    #[cfg(not(feature = "render"))]
+    {
+        let _ = config;
+        Err(BuildError::Input(
+            "rendering was requested, but this rh-pipeline was built without the `render` \
+             feature (cargo build --no-default-features): build with --no-render, or use a \
+             build with default features"
+                .into(),
+        ))
+    }
+    #[cfg(feature = "render")]
+    {
+        let renderer =
+            crate::render::Renderer::new(crate::render::RenderOptions::from_config(&config.render))
+                .map_err(|e| {
+                    BuildError::Input(format!("render stage: {e} (or build with --no-render)"))
+                })?;
+        if opts.progress {
+            eprintln!(
+                "rendering on {} ({} MSAA samples)",
+                renderer.adapter_name(),
+                renderer.samples()
+            );
+        }
+        Ok(())
+    }
 }
 
 /// Reads group `g`'s record if it is there and whole (right rows, every file it names
@@ -340,20 +347,7 @@ pub fn build(
     config: &Config,
 ) -> Result<BuildSummary, BuildError> {
     check_options(opts, catalog, config)?;
-    let render_opts = RenderOptions::from_config(&config.render);
-    if opts.render {
-        // Fail before any work when there is nothing to render with.
-        let renderer = Renderer::new(render_opts.clone()).map_err(|e| {
-            BuildError::Input(format!("render stage: {e} (or build with --no-render)"))
-        })?;
-        if opts.progress {
-            eprintln!(
-                "rendering on {} ({} MSAA samples)",
-                renderer.adapter_name(),
-                renderer.samples()
-            );
-        }
-    }
+    check_render_stage(opts, config)?;
     let mut manifest = Manifest::new(
         opts.seed,
         opts.n,
@@ -403,6 +397,19 @@ pub fn build(
         );
     }
 
+    // Stage 4 for the DAG driver (`scene::run_group`): a valid scene's videos and frames.
+    #[cfg(feature = "render")]
+    let render_opts = crate::render::RenderOptions::from_config(&config.render);
+    #[cfg(feature = "render")]
+    let render_stage = |r: &crate::scene::SceneResult| {
+        crate::render::render_stage(r, catalog, &render_opts, out)
+            .map_err(|e| format!("render {}: {e}", r.spec.scene_id))
+    };
+    #[cfg(feature = "render")]
+    let render: Option<&RenderStage> = opts.render.then_some(&render_stage as &RenderStage);
+    #[cfg(not(feature = "render"))]
+    let render: Option<&RenderStage> = None;
+
     let scenes_todo: u64 = todo.iter().map(|&g| manifest.group_size(g)).sum();
     let progress = Progress::new(scenes_todo, opts.progress);
     let pool = rayon::ThreadPoolBuilder::new()
@@ -412,20 +419,13 @@ pub fn build(
     pool.install(|| {
         todo.par_iter()
             .try_for_each(|&g| -> Result<(), BuildError> {
-                let selection = match &opts.selections {
-                    Some(s) => s[(g % s.len() as u64) as usize].clone(),
-                    None => plan_group(catalog, &opts.families, opts.seed, g)
-                        .map_err(|e| BuildError::Input(e.to_string()))?,
-                };
                 let count = manifest.group_size(g);
-                let mut results =
-                    produce_group(&selection, opts.seed, g * 4, count, catalog, config)
-                        .map_err(|e| BuildError::Input(e.to_string()))?;
-                if opts.render {
-                    for r in results.iter_mut() {
-                        r.media = render_scene(r, catalog, &render_opts, out)?;
-                    }
-                }
+                let results =
+                    run_group(catalog, &opts.families, opts.selections.as_deref(), opts.seed, g, count, config, render)
+                        .map_err(|e| match e {
+                            GroupError::Input(m) => BuildError::Input(m),
+                            GroupError::Render(m) => BuildError::Internal(m),
+                        })?;
                 for r in &results {
                     let path = out.join(dataset::spec_path(&r.spec.scene_id));
                     dataset::write_atomic(&path, r.spec.to_json().as_bytes())

@@ -257,98 +257,19 @@ pub fn render(input: &CardInput) -> String {
         },
     );
 
-    // Per-family table, in the build's family order.
-    let mut ft = String::from(
-        "Label counts are over valid scenes.\n\n| family | scenes | valid | CATCH | DODGE | NO_ACTION |",
-    );
-    if input.eval.is_some() {
-        ft.push_str(" eval |");
-    }
-    ft.push_str("\n|---|---|---|---|---|---|");
-    if input.eval.is_some() {
-        ft.push_str("---|");
-    }
-    ft.push('\n');
-    let mut total = FamilyCounts::default();
-    for f in &m.families {
-        let c = counts.get(f).cloned().unwrap_or_default();
-        let _ = write!(
-            ft,
-            "| {f} | {} | {} | {} | {} | {} |",
-            c.scenes, c.valid, c.catch, c.dodge, c.no_action
-        );
-        if let Some(e) = input.eval {
-            let _ = write!(ft, " {} |", e.get(f).copied().unwrap_or(0));
-        }
-        ft.push('\n');
-        total.scenes += c.scenes;
-        total.valid += c.valid;
-        total.catch += c.catch;
-        total.dodge += c.dodge;
-        total.no_action += c.no_action;
-    }
-    let _ = write!(
-        ft,
-        "| **total** | {} | {} | {} | {} | {} |",
-        total.scenes, total.valid, total.catch, total.dodge, total.no_action
-    );
-    if input.eval.is_some() {
-        let _ = write!(ft, " {total_eval} |");
-    }
-    v.insert("family_table", ft);
+    v.insert("family_table", family_table(input, &counts, total_eval));
 
-    // Features.
-    let schema = dataset::schema();
-    let mut features = String::new();
-    for field in schema.fields() {
-        let _ = writeln!(
-            features,
-            "| `{}` | {}{} | {} |",
-            field.name(),
-            type_name(field.data_type()),
-            if field.is_nullable() {
-                ", nullable"
-            } else {
-                ""
-            },
-            dataset::column_description(field.name()).unwrap_or_default()
-        );
-    }
-    v.insert("features_table", features.trim_end().to_string());
+    v.insert("features_table", features_table());
 
-    let l = &labels;
-    v.insert(
-        "label_rule",
-        format!(
-            "* **Impact point**: the hazard's centre where it first descends through the reach \
-plane z = {} m after t = 0 (interpolated within the physics step); for a body that never \
-does, its closest approach to the observer's torso axis if within {} m; else null.
-* **dangerous**: the object is sharp, hot, or large and fragile (catalog hazard flags of its \
-true physics), or its mass is ≥ {} kg, or its impact momentum is ≥ {} kg·m/s.
-* **danger_present**: in a counterfactual simulation with the observer's body (a capsule of \
-radius {} m, floor to {} m) as a static collider, the hazard touches it at ≥ {} m/s.
-* **reachable**: the hazard passes within {} m of the torso axis, or danger is present.
-* **gt_action**: `NO_ACTION` when not reachable; else `DODGE` when dangerous, or the impact \
-speed is > {} m/s, or the impact kinetic energy is > {} J; else `CATCH`.",
-            l.reach_plane_z,
-            l.closest_approach_max,
-            l.heavy_mass_kg,
-            l.heavy_momentum,
-            m.config
-                .pointer("/observer/torso_radius")
-                .and_then(|x| x.as_f64())
-                .unwrap_or(0.18),
-            m.config
-                .pointer("/observer/height")
-                .and_then(|x| x.as_f64())
-                .unwrap_or(1.32),
-            l.strike_speed_min,
-            l.reach_radius,
-            l.catch_speed_max,
-            l.catch_energy_max,
-        ),
-    );
+    v.insert("label_rule", label_rule(m, &labels));
 
+    insert_provenance(input, &mut v);
+    fill(TEMPLATE, &v)
+}
+
+/// The build summary table and the command that rebuilds this dataset.
+fn insert_provenance(input: &CardInput, v: &mut BTreeMap<&str, String>) {
+    let m = input.manifest;
     let default_config = crate::config::Config::embedded()
         .map(|c| crate::manifest::config_sha256(&c) == m.config_sha256)
         .unwrap_or(false);
@@ -397,7 +318,107 @@ speed is > {} m/s, or the impact kinetic energy is > {} J; else `CATCH`.",
             }
         ),
     );
-    fill(TEMPLATE, &v)
+}
+
+/// The per-family table, in the build's family order (label counts over valid scenes).
+fn family_table(
+    input: &CardInput,
+    counts: &BTreeMap<String, FamilyCounts>,
+    total_eval: usize,
+) -> String {
+    let m = input.manifest;
+    let mut ft = String::from(
+    "Label counts are over valid scenes.\n\n| family | scenes | valid | CATCH | DODGE | NO_ACTION |",
+);
+    if input.eval.is_some() {
+        ft.push_str(" eval |");
+    }
+    ft.push_str("\n|---|---|---|---|---|---|");
+    if input.eval.is_some() {
+        ft.push_str("---|");
+    }
+    ft.push('\n');
+    let mut total = FamilyCounts::default();
+    for f in &m.families {
+        let c = counts.get(f).cloned().unwrap_or_default();
+        let _ = write!(
+            ft,
+            "| {f} | {} | {} | {} | {} | {} |",
+            c.scenes, c.valid, c.catch, c.dodge, c.no_action
+        );
+        if let Some(e) = input.eval {
+            let _ = write!(ft, " {} |", e.get(f).copied().unwrap_or(0));
+        }
+        ft.push('\n');
+        total.scenes += c.scenes;
+        total.valid += c.valid;
+        total.catch += c.catch;
+        total.dodge += c.dodge;
+        total.no_action += c.no_action;
+    }
+    let _ = write!(
+        ft,
+        "| **total** | {} | {} | {} | {} | {} |",
+        total.scenes, total.valid, total.catch, total.dodge, total.no_action
+    );
+    if input.eval.is_some() {
+        let _ = write!(ft, " {total_eval} |");
+    }
+    ft
+}
+
+/// The feature table: every column of the scene table with its type and meaning.
+fn features_table() -> String {
+    let schema = dataset::schema();
+    let mut features = String::new();
+    for field in schema.fields() {
+        let _ = writeln!(
+            features,
+            "| `{}` | {}{} | {} |",
+            field.name(),
+            type_name(field.data_type()),
+            if field.is_nullable() {
+                ", nullable"
+            } else {
+                ""
+            },
+            dataset::column_description(field.name()).unwrap_or_default()
+        );
+    }
+    features.trim_end().to_string()
+}
+
+/// The label rule in words, with the build's thresholds.
+fn label_rule(m: &Manifest, labels: &crate::config::LabelConfig) -> String {
+    let l = labels;
+    format!(
+        "* **Impact point**: the hazard's centre where it first descends through the reach \
+plane z = {} m after t = 0 (interpolated within the physics step); for a body that never \
+does, its closest approach to the observer's torso axis if within {} m; else null.
+* **dangerous**: the object is sharp, hot, or large and fragile (catalog hazard flags of its \
+true physics), or its mass is ≥ {} kg, or its impact momentum is ≥ {} kg·m/s.
+* **danger_present**: in a counterfactual simulation with the observer's body (a capsule of \
+radius {} m, floor to {} m) as a static collider, the hazard touches it at ≥ {} m/s.
+* **reachable**: the hazard passes within {} m of the torso axis, or danger is present.
+* **gt_action**: `NO_ACTION` when not reachable; else `DODGE` when dangerous, or the impact \
+speed is > {} m/s, or the impact kinetic energy is > {} J; else `CATCH`.",
+        l.reach_plane_z,
+        l.closest_approach_max,
+        l.heavy_mass_kg,
+        l.heavy_momentum,
+        m.config
+            .pointer("/observer/torso_radius")
+            .and_then(|x| x.as_f64())
+            .unwrap_or(0.18),
+        m.config
+            .pointer("/observer/height")
+            .and_then(|x| x.as_f64())
+            .unwrap_or(1.32),
+        l.strike_speed_min,
+        l.reach_radius,
+        l.catch_speed_max,
+        l.catch_energy_max,
+    )
 }
 
 #[cfg(test)]

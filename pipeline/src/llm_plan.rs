@@ -11,7 +11,7 @@
 //! description text is stored too. Given its selections a build stays seed-pure, and with
 //! the cache a rebuild from the same descriptions makes no request.
 
-use crate::plan::{LexiconPlanner, PlanError, Planner};
+use crate::selection::{LexiconPlanner, PlanError, Planner};
 use crate::spec::{PlannerRecord, Selection};
 use rh_catalog::Catalog;
 use serde::Deserialize;

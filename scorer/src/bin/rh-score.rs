@@ -408,20 +408,20 @@ fn score(cli: Cli) -> Result<()> {
         }
     }
     if let Some(p) = &cli.csv {
-        write_file(p, "the CSV report", &rh_score::render::csv(&report))?;
+        write_file(p, "the CSV report", &rh_score::tables::csv(&report))?;
     }
     if let Some(p) = &cli.markdown {
         write_file(
             p,
             "the Markdown report",
-            &rh_score::render::markdown(&report),
+            &rh_score::tables::markdown(&report),
         )?;
     }
     if let Some(d) = &cli.figures {
         rh_score::figures::write_figures(&report, d)?;
     }
     if !cli.quiet && !json_stdout {
-        print_out(&rh_score::render::terminal(&report))?;
+        print_out(&rh_score::tables::terminal(&report))?;
     }
     let warned: u64 = report.input.warnings.iter().map(|w| w.count).sum();
     if warned > 0 {

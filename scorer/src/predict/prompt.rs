@@ -18,9 +18,9 @@ pub struct BuiltPrompt {
     pub encode_s: f64,
 }
 
-/// `frames/<id>/<cam>_t0.150.png` (the renderer's naming, SPEC §8).
+/// `frames/<id>/<cam>_t0.150.png` (the data contract's naming, SPEC §8).
 pub fn frame_rel_path(scene_id: &str, camera: &str, t: f64) -> String {
-    format!("frames/{scene_id}/{camera}_t{t:.3}.png")
+    rh_contract::layout::frame_path(scene_id, camera, t)
 }
 
 fn fill(text: &str, cfg: &PromptConfig) -> String {

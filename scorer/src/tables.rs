@@ -1,4 +1,5 @@
-//! Report renderings: terminal table, Markdown, CSV (JSON is `serde_json` of [`Report`]).
+//! Report text tables: terminal table, Markdown, CSV (JSON is `serde_json` of [`Report`]).
+//! (Named `tables`, not `render`, which in this project means the video renderer.)
 
 use crate::report::{MetricsRow, ModelReport, Report};
 use crate::types::Rule;
@@ -169,9 +170,19 @@ fn breakdown_table(r: &Report, title: &str, pick: fn(&ModelReport) -> &Vec<Metri
     t
 }
 
-fn analyses_tables(r: &Report) -> Vec<(String, Table, Option<String>)> {
-    let a = &r.analyses;
+/// A titled table with an optional note below it.
+type TitledTable = (String, Table, Option<String>);
+
+fn analyses_tables(r: &Report) -> Vec<TitledTable> {
     let mut out = Vec::new();
+    safety_and_reach_tables(r, &mut out);
+    speed_vote_and_adversarial_tables(r, &mut out);
+    out
+}
+
+/// Safety-rule breakdown, disposition, and correct but out of reach.
+fn safety_and_reach_tables(r: &Report, out: &mut Vec<TitledTable>) {
+    let a = &r.analyses;
 
     let mut t = Table::new(&[
         "Model",
@@ -258,7 +269,11 @@ fn analyses_tables(r: &Report) -> Vec<(String, Table, Option<String>)> {
         ]);
     }
     out.push(("Correct but out of reach".into(), t, Some("Correct CATCH decisions with an impact point. Miss: d_end above the miss radius; falling short: the final hands are closer (horizontally) to the final pelvis than the impact point is; standing far: the final pelvis is farther than the far-standing distance from the impact point (horizontal).".into())));
+}
 
+/// Speed bands, majority vote, adversarial probes and look-alikes.
+fn speed_vote_and_adversarial_tables(r: &Report, out: &mut Vec<TitledTable>) {
+    let a = &r.analyses;
     let mut t = Table::new(&[
         "Model",
         "Decisions",
@@ -353,7 +368,6 @@ fn analyses_tables(r: &Report) -> Vec<(String, Table, Option<String>)> {
             None,
         ));
     }
-    out
 }
 
 fn header(r: &Report) -> String {
