@@ -181,7 +181,7 @@ mod tests {
         )
         .unwrap();
         let ex = prepare(&p, "m", false).unwrap();
-        assert_eq!(ex.torn_bytes, 19);
+        assert_eq!(ex.torn_bytes, r#"{"scene_id":"d","mod"#.len());
         assert_eq!(ex.done.len(), 3);
         assert_eq!(ex.errors, 1);
         assert_eq!(ex.paid_cost, 0.5);
