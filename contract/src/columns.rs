@@ -394,7 +394,7 @@ pub const COLUMNS: &[Column] = &[
         col::TRAJECTORY,
         Vec4F32List,
         false,
-        "Hazard centre [t (s), x, y, z (m)] at each video frame (float32)",
+        "Hazard centre [t (s), x, y, z (m)] over the whole simulation (t = 0 to its last step), sampled at the video rate (every 1/fps s, physics step round(t / dt)); the first entries, t ≤ the observation window, match the camera videos' frames (float32)",
     ),
 ];
 

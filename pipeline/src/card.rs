@@ -21,6 +21,27 @@ pub const EVAL_PER_FAMILY: usize = 18;
 /// The `eval` config's Parquet file.
 pub const EVAL_FILE: &str = "eval/test-00000-of-00001.parquet";
 
+/// How to get videos from the `*_file_name` columns (plain relative paths).
+const VIDEO_NOTE: &str = r#"**Videos.** The `ego_file_name`, `closeup_file_name`, `overhead_file_name` and
+`full_event_file_name` columns hold paths relative to this folder (plain strings, so pyarrow,
+pandas, polars and duckdb read the table as is; null for invalid or unrendered scenes). To
+get decodable videos in `datasets` (decoding needs `torchcodec`), make them absolute and cast
+them to `Video`:
+
+```python
+from datasets import Video
+def media(row):
+    return {cam: os.path.join(DIR, row[f"{cam}_file_name"]) if row[f"{cam}_file_name"] else None
+            for cam in ("ego", "closeup", "overhead", "full_event")}
+scenes = scenes.map(media)
+for cam in ("ego", "closeup", "overhead", "full_event"):
+    scenes = scenes.cast_column(cam, Video())
+# scenes[0]["ego"] is a torchcodec VideoDecoder; frame k shows physics step frame_steps[k]
+```
+
+For a Hub copy, `DIR = huggingface_hub.snapshot_download("owner/name", repo_type="dataset")`
+fetches the videos too."#;
+
 /// Per-family counts of a set of rows.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct FamilyCounts {
@@ -103,6 +124,21 @@ pub fn select_eval(rows: &[(&str, u64, bool)]) -> (Vec<u32>, BTreeMap<String, us
     }
     chosen.sort_by_key(|&r| index(r));
     (chosen.into_iter().map(|r| r as u32).collect(), counts)
+}
+
+/// "object_drop 4, shelf_slide 4, …" (families in name order).
+fn eval_counts_text(eval: &BTreeMap<String, usize>) -> String {
+    let families = eval.values().filter(|&&n| n > 0).count();
+    let full = eval.values().filter(|&&n| n == EVAL_PER_FAMILY).count();
+    if families == full {
+        format!("{EVAL_PER_FAMILY} in each of {families} families")
+    } else {
+        format!(
+            "{} famil{}, {full} of them with {EVAL_PER_FAMILY}",
+            families,
+            if families == 1 { "y" } else { "ies" }
+        )
+    }
 }
 
 /// Hugging Face size category of a row count.
@@ -188,13 +224,13 @@ pub fn render(input: &CardInput) -> String {
         );
         let _ = writeln!(
             table,
-            "| `eval` | `{EVAL_FILE}` | {total_eval} | balanced evaluation subset: {EVAL_PER_FAMILY} valid scenes per family |"
+            "| `eval` | `{EVAL_FILE}` | {total_eval} | balanced evaluation subset: up to {EVAL_PER_FAMILY} valid scenes per family (whole speed-band groups first); here {} |",
+            eval_counts_text(input.eval.unwrap_or(&BTreeMap::new()))
         );
         v.insert(
             "eval_example",
             format!(
-                "subset = load_dataset(\"{}\", \"eval\", split=\"test\")  # {total_eval} scenes\n",
-                rh_hub::RELEASED_DATASET
+                "subset = load_dataset(DIR, \"eval\", split=\"test\")  # {total_eval} scenes\n"
             ),
         );
     } else {
@@ -205,12 +241,13 @@ pub fn render(input: &CardInput) -> String {
 
     let mut scope = if m.is_whole() {
         format!(
-            "This build holds **{n_rows} scenes** ({} valid) of {} famil{} in {} scene groups \
+            "This build holds **{n_rows} scenes** ({} valid) of {} famil{} in {} scene group{} \
              (four speed bands per group: slow, normal, fast, very_fast).",
             counts.values().map(|c| c.valid).sum::<usize>(),
             counts.len(),
             if counts.len() == 1 { "y" } else { "ies" },
-            m.n_groups()
+            m.n_groups(),
+            if m.n_groups() == 1 { "" } else { "s" }
         )
     } else {
         format!(
@@ -220,23 +257,44 @@ pub fn render(input: &CardInput) -> String {
             m.shard[0], m.shard[1], m.n, m.shard[1], m.shard[0]
         )
     };
+    let absent: Vec<&str> = m
+        .families
+        .iter()
+        .filter(|f| !counts.contains_key(*f))
+        .map(String::as_str)
+        .collect();
+    if !absent.is_empty() {
+        let _ =
+            write!(
+            scope,
+            "\n\nThe build was asked for {} families; {} got no scene group because the build is \
+             smaller than one group per family (families are dealt to groups in turn): {}.",
+            m.families.len(),
+            absent.len(),
+            absent.iter().map(|f| format!("`{f}`")).collect::<Vec<_>>().join(", ")
+        );
+    }
     if let Some(eval) = input.eval {
         let short: Vec<String> = m
             .families
             .iter()
+            .filter(|f| counts.contains_key(*f))
             .filter(|f| eval.get(*f).copied().unwrap_or(0) < EVAL_PER_FAMILY)
             .map(|f| format!("`{f}` ({})", eval.get(f).copied().unwrap_or(0)))
             .collect();
         if !short.is_empty() {
             let _ = write!(
                 scope,
-                "\n\n**Note:** the `eval` config should hold {EVAL_PER_FAMILY} scenes per family, but this \
-                 build has fewer valid scenes in {}; the subset holds all of them.",
+                "\n\n**Note:** the `eval` config takes up to {EVAL_PER_FAMILY} valid scenes per family; \
+                 this build has fewer in {} of its {} families, so the subset holds all valid scenes of: {}.",
+                short.len(),
+                counts.len(),
                 short.join(", ")
             );
         }
     }
     v.insert("scope", scope);
+    v.insert("video_note", VIDEO_NOTE.trim_end().to_string());
     let rendered = input
         .rows
         .column_by_name("ego_file_name")
@@ -339,7 +397,7 @@ fn family_table(
     }
     ft.push('\n');
     let mut total = FamilyCounts::default();
-    for f in &m.families {
+    for f in m.families.iter().filter(|f| counts.contains_key(*f)) {
         let c = counts.get(f).cloned().unwrap_or_default();
         let _ = write!(
             ft,

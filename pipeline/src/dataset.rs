@@ -19,6 +19,7 @@ use std::sync::Arc;
 /// Rows per Parquet row group: small enough for the Hub's dataset viewer to page.
 pub const ROW_GROUP_SIZE: usize = 1000;
 
+pub use crate::dataset_stream::{project, read_columns, ParquetStream, SUMMARY_COLUMNS};
 pub use crate::fsio::write_atomic;
 pub use rh_contract::layout::{data_file_name, frame_files, spec_path};
 
@@ -353,6 +354,20 @@ pub fn bool_column(batch: &RecordBatch, name: &str) -> Vec<bool> {
 /// Serialises rows to Parquet bytes (Snappy, fixed row groups, no timestamps: the same
 /// rows always give the same bytes).
 pub fn parquet_bytes(batch: &RecordBatch) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    {
+        let mut writer =
+            ArrowWriter::try_new(&mut bytes, batch.schema(), Some(writer_props(batch)))
+                .expect("valid schema");
+        writer.write(batch).expect("in-memory write");
+        writer.close().expect("in-memory close");
+    }
+    bytes
+}
+
+/// The writer settings of every scene table: Snappy, `ROW_GROUP_SIZE` rows per row group,
+/// no timestamps.
+pub(crate) fn writer_props(batch: &RecordBatch) -> WriterProperties {
     // The `huggingface` features also as a plain key-value entry of the file, for readers
     // that do not decode the embedded Arrow schema.
     let kv = batch.schema().metadata().get("huggingface").map(|v| {
@@ -361,20 +376,12 @@ pub fn parquet_bytes(batch: &RecordBatch) -> Vec<u8> {
             v.clone(),
         )]
     });
-    let props = WriterProperties::builder()
+    WriterProperties::builder()
         .set_key_value_metadata(kv)
         .set_compression(Compression::SNAPPY)
         .set_max_row_group_row_count(Some(ROW_GROUP_SIZE))
         .set_created_by("rh-pipeline".to_string())
-        .build();
-    let mut bytes = Vec::new();
-    {
-        let mut writer =
-            ArrowWriter::try_new(&mut bytes, batch.schema(), Some(props)).expect("valid schema");
-        writer.write(batch).expect("in-memory write");
-        writer.close().expect("in-memory close");
-    }
-    bytes
+        .build()
 }
 
 /// Paths of the dataset's Parquet files, in name order.

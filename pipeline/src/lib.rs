@@ -18,6 +18,7 @@ pub mod card;
 pub mod cli;
 pub mod config;
 pub mod dataset;
+pub mod dataset_stream;
 pub mod families;
 pub mod fsio;
 pub mod label;

@@ -36,6 +36,7 @@ pub mod dataset;
 pub mod explain;
 pub mod figures;
 pub mod fixture;
+pub mod html;
 pub mod layout;
 pub mod metrics;
 pub mod plan;

@@ -66,10 +66,11 @@ pub fn contact_sheet(dataset_dir: &Path, out_png: &Path) -> Result<ContactSheet,
             order.push(f.clone());
         }
     }
-    let (tw, th, label) = (384u32, 216u32, 22u32);
-    let cols = (order.len() as f64).sqrt().ceil().max(1.0) as u32;
-    let cols = cols.clamp(1, 5);
-    let rows = (order.len() as u32).div_ceil(cols);
+    // Label strip: 4 px, the 9-row font at scale 2 (descenders included), 4 px.
+    let (tw, th, label) = (384u32, 216u32, 8 + 2 * font::ROWS);
+    let n = order.len() as u32;
+    let cols = sheet_columns(n);
+    let rows = n.div_ceil(cols);
     let (w, h) = (cols * tw, rows * (th + label));
     let mut sheet = image::RgbImage::from_pixel(w, h, image::Rgb([24, 24, 28]));
     let mut tiles = Vec::new();
@@ -79,7 +80,15 @@ pub fn contact_sheet(dataset_dir: &Path, out_png: &Path) -> Result<ContactSheet,
             .map_err(|e| RenderError::Io(format!("{}: {e}", path.display())))?
             .to_rgb8();
         let tile = image::imageops::resize(&img, tw, th, image::imageops::FilterType::Triangle);
-        let (x, y) = ((i as u32 % cols) * tw, (i as u32 / cols) * (th + label));
+        // A short last row is centred rather than leaving empty tiles at its end.
+        let (row, col) = (i as u32 / cols, i as u32 % cols);
+        let in_row = if row + 1 == rows {
+            n - row * cols
+        } else {
+            cols
+        };
+        let x = col * tw + (cols - in_row) * tw / 2;
+        let y = row * (th + label);
         image::imageops::replace(&mut sheet, &tile, x as i64, (y + label) as i64);
         font::draw_text(
             &mut sheet,
@@ -105,4 +114,30 @@ pub fn contact_sheet(dataset_dir: &Path, out_png: &Path) -> Result<ContactSheet,
         width: w,
         height: h,
     })
+}
+
+/// Columns of a contact sheet of `n` tiles: 3 to 5 (fewer when there are fewer tiles),
+/// the count that leaves the fewest empty places in the last row, the most columns on a tie.
+fn sheet_columns(n: u32) -> u32 {
+    if n <= 3 {
+        return n.max(1);
+    }
+    (3..=5u32)
+        .min_by_key(|&c| (n.div_ceil(c) * c - n, u32::MAX - c))
+        .unwrap_or(5)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn contact_sheet_columns_leave_the_fewest_gaps() {
+        assert_eq!(sheet_columns(1), 1);
+        assert_eq!(sheet_columns(2), 2);
+        assert_eq!(sheet_columns(15), 5);
+        assert_eq!(sheet_columns(16), 4);
+        assert_eq!(sheet_columns(17), 3);
+        assert_eq!(sheet_columns(10), 5);
+    }
 }
