@@ -22,6 +22,7 @@ pub mod dataset_stream;
 pub mod families;
 pub mod fsio;
 pub mod label;
+pub mod llm_plan;
 pub mod manifest;
 pub mod merge;
 pub mod selection;

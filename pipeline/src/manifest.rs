@@ -36,6 +36,10 @@ pub struct Manifest {
     pub catalog_sha256: String,
     /// The whole build configuration (label thresholds included).
     pub config: serde_json::Value,
+    /// The planned selections of a build from descriptions (`--descriptions`), one per
+    /// description with its planner record; group g takes selection g mod len.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub selections: Option<Vec<crate::spec::Selection>>,
 }
 
 fn sha256_hex(bytes: &[u8]) -> String {
@@ -80,6 +84,7 @@ impl Manifest {
             config_sha256: config_sha256(config),
             catalog_sha256: catalog_sha256(catalog),
             config: serde_json::to_value(config).expect("config serializes"),
+            selections: None,
         }
     }
 
@@ -132,6 +137,11 @@ impl Manifest {
             other.rh_pipeline_version.clone(),
         );
         cmp("seed", self.seed.to_string(), other.seed.to_string());
+        cmp(
+            "planned selections (--descriptions)",
+            serde_json::to_string(&self.selections).unwrap_or_default(),
+            serde_json::to_string(&other.selections).unwrap_or_default(),
+        );
         cmp("n", self.n.to_string(), other.n.to_string());
         cmp(
             "families",
