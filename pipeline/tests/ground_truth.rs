@@ -27,6 +27,7 @@ fn constructed(object: &str) -> SceneSpec {
         object_id: object.into(),
         room_id: "gym".into(),
         description: None,
+        planner: None,
     };
     let mut spec = randomize(&selection, &SceneKey::new(5, 0, 0), &catalog, &config).unwrap();
     assert_eq!(spec.bodies.len(), 1, "a thrown object is the only body");
@@ -130,6 +131,7 @@ fn the_impact_point_is_the_centre_of_mass_not_the_body_origin() {
         object_id: hammer.id.clone(),
         room_id: catalog.rooms[0].id.clone(),
         description: None,
+        planner: None,
     };
     let spec = randomize(&selection, &SceneKey::new(9, 0, 0), &catalog, &config).unwrap();
     let com = families::com_offset(hammer);
