@@ -482,12 +482,20 @@ pub fn build(
         todo.par_iter()
             .try_for_each(|&g| -> Result<(), BuildError> {
                 let count = manifest.group_size(g);
-                let results =
-                    run_group(catalog, &opts.families, opts.selections.as_deref(), opts.seed, g, count, config, render)
-                        .map_err(|e| match e {
-                            GroupError::Input(m) => BuildError::Input(m),
-                            GroupError::Render(m) => BuildError::Internal(m),
-                        })?;
+                let results = run_group(
+                    catalog,
+                    &opts.families,
+                    opts.selections.as_deref(),
+                    opts.seed,
+                    g,
+                    count,
+                    config,
+                    render,
+                )
+                .map_err(|e| match e {
+                    GroupError::Input(m) => BuildError::Input(m),
+                    GroupError::Render(m) => BuildError::Internal(m),
+                })?;
                 let mut files = Vec::with_capacity(results.len() + 1);
                 for r in &results {
                     let path = out.join(dataset::spec_path(&r.spec.scene_id));

@@ -180,14 +180,16 @@ fn llm_planner<'a>(
         .ok_or_else(|| input("the LLM planner needs --model ID"))?;
     let cfg = crate::llm_plan::PlannerConfig::embedded();
     let mut client = cfg.client.clone();
-    if let Some(u) = args
-        .base_url
-        .clone()
-        .or_else(|| std::env::var("OPENAI_BASE_URL").ok().filter(|s| !s.is_empty()))
-    {
+    if let Some(u) = args.base_url.clone().or_else(|| {
+        std::env::var("OPENAI_BASE_URL")
+            .ok()
+            .filter(|s| !s.is_empty())
+    }) {
         client.base_url = u;
     }
-    client.api_key = std::env::var(&args.api_key_env).ok().filter(|k| !k.is_empty());
+    client.api_key = std::env::var(&args.api_key_env)
+        .ok()
+        .filter(|k| !k.is_empty());
     let cache = (!args.no_cache).then(|| rh_llm::cache::Cache::new(rh_llm::cache::default_dir()));
     crate::llm_plan::LlmPlanner::new(catalog, client, cache, model, cfg).map_err(|m| Failure {
         code: 1,
@@ -197,8 +199,12 @@ fn llm_planner<'a>(
 
 /// Reads a descriptions file: one a line; blank lines and `#` comments skipped.
 fn read_descriptions(path: &std::path::Path) -> Result<Vec<String>, Failure> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| input(format!("cannot read --descriptions {}: {e}", path.display())))?;
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        input(format!(
+            "cannot read --descriptions {}: {e}",
+            path.display()
+        ))
+    })?;
     let lines: Vec<String> = text
         .lines()
         .map(str::trim)
@@ -408,6 +414,73 @@ fn run_verify(dir: &Path, json: bool) -> Result<(), Failure> {
     }
 }
 
+/// `rh-pipeline download`: fetch a dataset from the Hub (or its cache), optionally copy it.
+fn download(repo: &str, revision: Option<&str>, out: Option<&Path>) -> Result<(), Failure> {
+    let snapshot = rh_hub::fetch(repo, revision).map_err(|e| Failure {
+        code: e.exit_code(),
+        message: e.to_string(),
+    })?;
+    if snapshot.from_cache_only {
+        eprintln!(
+            "the Hub at {} was not used; {repo} comes from the Hugging Face cache",
+            rh_hub::endpoint()
+        );
+    }
+    let path = match out {
+        Some(dir) => {
+            let files = rh_hub::copy_snapshot(&snapshot.path, dir).map_err(|e| Failure {
+                code: 1,
+                message: format!("cannot copy {repo} into {}: {e}", dir.display()),
+            })?;
+            eprintln!("copied {files} files into {}", dir.display());
+            dir.to_path_buf()
+        }
+        None => snapshot.path,
+    };
+    println!("{}", path.display());
+    Ok(())
+}
+
+/// `rh-pipeline balance`: label counts and rejection shares per family.
+fn balance(
+    catalog: &Catalog,
+    config: &Config,
+    seed: Option<u64>,
+    per_family: usize,
+    families: Option<Vec<String>>,
+    json: bool,
+) -> Result<(), Failure> {
+    if per_family == 0 {
+        return Err(input("--per-family must be at least 1"));
+    }
+    let families = families.unwrap_or_default();
+    for f in &families {
+        if crate::families::get(f).is_none() {
+            return Err(input(format!(
+                "unknown or unimplemented family '{f}' (implemented: {})",
+                crate::randomize::implemented_families()
+            )));
+        }
+    }
+    let rows = crate::balance::label_balance(
+        &catalog,
+        &config,
+        seed.unwrap_or(config.build.seed),
+        &families,
+        per_family,
+    )
+    .map_err(|e| Failure {
+        code: 1,
+        message: format!("{e:#}"),
+    })?;
+    if json {
+        print_json(&rows);
+    } else {
+        print!("{}", crate::balance::format_table(&rows));
+    }
+    Ok(())
+}
+
 pub fn run(cli: Cli) -> Result<(), Failure> {
     // Commands that need neither the catalog nor the configuration.
     match &cli.command {
@@ -428,32 +501,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             repo,
             revision,
             out,
-        } => {
-            let snapshot = rh_hub::fetch(repo, revision.as_deref()).map_err(|e| Failure {
-                code: e.exit_code(),
-                message: e.to_string(),
-            })?;
-            if snapshot.from_cache_only {
-                eprintln!(
-                    "the Hub at {} was not used; {repo} comes from the Hugging Face cache",
-                    rh_hub::endpoint()
-                );
-            }
-            let path = match out {
-                Some(dir) => {
-                    let files =
-                        rh_hub::copy_snapshot(&snapshot.path, dir).map_err(|e| Failure {
-                            code: 1,
-                            message: format!("cannot copy {repo} into {}: {e}", dir.display()),
-                        })?;
-                    eprintln!("copied {files} files into {}", dir.display());
-                    dir.clone()
-                }
-                None => snapshot.path,
-            };
-            println!("{}", path.display());
-            return Ok(());
-        }
+        } => return download(repo, revision.as_deref(), out.as_deref()),
         _ => {}
     }
     let (catalog, config) = load(&cli)?;
@@ -481,12 +529,9 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                 Some(path) => {
                     let texts = read_descriptions(path)?;
                     let sel = match planner {
-                        PlannerKind::Lexicon => plan_descriptions(
-                            &LexiconPlanner::new(&catalog),
-                            &texts,
-                            path,
-                            seed,
-                        )?,
+                        PlannerKind::Lexicon => {
+                            plan_descriptions(&LexiconPlanner::new(&catalog), &texts, path, seed)?
+                        }
                         PlannerKind::Llm => {
                             plan_descriptions(&llm_planner(&catalog, &llm)?, &texts, path, seed)?
                         }
@@ -533,37 +578,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             per_family,
             families,
             json,
-        } => {
-            if per_family == 0 {
-                return Err(input("--per-family must be at least 1"));
-            }
-            let families = families.unwrap_or_default();
-            for f in &families {
-                if crate::families::get(f).is_none() {
-                    return Err(input(format!(
-                        "unknown or unimplemented family '{f}' (implemented: {})",
-                        crate::randomize::implemented_families()
-                    )));
-                }
-            }
-            let rows = crate::balance::label_balance(
-                &catalog,
-                &config,
-                seed.unwrap_or(config.build.seed),
-                &families,
-                per_family,
-            )
-            .map_err(|e| Failure {
-                code: 1,
-                message: format!("{e:#}"),
-            })?;
-            if json {
-                print_json(&rows);
-            } else {
-                print!("{}", crate::balance::format_table(&rows));
-            }
-            Ok(())
-        }
+        } => balance(&catalog, &config, seed, per_family, families, json),
         Command::Plan {
             description,
             seed,

@@ -210,17 +210,25 @@ impl<'a> LlmPlanner<'a> {
         params.insert("max_tokens".into(), json!(self.cfg.max_tokens));
         let mut last = String::new();
         for attempt in 1..=self.cfg.max_tries.max(1) {
-            let req =
-                rh_llm::ChatRequest::new(&self.model, Value::Array(messages.clone()), params.clone(), 0);
-            let reply = self
-                .rt
-                .block_on(self.client.chat(&req))
-                .map_err(|e| format!("the model could not be asked: {}", self.client.redact(&e.to_string())))?;
+            let req = rh_llm::ChatRequest::new(
+                &self.model,
+                Value::Array(messages.clone()),
+                params.clone(),
+                0,
+            );
+            let reply = self.rt.block_on(self.client.chat(&req)).map_err(|e| {
+                format!(
+                    "the model could not be asked: {}",
+                    self.client.redact(&e.to_string())
+                )
+            })?;
             match validate(self.catalog, &reply.text) {
                 Ok(sel) => return Ok((sel, attempt)),
                 Err(e) => {
                     messages.push(json!({"role": "assistant", "content": reply.text}));
-                    messages.push(json!({"role": "user", "content": self.cfg.retry.replace("{error}", &e)}));
+                    messages.push(
+                        json!({"role": "user", "content": self.cfg.retry.replace("{error}", &e)}),
+                    );
                     last = e;
                 }
             }
@@ -279,9 +287,17 @@ mod tests {
         )
         .unwrap();
         assert_eq!(ok.1, "steel_apple");
-        let e = validate(&c, "{\"family\": \"juggling\", \"object_id\": \"apple\", \"room_id\": \"kitchen\"}").unwrap_err();
+        let e = validate(
+            &c,
+            "{\"family\": \"juggling\", \"object_id\": \"apple\", \"room_id\": \"kitchen\"}",
+        )
+        .unwrap_err();
         assert!(e.contains("family \"juggling\" does not exist"), "{e}");
-        let e = validate(&c, "{\"family\": \"thrown_object\", \"object_id\": \"unicorn\", \"room_id\": \"kitchen\"}").unwrap_err();
+        let e = validate(
+            &c,
+            "{\"family\": \"thrown_object\", \"object_id\": \"unicorn\", \"room_id\": \"kitchen\"}",
+        )
+        .unwrap_err();
         assert!(e.contains("not in the catalogue"), "{e}");
         let e = validate(&c, "no json here").unwrap_err();
         assert!(e.contains("no JSON object"), "{e}");

@@ -68,8 +68,9 @@ pub fn run_group(
     // Selections planned from descriptions (`build --descriptions`): group g takes g mod D.
     let selection = match planned {
         Some(s) if !s.is_empty() => s[(g % s.len() as u64) as usize].clone(),
-        _ => plan_group(catalog, families, seed, g)
-            .map_err(|e| GroupError::Input(e.to_string()))?,
+        _ => {
+            plan_group(catalog, families, seed, g).map_err(|e| GroupError::Input(e.to_string()))?
+        }
     };
     let mut results = produce_group(&selection, seed, g * 4, count, catalog, config)
         .map_err(|e| GroupError::Input(e.to_string()))?;

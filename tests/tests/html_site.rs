@@ -201,10 +201,14 @@ fn html_site_opens_in_headless_chromium() {
         Some(BASELINES.len() as u64),
         "one hand path per model"
     );
-    // Pixels in the models' colours (the site's palette) on the overlay canvas.
+    // Pixels of the overlay on the canvas: the models' colours (the site's palette), the
+    // hazard's path (white) and its current position (yellow). Since label rule v2 the
+    // observer often stands beyond the overhead view's frame (it is framed on the hazard's
+    // observation-window path), so the planned hands may lie off-image; the hazard's path
+    // never does.
     let coloured = b.eval(
         "(() => { const c = document.getElementById('overlay'); \
-         const pal = [[31,119,180],[255,127,14],[44,160,44],[214,39,40],[148,103,189]]; \
+         const pal = [[31,119,180],[255,127,14],[44,160,44],[214,39,40],[148,103,189],[255,255,255],[255,212,0]]; \
          const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; let n = 0; \
          for (let i = 0; i < d.length; i += 4) \
            if (d[i+3] > 200 && pal.some(p => Math.abs(d[i]-p[0]) < 20 && Math.abs(d[i+1]-p[1]) < 20 && Math.abs(d[i+2]-p[2]) < 20)) n++; \
@@ -212,7 +216,7 @@ fn html_site_opens_in_headless_chromium() {
     );
     assert!(
         coloured.as_u64().unwrap() >= 10,
-        "the planned hands are drawn: {coloured}"
+        "the overlay is drawn: {coloured}"
     );
     let decisions = b.eval("document.querySelectorAll('#decisions tbody tr').length");
     assert_eq!(decisions.as_u64(), Some(BASELINES.len() as u64));
