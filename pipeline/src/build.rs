@@ -22,6 +22,7 @@ use crate::card;
 use crate::config::Config;
 use crate::dataset;
 use crate::families;
+use crate::integrity::{self, FileSums};
 use crate::manifest::{Manifest, MANIFEST_FILE};
 use crate::plan::plan_group;
 use crate::render::{with_thread_renderer, RenderOptions, Renderer};
@@ -117,7 +118,8 @@ pub fn check_options(
         }
         if config.speed_bands(f).is_none() {
             return Err(BuildError::Input(format!(
-                "the configuration has no [speed_bands] entry for '{f}'"
+                "{}: [speed_bands] has no entry for family '{f}' (add `{f} = [slow, normal, fast, very_fast]`)",
+                config.source
             )));
         }
         if catalog.objects_for_family(f).next().is_none() {
@@ -267,13 +269,23 @@ pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError
             }
         }
         None => {
-            let occupied = ["data", "specs", "eval", WORK_DIR, "README.md"]
-                .iter()
-                .any(|p| out.join(p).exists());
-            if occupied {
+            // A build owns its directory: anything already there (a dataset of another
+            // version, or unrelated files) is refused rather than mixed with the dataset.
+            let mut present: Vec<String> = std::fs::read_dir(out)
+                .map_err(fail)?
+                .flatten()
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .collect();
+            present.sort();
+            if !present.is_empty() {
+                let shown: Vec<&str> = present.iter().take(5).map(|s| s.as_str()).collect();
                 return Err(BuildError::Input(format!(
-                    "{} holds files but no {MANIFEST_FILE} (not a build of this version); use a new --out or delete it",
-                    out.display()
+                    "--out {} is not empty and holds no {MANIFEST_FILE} ({} entr{}: {}{}); a build writes into a new or empty directory, or resumes its own — use a new --out",
+                    out.display(),
+                    present.len(),
+                    if present.len() == 1 { "y" } else { "ies" },
+                    shown.join(", "),
+                    if present.len() > 5 { ", …" } else { "" }
                 )));
             }
             dataset::write_atomic(&out.join(MANIFEST_FILE), manifest.to_json().as_bytes())
@@ -324,10 +336,64 @@ fn load_record(out: &Path, manifest: &Manifest, g: u64) -> Option<RecordBatch> {
     if indices != expected {
         return None;
     }
-    let files_there = dataset::referenced_files(&batch)
-        .iter()
-        .all(|f| out.join(f).exists());
-    files_there.then_some(batch)
+    // Every file the rows name, with the checksum recorded when the group finished.
+    let sums = integrity::read_group_sums(&path)?;
+    let named: Vec<String> = dataset::referenced_files(&batch);
+    if named.len() != sums.len() || !named.iter().all(|f| sums.contains_key(f)) {
+        return None;
+    }
+    let problems = integrity::check(out, &sums);
+    if !problems.is_empty() {
+        eprintln!(
+            "group {g}: {}; computing it again",
+            integrity::describe(&problems, 3)
+        );
+        return None;
+    }
+    Some(batch)
+}
+
+/// A finished build whose files are not all what its manifest records: turns it back
+/// into an unfinished one, keeping (as records) the groups whose files are intact, so
+/// the run recomputes only the damaged groups. Returns the problems found (empty: the
+/// build is intact and nothing was changed).
+fn reopen_if_damaged(out: &Path, manifest: &Manifest) -> Result<Vec<integrity::FileProblem>, BuildError> {
+    let Some(sums) = &manifest.files else {
+        // A finished build of a version that recorded no checksums: nothing to compare.
+        return Ok(vec![]);
+    };
+    let problems = integrity::check(out, sums);
+    if problems.is_empty() {
+        return Ok(problems);
+    }
+    let groups_dir = out.join(WORK_DIR).join("groups");
+    std::fs::create_dir_all(&groups_dir).map_err(|e| internal(&groups_dir, e))?;
+    let data_file = dataset::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
+    let data_ok = !problems.iter().any(|p| p.file == data_file);
+    let rows = if data_ok {
+        dataset::read_batch(&out.join(&data_file)).ok()
+    } else {
+        None
+    };
+    if let Some(rows) = rows {
+        let bad: std::collections::BTreeSet<&str> = problems.iter().map(|p| p.file.as_str()).collect();
+        let index = dataset::u64_column(&rows, "scene_index");
+        for g in manifest.groups() {
+            let picks: Vec<u32> = (0..rows.num_rows() as u32)
+                .filter(|&i| index[i as usize] / 4 == g)
+                .collect();
+            let batch = dataset::take_rows(&rows, &picks);
+            let files = dataset::referenced_files(&batch);
+            if picks.is_empty() || files.iter().any(|f| bad.contains(f.as_str()) || !sums.contains_key(f)) {
+                continue;
+            }
+            let group_sums: FileSums = files.iter().map(|f| (f.clone(), sums[f].clone())).collect();
+            let record = record_path(out, g);
+            integrity::write_group_sums(&record, &group_sums).map_err(|e| internal(&record, e))?;
+            dataset::write_atomic(&record, &dataset::parquet_bytes(&batch)).map_err(|e| internal(&record, e))?;
+        }
+    }
+    Ok(problems)
 }
 
 /// Builds the dataset described by `opts`.
@@ -366,9 +432,23 @@ pub fn build(
     let _lock = lock_dir(out)?;
     let complete = claim_out_dir(out, &manifest)?;
     remove_stale_temporaries(out);
+    interrupt::say_resume_on_interrupt(out);
     let data_file = dataset::data_file_name(opts.shard.0 as usize, opts.shard.1 as usize);
     let groups = manifest.groups();
 
+    let complete = complete && {
+        let on_disk = Manifest::read(out).map_err(BuildError::Input)?.unwrap_or_else(|| manifest.clone());
+        let problems = reopen_if_damaged(out, &on_disk)?;
+        if !problems.is_empty() {
+            eprintln!(
+                "{} holds this build, but {} file(s) are not what its {MANIFEST_FILE} records ({}); rebuilding the groups they belong to",
+                out.display(),
+                problems.len(),
+                integrity::describe(&problems, 5)
+            );
+        }
+        problems.is_empty()
+    };
     if complete {
         if opts.progress {
             eprintln!(
@@ -424,9 +504,13 @@ pub fn build(
                     dataset::write_atomic(&path, r.spec.to_json().as_bytes())
                         .map_err(|e| internal(&path, e))?;
                 }
-                // The record last: its presence says the group (specs included) is done.
+                // Then the checksums of every file the rows name, and the record last: its
+                // presence says the group (specs, media, sums) is done.
                 let path = record_path(out, g);
-                let bytes = dataset::parquet_bytes(&dataset::record_batch(&results, catalog));
+                let batch = dataset::record_batch(&results, catalog);
+                let sums = integrity::group_sums(out, &batch).map_err(|e| internal(out, e))?;
+                integrity::write_group_sums(&path, &sums).map_err(|e| internal(&path, e))?;
+                let bytes = dataset::parquet_bytes(&batch);
                 dataset::write_atomic(&path, &bytes).map_err(|e| internal(&path, e))?;
                 progress.advance(count, opts.progress);
                 Ok(())
@@ -443,7 +527,15 @@ pub fn build(
         })
         .collect::<Result<_, _>>()?;
     let rows = dataset::concat(&batches).map_err(BuildError::Internal)?;
-    let eval = finalize(out, &manifest, &rows)?;
+    let mut sums = FileSums::new();
+    for &g in &groups {
+        let path = record_path(out, g);
+        let group = integrity::read_group_sums(&path).ok_or_else(|| {
+            BuildError::Internal(format!("{}: checksums missing", integrity::group_sums_path(&path).display()))
+        })?;
+        sums.extend(group);
+    }
+    let eval = finalize(out, &manifest, &rows, sums)?;
     // Retire the records in one atomic step (a rename), then delete them: a crash in
     // between leaves a finished build whose next run only removes the leftover.
     let work = out.join(WORK_DIR);
@@ -461,21 +553,27 @@ pub fn build(
 }
 
 /// Writes the dataset's final files from its rows (in scene-index order): the data
-/// Parquet, the eval subset (whole builds), and the card. Returns the eval subset's size.
+/// Parquet, the eval subset (whole builds), and the card; then `build.json` again, now
+/// with the SHA-256 of every file (`sums`: the groups' specs and media, plus the files
+/// written here). Returns the eval subset's size.
 pub fn finalize(
     out: &Path,
     manifest: &Manifest,
     rows: &RecordBatch,
+    mut sums: FileSums,
 ) -> Result<Option<usize>, BuildError> {
     let data_file = dataset::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
     let path = out.join(&data_file);
-    dataset::write_atomic(&path, &dataset::parquet_bytes(rows)).map_err(|e| internal(&path, e))?;
+    let bytes = dataset::parquet_bytes(rows);
+    dataset::write_atomic(&path, &bytes).map_err(|e| internal(&path, e))?;
+    sums.insert(data_file.clone(), integrity::sha256_bytes(&bytes));
     let eval = if manifest.is_whole() {
         let (indices, counts) = card::eval_selection(rows);
         let subset = dataset::take_rows(rows, &indices);
         let path = out.join(card::EVAL_FILE);
-        dataset::write_atomic(&path, &dataset::parquet_bytes(&subset))
-            .map_err(|e| internal(&path, e))?;
+        let bytes = dataset::parquet_bytes(&subset);
+        dataset::write_atomic(&path, &bytes).map_err(|e| internal(&path, e))?;
+        sums.insert(card::EVAL_FILE.to_string(), integrity::sha256_bytes(&bytes));
         Some(counts)
     } else {
         None
@@ -488,6 +586,13 @@ pub fn finalize(
     });
     let path = out.join("README.md");
     dataset::write_atomic(&path, readme.as_bytes()).map_err(|e| internal(&path, e))?;
+    sums.insert("README.md".to_string(), integrity::sha256_bytes(readme.as_bytes()));
+    let finished = Manifest {
+        files: Some(sums),
+        ..manifest.clone()
+    };
+    let path = out.join(MANIFEST_FILE);
+    dataset::write_atomic(&path, finished.to_json().as_bytes()).map_err(|e| internal(&path, e))?;
     Ok(eval.map(|c| c.values().sum()))
 }
 
@@ -525,4 +630,38 @@ fn summarize(
         *summary.per_action.entry(action[i].clone()).or_default() += 1;
     }
     summary
+}
+
+/// Ctrl-C (SIGINT) or SIGTERM during a build: say that the finished groups are kept and
+/// that running the same command again resumes, then exit 130. The message is prepared
+/// before the handler is installed; the handler only writes it (async-signal-safe).
+mod interrupt {
+    use std::path::Path;
+    use std::sync::OnceLock;
+
+    static MESSAGE: OnceLock<Vec<u8>> = OnceLock::new();
+
+    extern "C" fn on_signal(_: libc::c_int) {
+        if let Some(m) = MESSAGE.get() {
+            // SAFETY: write(2) and _exit(2) are async-signal-safe; the buffer is immutable.
+            unsafe {
+                libc::write(2, m.as_ptr().cast(), m.len());
+            }
+        }
+        unsafe { libc::_exit(130) }
+    }
+
+    pub fn say_resume_on_interrupt(out: &Path) {
+        let text = format!(
+            "\nrh-pipeline: interrupted. Finished scene groups are kept in {}; run the same command again to resume (they are not recomputed, and the result is byte-identical to an uninterrupted build).\n",
+            out.display()
+        );
+        if MESSAGE.set(text.into_bytes()).is_ok() {
+            // SAFETY: installs a handler that only calls async-signal-safe functions.
+            unsafe {
+                libc::signal(libc::SIGINT, on_signal as *const () as libc::sighandler_t);
+                libc::signal(libc::SIGTERM, on_signal as *const () as libc::sighandler_t);
+            }
+        }
+    }
 }

@@ -4,7 +4,7 @@
 use crate::build::{build, BuildError, BuildOptions};
 use crate::config::Config;
 use crate::plan::{LexiconPlanner, Planner};
-use crate::verify::verify;
+use crate::verify::{verify, verify_fast};
 use clap::{Parser, Subcommand};
 use rh_catalog::Catalog;
 use std::path::PathBuf;
@@ -92,10 +92,17 @@ pub enum Command {
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
     },
-    /// Replay every spec of a dataset and compare per-step state hashes (exit 2 on any mismatch).
+    /// Check a dataset end to end (exit 2 on any problem): every file against the SHA-256
+    /// its build.json records, every spec against the one derived again from (selection,
+    /// seed, configuration), every Parquet column against the value derived from the
+    /// replay. `--fast` only replays the specs and compares per-step state hashes.
     Verify {
         /// Dataset directory built by `rh-pipeline build`.
         dir: PathBuf,
+        /// Only replay each stored spec and compare its state hash (no file checksums, no
+        /// re-derivation of specs and labels).
+        #[arg(long)]
+        fast: bool,
         /// Print the report as JSON on stdout.
         #[arg(long)]
         json: bool,
@@ -255,8 +262,10 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             })?;
             if snapshot.from_cache_only {
                 eprintln!(
-                    "the Hub at {} was not used; {repo} comes from the Hugging Face cache",
-                    rh_hub::endpoint()
+                    "the Hub at {} was not used ({}); {repo} comes from the Hugging Face cache, all {} files checked",
+                    rh_hub::endpoint(),
+                    snapshot.cache_reason.as_deref().unwrap_or("offline"),
+                    snapshot.files
                 );
             }
             let path = match out {
@@ -387,26 +396,52 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             );
             Ok(())
         }
-        Command::Verify { dir, json } => {
-            let report = verify(&dir).map_err(input)?;
+        Command::Verify { dir, fast, json } => {
+            let report = if fast {
+                verify_fast(&dir)
+            } else {
+                verify(&dir, &catalog)
+            }
+            .map_err(input)?;
             if json {
                 println!(
                     "{}",
                     serde_json::to_string_pretty(&report).expect("report serializes")
                 );
             } else {
+                for p in &report.file_problems {
+                    println!("FILE {}: {}", p.file, p.problem);
+                }
                 for m in &report.mismatches {
                     println!("MISMATCH {}: {}", m.scene_id, m.problem);
                 }
-                println!(
-                    "verified {} scenes: {} match, {} mismatch",
-                    report.scenes,
-                    report.matched,
-                    report.mismatches.len()
-                );
+                if report.mode == "full" {
+                    println!(
+                        "verified {} files against build.json: {} problem(s); {} scenes derived again: {} match, {} differ",
+                        report.files_checked,
+                        report.file_problems.len(),
+                        report.scenes,
+                        report.matched,
+                        report.scenes - report.matched
+                    );
+                } else {
+                    println!(
+                        "verified {} scenes: {} match, {} mismatch",
+                        report.scenes,
+                        report.matched,
+                        report.mismatches.len()
+                    );
+                }
             }
             if report.ok() {
                 Ok(())
+            } else if report.mode == "full" {
+                Err(input(format!(
+                    "{}: {} file problem(s), {} scene(s) differ from what their build derives",
+                    dir.display(),
+                    report.file_problems.len(),
+                    report.scenes - report.matched
+                )))
             } else {
                 Err(input(format!(
                     "{} scene(s) did not replay to their stored state hash",

@@ -14,6 +14,7 @@ pub mod cli;
 pub mod config;
 pub mod dataset;
 pub mod families;
+pub mod integrity;
 pub mod label;
 pub mod manifest;
 pub mod merge;
