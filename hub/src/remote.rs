@@ -281,7 +281,12 @@ impl Remote {
     /// all into the snapshot. Prints progress to stderr when there is much to fetch.
     pub async fn download_all(&self, cache: &RepoCache, commit: &str, entries: &[Entry]) -> Result<usize, RemoteError> {
         let mut todo = Vec::new();
+        let mut seen = std::collections::BTreeSet::new();
         for e in entries {
+            // Files with the same content share one blob: fetch it once.
+            if !seen.insert(e.blob.as_str()) {
+                continue;
+            }
             let blob = cache.blob_path(&e.blob);
             let good = blob.exists() && crate::cache::content_matches(&blob, &e.blob).unwrap_or(false);
             if !good {

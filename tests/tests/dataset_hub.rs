@@ -554,12 +554,15 @@ fn corrupt_bodies_never_enter_the_cache_and_bad_blobs_are_refetched() {
     let blobs = home.join("hub/datasets--rh-test--tiny/blobs");
 
     // An LFS file (hash: SHA-256) and a plain one (git blob SHA-1) served altered.
-    for victim in [&data, &spec] {
+    // (Each into a fresh cache: the other files are stored meanwhile.)
+    for (i, victim) in [&data, &spec].into_iter().enumerate() {
         let bad = Hub::serve_mode(files.clone(), Mode::Corrupt(victim.clone()));
+        let fresh = tmp.path().join(format!("fresh-{i}"));
+        let blobs = fresh.join("hub/datasets--rh-test--tiny/blobs");
         let (code, err, _, _) = timed(hub_cmd(
-            "rh-pipeline", &["download", REPO], &bad.endpoint, &home, Some(TOKEN),
+            "rh-pipeline", &["download", REPO], &bad.endpoint, &fresh, Some(TOKEN),
         ));
-        assert_eq!(code, Some(1), "{err}");
+        assert_eq!(code, Some(1), "{victim}: {err}");
         assert!(err.contains(victim.as_str()) && err.contains("corrupt"), "{err}");
         // Every blob in the store matches its name; no temporary is left.
         for entry in std::fs::read_dir(&blobs).unwrap() {
