@@ -23,5 +23,7 @@ for baseline in oracle majority random always-catch freeze; do
   ./target/release/rh-score baseline "$baseline" --dataset "$dataset" --model "$baseline" >> "$preds"
 done
 ./target/release/rh-score "$preds" --dataset "$dataset" \
-  --json "$out/report.json" --csv "$out/report.csv" --markdown "$out/report.md" --figures "$out/figures"
+  --json "$out/report.json" --csv "$out/report.csv" --markdown "$out/report.md" --figures "$out/figures" \
+  --html "$out/site"
 echo "quickstart: dataset in $dataset (videos/, frames/; contact sheet $out/sheet.png), report in $out/report.md, figures in $out/figures"
+echo "quickstart: open the report site: file://$(cd "$out/site" && pwd)/index.html"

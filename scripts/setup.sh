@@ -9,6 +9,8 @@ apt_packages=(
   libavfilter-dev libavdevice-dev libswresample-dev
   clang libclang-dev pkg-config ffmpeg
   python3 python3-pip python3-venv
+  chromium
+  slurm-wlm munge
 )
 python_packages=(pyarrow datasets)
 
@@ -36,6 +38,14 @@ if [ ${#py_missing[@]} -gt 0 ]; then
   echo "setup: installing Python packages: ${py_missing[*]}"
   python3 -m pip install --quiet --disable-pip-version-check "${py_missing[@]}" \
     || python3 -m pip install --quiet --disable-pip-version-check --break-system-packages "${py_missing[@]}"
+fi
+
+# Offline Kubernetes Job schema validation (tests/tests/cluster_manifests.rs); its import
+# name differs from the package's, so it has its own check.
+if ! python3 -c "import kubernetes_validate" 2>/dev/null; then
+  echo "setup: installing Python package: kubernetes-validate"
+  python3 -m pip install --quiet --disable-pip-version-check kubernetes-validate \
+    || python3 -m pip install --quiet --disable-pip-version-check --break-system-packages kubernetes-validate
 fi
 
 command -v cargo >/dev/null || { echo "setup: cargo not found; install Rust (rustup) first" >&2; exit 1; }

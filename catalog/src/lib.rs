@@ -9,26 +9,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 use std::path::Path;
 
-/// The seventeen event families (SPEC §4), in their canonical order.
-pub const FAMILIES: [&str; 17] = [
-    "object_drop",
-    "shelf_slide",
-    "hanging_fall",
-    "ceiling_drop",
-    "sliding_object",
-    "rolling_ball",
-    "surface_cascade",
-    "furniture_tip",
-    "stack_collapse",
-    "ladder_slip",
-    "door_swing",
-    "pendulum_swing",
-    "thrown_object",
-    "bouncing_object",
-    "stair_tumble",
-    "chain_reaction",
-    "multi_object",
-];
+/// The seventeen event families (SPEC §4), in their canonical order (the data contract's).
+pub use rh_contract::FAMILIES;
 
 /// Hazard flags an object may carry (SPEC §5). `heavy` must agree with the mass.
 pub const HAZARDS: [&str; 5] = ["sharp", "hot", "heavy", "fragile", "large"];
@@ -560,35 +542,7 @@ fn validate_objects(file: &str, raw: Vec<RawObject>) -> Result<Vec<Object>, Cata
         if o.parts.is_empty() {
             return Err(check.fail("parts", "must have at least one part"));
         }
-        for (k, p) in o.parts.iter().enumerate() {
-            let field = format!("parts[{k}].size");
-            if p.size.len() != p.expected_size_len() {
-                return Err(check.fail(
-                    &field,
-                    format!(
-                        "a {:?} needs {} numbers (got {})",
-                        p.shape,
-                        p.expected_size_len(),
-                        p.size.len()
-                    ),
-                ));
-            }
-            for &s in &p.size {
-                check.range(&field, s, SIZE_RANGE_M.0, SIZE_RANGE_M.1, " m")?;
-            }
-            if p.shape == ShapeKind::Capsule && p.size[1] < p.size[0] {
-                return Err(check.fail(&field, "a capsule's length must be at least its diameter"));
-            }
-            for &v in &p.offset {
-                check.range(
-                    &format!("parts[{k}].offset"),
-                    v,
-                    -SIZE_RANGE_M.1,
-                    SIZE_RANGE_M.1,
-                    " m",
-                )?;
-            }
-        }
+        check_parts(&check, &o.parts)?;
         let volume: f64 = o.parts.iter().map(Part::volume).sum();
         let (density, mass) = match (o.density, o.mass) {
             (Some(_), Some(_)) => {
@@ -647,9 +601,48 @@ fn validate_objects(file: &str, raw: Vec<RawObject>) -> Result<Vec<Object>, Cata
             looks_like: o.looks_like,
         });
     }
-    // Look-alikes need the whole list: an adversarial entry must point at a genuine
-    // object and share its shape, so that rendering it "exactly like" the other is honest.
-    for o in &objects {
+    check_look_alikes(file, &objects)?;
+    Ok(objects)
+}
+
+/// Each part's size (as many numbers as its shape needs, within range) and offset.
+fn check_parts(check: &EntryCheck, parts: &[Part]) -> Result<(), CatalogError> {
+    for (k, p) in parts.iter().enumerate() {
+        let field = format!("parts[{k}].size");
+        if p.size.len() != p.expected_size_len() {
+            return Err(check.fail(
+                &field,
+                format!(
+                    "a {:?} needs {} numbers (got {})",
+                    p.shape,
+                    p.expected_size_len(),
+                    p.size.len()
+                ),
+            ));
+        }
+        for &s in &p.size {
+            check.range(&field, s, SIZE_RANGE_M.0, SIZE_RANGE_M.1, " m")?;
+        }
+        if p.shape == ShapeKind::Capsule && p.size[1] < p.size[0] {
+            return Err(check.fail(&field, "a capsule's length must be at least its diameter"));
+        }
+        for &v in &p.offset {
+            check.range(
+                &format!("parts[{k}].offset"),
+                v,
+                -SIZE_RANGE_M.1,
+                SIZE_RANGE_M.1,
+                " m",
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// Look-alikes need the whole list: an adversarial entry must point at a genuine
+/// object and share its shape, so that rendering it "exactly like" the other is honest.
+fn check_look_alikes(file: &str, objects: &[Object]) -> Result<(), CatalogError> {
+    for o in objects {
         let Some(target) = &o.looks_like else {
             continue;
         };
@@ -676,7 +669,7 @@ fn validate_objects(file: &str, raw: Vec<RawObject>) -> Result<Vec<Object>, Cata
             ));
         }
     }
-    Ok(objects)
+    Ok(())
 }
 
 fn validate_rooms(file: &str, raw: Vec<RawRoom>) -> Result<Vec<Room>, CatalogError> {

@@ -7,8 +7,8 @@
 use rayon::prelude::*;
 use rh_catalog::Catalog;
 use rh_pipeline::config::Config;
-use rh_pipeline::plan::plan_group;
 use rh_pipeline::scene::produce_group;
+use rh_pipeline::selection::plan_group;
 use std::time::Instant;
 
 fn main() {

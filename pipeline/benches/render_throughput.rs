@@ -14,9 +14,9 @@
 use rayon::prelude::*;
 use rh_catalog::Catalog;
 use rh_pipeline::config::Config;
-use rh_pipeline::plan::plan_group;
 use rh_pipeline::render::{with_thread_renderer, RenderOptions};
 use rh_pipeline::scene::produce_group;
+use rh_pipeline::selection::plan_group;
 use rh_pipeline::simulate::{simulate, SimOptions};
 use std::time::Instant;
 

@@ -18,8 +18,8 @@
 use crate::config::Config;
 use crate::families;
 use crate::label::Action;
-use crate::plan::plan_group;
 use crate::scene::produce_group;
+use crate::selection::plan_group;
 use rh_catalog::Catalog;
 use serde::Serialize;
 

@@ -23,11 +23,10 @@ use crate::config::Config;
 use crate::dataset;
 use crate::families;
 use crate::integrity::{self, FileSums};
+pub use crate::records::{record_path, WORK_DIR};
+use crate::records::{group_files, load_record, reopen_if_damaged};
 use crate::manifest::{Manifest, MANIFEST_FILE};
-use crate::plan::plan_group;
-use crate::render::{with_thread_renderer, RenderOptions, Renderer};
-use crate::scene::{produce_group, SceneMedia, SceneResult};
-use crate::simulate::{simulate, SimOptions};
+use crate::scene::{run_group, GroupError, RenderStage};
 use arrow::array::RecordBatch;
 use rayon::prelude::*;
 use rh_catalog::Catalog;
@@ -36,9 +35,6 @@ use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
-
-/// Work-in-progress folder of an unfinished build (removed when the build completes).
-pub const WORK_DIR: &str = ".rh-build";
 
 #[derive(Debug, Clone)]
 pub struct BuildOptions {
@@ -104,10 +100,10 @@ pub fn check_options(
         ));
     }
     for f in &opts.families {
-        if !rh_catalog::FAMILIES.contains(&f.as_str()) {
+        if !rh_contract::FAMILIES.contains(&f.as_str()) {
             return Err(BuildError::Input(format!(
                 "unknown family '{f}' (known: {})",
-                rh_catalog::FAMILIES.join(", ")
+                rh_contract::FAMILIES.join(", ")
             )));
         }
         if families::get(f).is_none() {
@@ -185,11 +181,62 @@ fn internal(path: &Path, e: impl std::fmt::Display) -> BuildError {
     BuildError::Internal(format!("{}: {e}", path.display()))
 }
 
-/// Path of group `g`'s record.
-pub fn record_path(out: &Path, g: u64) -> PathBuf {
-    out.join(WORK_DIR)
-        .join("groups")
-        .join(format!("{g:08}.parquet"))
+/// Makes finished groups durable off the workers' path: fsyncs each file of a group and
+/// renames it into place, in the order given (specs, then the record last, so a record
+/// never names a spec that is not there). Workers hand over a group and go on simulating
+/// while a few threads wait on the disk (fsync is I/O wait, not CPU: done inline it took
+/// 10-30% of a label-only build on a busy disk). At most `SYNC_BACKLOG` groups wait.
+struct Syncer {
+    tx: Option<std::sync::mpsc::SyncSender<Vec<crate::fsio::Unsynced>>>,
+    threads: Vec<std::thread::JoinHandle<Result<(), BuildError>>>,
+}
+
+const SYNC_THREADS: usize = 4;
+const SYNC_BACKLOG: usize = 32;
+
+impl Syncer {
+    fn start() -> Syncer {
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<crate::fsio::Unsynced>>(SYNC_BACKLOG);
+        let rx = std::sync::Arc::new(std::sync::Mutex::new(rx));
+        let threads = (0..SYNC_THREADS)
+            .map(|_| {
+                let rx = rx.clone();
+                std::thread::spawn(move || loop {
+                    let next = rx.lock().expect("syncer queue").recv();
+                    let Ok(files) = next else { return Ok(()) };
+                    for f in files {
+                        let path = f.path().to_path_buf();
+                        f.commit().map_err(|e| internal(&path, e))?;
+                    }
+                })
+            })
+            .collect();
+        Syncer {
+            tx: Some(tx),
+            threads,
+        }
+    }
+
+    fn submit(&self, files: Vec<crate::fsio::Unsynced>) -> Result<(), BuildError> {
+        let tx = self.tx.as_ref().expect("open until finish");
+        tx.send(files)
+            .map_err(|_| BuildError::Internal("the file syncer stopped".into()))
+    }
+
+    /// Waits until every submitted file is in place; the first error, if any.
+    fn finish(mut self) -> Result<(), BuildError> {
+        drop(self.tx.take());
+        let mut result = Ok(());
+        for t in self.threads.drain(..) {
+            let r = t
+                .join()
+                .unwrap_or_else(|_| Err(BuildError::Internal("file syncer panicked".into())));
+            if result.is_ok() {
+                result = r;
+            }
+        }
+        result
+    }
 }
 
 /// Holds an exclusive `flock` on a directory while alive (released by the kernel when
@@ -299,101 +346,77 @@ pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError
     Ok(!out.join(WORK_DIR).exists() && data.exists() && out.join("README.md").exists())
 }
 
-/// Renders a valid scene's videos and frames into `out` (stage 4). Invalid scenes are
-/// not rendered: their video columns stay null. The simulation is run again from the
-/// spec (milliseconds, and identical by construction) rather than kept per group.
-fn render_scene(
-    r: &SceneResult,
-    catalog: &Catalog,
-    opts: &RenderOptions,
-    out: &Path,
-) -> Result<Option<SceneMedia>, BuildError> {
-    if !r.verdicts.all() || r.spec.cameras.is_empty() {
+/// Fails before any work when rendering is requested but impossible: no GPU, no
+/// encoder, or a program built without the `render` feature.
+fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<Option<String>, BuildError> {
+    if !opts.render {
         return Ok(None);
     }
-    let sim = simulate(&r.spec, SimOptions::default());
-    let rendered = with_thread_renderer(opts, |renderer| {
-        renderer.render_scene(&r.spec, &sim, catalog, out)
-    })
-    .and_then(|x| x)
-    .map_err(|e| BuildError::Internal(format!("render {}: {e}", r.spec.scene_id)))?;
-    Ok(Some(SceneMedia {
-        videos: rendered.videos,
-        full_event: rendered.full_event,
-    }))
+    #[cfg(not(feature = "render"))]
+    {
+        let _ = config;
+        Err(BuildError::Input(
+            "rendering was requested, but this rh-pipeline was built without the `render` \
+             feature (cargo build --no-default-features): build with --no-render, or use a \
+             build with default features"
+                .into(),
+        ))
+    }
+    #[cfg(feature = "render")]
+    {
+        let renderer =
+            crate::render::Renderer::new(crate::render::RenderOptions::from_config(&config.render))
+                .map_err(|e| {
+                    BuildError::Input(format!("render stage: {e} (or build with --no-render)"))
+                })?;
+        Ok(Some(format!(
+            "rendering on {} ({} MSAA samples)",
+            renderer.adapter_name(),
+            renderer.samples()
+        )))
+    }
 }
 
-/// Reads group `g`'s record if it is there and whole (right rows, every file it names
-/// present: specs, videos, frames).
-fn load_record(out: &Path, manifest: &Manifest, g: u64) -> Option<RecordBatch> {
-    let path = record_path(out, g);
-    if !path.exists() {
-        return None;
+/// A build that `claim_out_dir` found complete (`complete`): its summary when every file
+/// is what its manifest records, else None after reopening it (the damaged groups'
+/// records removed, the intact ones kept) so that the build goes on and repairs it.
+fn finished_build(
+    out: &Path,
+    manifest: &Manifest,
+    complete: bool,
+    progress: bool,
+) -> Result<Option<BuildSummary>, BuildError> {
+    if !complete {
+        return Ok(None);
     }
-    let batch = dataset::read_batch(&path).ok()?;
-    let indices = dataset::u64_column(&batch, "scene_index");
-    let expected: Vec<u64> = (g * 4..g * 4 + manifest.group_size(g)).collect();
-    if indices != expected {
-        return None;
-    }
-    // Every file the rows name, with the checksum recorded when the group finished.
-    let sums = integrity::read_group_sums(&path)?;
-    let named: Vec<String> = dataset::referenced_files(&batch);
-    if named.len() != sums.len() || !named.iter().all(|f| sums.contains_key(f)) {
-        return None;
-    }
-    let problems = integrity::check(out, &sums);
+    let on_disk = Manifest::read(out)
+        .map_err(BuildError::Input)?
+        .unwrap_or_else(|| manifest.clone());
+    let problems = reopen_if_damaged(out, &on_disk).map_err(BuildError::Internal)?;
     if !problems.is_empty() {
         eprintln!(
-            "group {g}: {}; computing it again",
-            integrity::describe(&problems, 3)
+            "{} holds this build, but {} file(s) are not what its {MANIFEST_FILE} records ({}); rebuilding the groups they belong to",
+            out.display(),
+            problems.len(),
+            integrity::describe(&problems, 5)
         );
-        return None;
+        return Ok(None);
     }
-    Some(batch)
-}
-
-/// A finished build whose files are not all what its manifest records: turns it back
-/// into an unfinished one, keeping (as records) the groups whose files are intact, so
-/// the run recomputes only the damaged groups. Returns the problems found (empty: the
-/// build is intact and nothing was changed).
-fn reopen_if_damaged(out: &Path, manifest: &Manifest) -> Result<Vec<integrity::FileProblem>, BuildError> {
-    let Some(sums) = &manifest.files else {
-        // A finished build of a version that recorded no checksums: nothing to compare.
-        return Ok(vec![]);
-    };
-    let problems = integrity::check(out, sums);
-    if problems.is_empty() {
-        return Ok(problems);
+    if progress {
+        eprintln!(
+            "{} already holds this build, complete; nothing to do",
+            out.display()
+        );
     }
-    let groups_dir = out.join(WORK_DIR).join("groups");
-    std::fs::create_dir_all(&groups_dir).map_err(|e| internal(&groups_dir, e))?;
     let data_file = dataset::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
-    let data_ok = !problems.iter().any(|p| p.file == data_file);
-    let rows = if data_ok {
-        dataset::read_batch(&out.join(&data_file)).ok()
-    } else {
-        None
-    };
-    if let Some(rows) = rows {
-        let bad: std::collections::BTreeSet<&str> = problems.iter().map(|p| p.file.as_str()).collect();
-        let index = dataset::u64_column(&rows, "scene_index");
-        for g in manifest.groups() {
-            let picks: Vec<u32> = (0..rows.num_rows() as u32)
-                .filter(|&i| index[i as usize] / 4 == g)
-                .collect();
-            let batch = dataset::take_rows(&rows, &picks);
-            let files = dataset::referenced_files(&batch);
-            if picks.is_empty() || files.iter().any(|f| bad.contains(f.as_str()) || !sums.contains_key(f)) {
-                continue;
-            }
-            let group_sums: FileSums = files.iter().map(|f| (f.clone(), sums[f].clone())).collect();
-            let record = record_path(out, g);
-            integrity::write_group_sums(&record, &group_sums).map_err(|e| internal(&record, e))?;
-            dataset::write_atomic(&record, &dataset::parquet_bytes(&batch)).map_err(|e| internal(&record, e))?;
-        }
-    }
-    Ok(problems)
+    let rows = dataset::read_columns(&out.join(&data_file), &dataset::SUMMARY_COLUMNS)
+        .map_err(BuildError::Internal)?;
+    let eval = out
+        .join(card::EVAL_FILE)
+        .exists()
+        .then(|| card::eval_selection(&rows).0.len());
+    let groups = manifest.groups().len();
+    Ok(Some(summarize(out, &rows, data_file, groups, 0, eval)))
 }
 
 /// Builds the dataset described by `opts`.
@@ -403,20 +426,9 @@ pub fn build(
     config: &Config,
 ) -> Result<BuildSummary, BuildError> {
     check_options(opts, catalog, config)?;
-    let render_opts = RenderOptions::from_config(&config.render);
-    if opts.render {
-        // Fail before any work when there is nothing to render with.
-        let renderer = Renderer::new(render_opts.clone()).map_err(|e| {
-            BuildError::Input(format!("render stage: {e} (or build with --no-render)"))
-        })?;
-        if opts.progress {
-            eprintln!(
-                "rendering on {} ({} MSAA samples)",
-                renderer.adapter_name(),
-                renderer.samples()
-            );
-        }
-    }
+    // Fail before any work when there is nothing to render with; say what renders only
+    // once there is something to render (not before "nothing to do").
+    let render_banner = check_render_stage(opts, config)?;
     let manifest = Manifest::new(
         opts.seed,
         opts.n,
@@ -436,34 +448,9 @@ pub fn build(
     let data_file = dataset::data_file_name(opts.shard.0 as usize, opts.shard.1 as usize);
     let groups = manifest.groups();
 
-    let complete = complete && {
-        let on_disk = Manifest::read(out).map_err(BuildError::Input)?.unwrap_or_else(|| manifest.clone());
-        let problems = reopen_if_damaged(out, &on_disk)?;
-        if !problems.is_empty() {
-            eprintln!(
-                "{} holds this build, but {} file(s) are not what its {MANIFEST_FILE} records ({}); rebuilding the groups they belong to",
-                out.display(),
-                problems.len(),
-                integrity::describe(&problems, 5)
-            );
-        }
-        problems.is_empty()
-    };
-    if complete {
-        if opts.progress {
-            eprintln!(
-                "{} already holds this build, complete; nothing to do",
-                out.display()
-            );
-        }
-        let rows = dataset::read_batch(&out.join(&data_file)).map_err(BuildError::Internal)?;
-        let eval = out
-            .join(card::EVAL_FILE)
-            .exists()
-            .then(|| card::eval_selection(&rows).0.len());
-        return Ok(summarize(out, &rows, data_file, groups.len(), 0, eval));
+    if let Some(summary) = finished_build(out, &manifest, complete, opts.progress)? {
+        return Ok(summary);
     }
-
     for sub in ["specs", "data", ".rh-build/groups"] {
         std::fs::create_dir_all(out.join(sub)).map_err(|e| internal(&out.join(sub), e))?;
     }
@@ -479,63 +466,63 @@ pub fn build(
         );
     }
 
+    // Stage 4 for the DAG driver (`scene::run_group`): a valid scene's videos and frames.
+    #[cfg(feature = "render")]
+    let render_opts = crate::render::RenderOptions::from_config(&config.render);
+    #[cfg(feature = "render")]
+    let render_stage = |r: &crate::scene::SceneResult| {
+        crate::render::render_stage(r, catalog, &render_opts, out)
+            .map_err(|e| format!("render {}: {e}", r.spec.scene_id))
+    };
+    #[cfg(feature = "render")]
+    let render: Option<&RenderStage> = opts.render.then_some(&render_stage as &RenderStage);
+    #[cfg(not(feature = "render"))]
+    let render: Option<&RenderStage> = None;
+
     let scenes_todo: u64 = todo.iter().map(|&g| manifest.group_size(g)).sum();
+    if let (Some(banner), true) = (&render_banner, opts.progress && scenes_todo > 0) {
+        eprintln!("{banner}");
+    }
     let progress = Progress::new(scenes_todo, opts.progress);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs)
         .build()
         .map_err(|e| BuildError::Internal(format!("thread pool: {e}")))?;
-    pool.install(|| {
+    let syncer = Syncer::start();
+    let produced = pool.install(|| {
         todo.par_iter()
             .try_for_each(|&g| -> Result<(), BuildError> {
-                let selection = plan_group(catalog, &opts.families, opts.seed, g)
-                    .map_err(|e| BuildError::Input(e.to_string()))?;
                 let count = manifest.group_size(g);
-                let mut results =
-                    produce_group(&selection, opts.seed, g * 4, count, catalog, config)
-                        .map_err(|e| BuildError::Input(e.to_string()))?;
-                if opts.render {
-                    for r in results.iter_mut() {
-                        r.media = render_scene(r, catalog, &render_opts, out)?;
-                    }
-                }
-                for r in &results {
-                    let path = out.join(dataset::spec_path(&r.spec.scene_id));
-                    dataset::write_atomic(&path, r.spec.to_json().as_bytes())
-                        .map_err(|e| internal(&path, e))?;
-                }
-                // Then the checksums of every file the rows name, and the record last: its
-                // presence says the group (specs, media, sums) is done.
-                let path = record_path(out, g);
-                let batch = dataset::record_batch(&results, catalog);
-                let sums = integrity::group_sums(out, &batch).map_err(|e| internal(out, e))?;
-                integrity::write_group_sums(&path, &sums).map_err(|e| internal(&path, e))?;
-                let bytes = dataset::parquet_bytes(&batch);
-                dataset::write_atomic(&path, &bytes).map_err(|e| internal(&path, e))?;
+                let results =
+                    run_group(catalog, &opts.families, opts.seed, g, count, config, render)
+                        .map_err(|e| match e {
+                            GroupError::Input(m) => BuildError::Input(m),
+                            GroupError::Render(m) => BuildError::Internal(m),
+                        })?;
+                // Specs, then the checksums of every file the rows name, and the record
+                // last: its presence says the group (specs, media, sums) is done.
+                let files = group_files(out, g, &results, catalog).map_err(BuildError::Internal)?;
+                syncer.submit(files)?;
                 progress.advance(count, opts.progress);
                 Ok(())
             })
-    })?;
+    });
+    // Every submitted group is made durable, also when a worker failed.
+    let synced = syncer.finish();
+    synced?;
+    produced?;
     progress.finish();
 
-    // Every group's rows, from the records, in scene-index order.
-    let batches: Vec<RecordBatch> = groups
-        .iter()
-        .map(|&g| {
-            let path = record_path(out, g);
-            dataset::read_batch(&path).map_err(BuildError::Internal)
-        })
-        .collect::<Result<_, _>>()?;
-    let rows = dataset::concat(&batches).map_err(BuildError::Internal)?;
-    let mut sums = FileSums::new();
-    for &g in &groups {
-        let path = record_path(out, g);
-        let group = integrity::read_group_sums(&path).ok_or_else(|| {
-            BuildError::Internal(format!("{}: checksums missing", integrity::group_sums_path(&path).display()))
-        })?;
-        sums.extend(group);
-    }
-    let eval = finalize(out, &manifest, &rows, sums)?;
+    // Every group's rows, from the records, in scene-index order: streamed, one group
+    // at a time, so memory does not grow with --n.
+    let records = |f: &mut RowSink| -> Result<(), BuildError> {
+        for &g in &groups {
+            f(dataset::read_batch(&record_path(out, g)).map_err(BuildError::Internal)?)?;
+        }
+        Ok(())
+    };
+    let sums = crate::records::gather_sums(out, &groups).map_err(BuildError::Internal)?;
+    let (rows, eval) = finalize(out, &manifest, &records, sums)?;
     // Retire the records in one atomic step (a rename), then delete them: a crash in
     // between leaves a finished build whose next run only removes the leftover.
     let work = out.join(WORK_DIR);
@@ -552,24 +539,53 @@ pub fn build(
     ))
 }
 
-/// Writes the dataset's final files from its rows (in scene-index order): the data
-/// Parquet, the eval subset (whole builds), and the card; then `build.json` again, now
-/// with the SHA-256 of every file (`sums`: the groups' specs and media, plus the files
-/// written here). Returns the eval subset's size.
+/// Receives a dataset's rows, a batch at a time.
+pub type RowSink<'a> = dyn FnMut(RecordBatch) -> Result<(), BuildError> + 'a;
+
+/// Feeds every row of a dataset, in scene-index order, to the sink; may be called more
+/// than once and must give the same rows each time.
+pub type RowSource<'a> = dyn Fn(&mut RowSink) -> Result<(), BuildError> + 'a;
+
+/// Writes the dataset's final files from its rows (in scene-index order, streamed from
+/// `rows`): the data Parquet (row group by row group), the eval subset (whole builds; a
+/// second pass over the rows picks it), and the card. Memory stays flat in the number of
+/// rows but for `dataset::SUMMARY_COLUMNS`, which it returns (every row, those columns)
+/// with the eval subset's size. Then it writes `build.json` again, now with the SHA-256
+/// of every file (`sums`: the groups' specs and media, plus the files written here).
 pub fn finalize(
     out: &Path,
     manifest: &Manifest,
-    rows: &RecordBatch,
+    rows: &RowSource,
     mut sums: FileSums,
-) -> Result<Option<usize>, BuildError> {
+) -> Result<(RecordBatch, Option<usize>), BuildError> {
     let data_file = dataset::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
-    let path = out.join(&data_file);
-    let bytes = dataset::parquet_bytes(rows);
-    dataset::write_atomic(&path, &bytes).map_err(|e| internal(&path, e))?;
-    sums.insert(data_file.clone(), integrity::sha256_bytes(&bytes));
+    let data_path = out.join(&data_file);
+    let mut data = dataset::ParquetStream::create(&data_path).map_err(BuildError::Internal)?;
+    let summary_schema = dataset::project(
+        &RecordBatch::new_empty(std::sync::Arc::new(dataset::schema())),
+        &dataset::SUMMARY_COLUMNS,
+    )
+    .schema();
+    let compact = |parts: &[RecordBatch]| {
+        arrow::compute::concat_batches(&summary_schema, parts)
+            .map_err(|e| BuildError::Internal(e.to_string()))
+    };
+    let mut summary: Vec<RecordBatch> = Vec::new();
+    rows(&mut |batch| {
+        data.write(&batch).map_err(BuildError::Internal)?;
+        summary.push(dataset::project(&batch, &dataset::SUMMARY_COLUMNS));
+        if summary.len() >= 256 {
+            summary = vec![compact(&summary)?];
+        }
+        Ok(())
+    })?;
+    data.finish().map_err(BuildError::Internal)?;
+    let data_sum = integrity::sha256_file(&data_path).map_err(|e| internal(&data_path, e))?;
+    sums.insert(data_file.clone(), data_sum);
+    let summary = compact(&summary)?;
     let eval = if manifest.is_whole() {
-        let (indices, counts) = card::eval_selection(rows);
-        let subset = dataset::take_rows(rows, &indices);
+        let (indices, counts) = card::eval_selection(&summary);
+        let subset = take_streamed(rows, &indices)?;
         let path = out.join(card::EVAL_FILE);
         let bytes = dataset::parquet_bytes(&subset);
         dataset::write_atomic(&path, &bytes).map_err(|e| internal(&path, e))?;
@@ -580,7 +596,7 @@ pub fn finalize(
     };
     let readme = card::render(&card::CardInput {
         manifest,
-        rows,
+        rows: &summary,
         data_files: std::slice::from_ref(&data_file),
         eval: eval.as_ref(),
     });
@@ -593,7 +609,28 @@ pub fn finalize(
     };
     let path = out.join(MANIFEST_FILE);
     dataset::write_atomic(&path, finished.to_json().as_bytes()).map_err(|e| internal(&path, e))?;
-    Ok(eval.map(|c| c.values().sum()))
+    Ok((summary, eval.map(|c| c.values().sum())))
+}
+
+/// The rows at `indices` (ascending positions in the whole table) of a streamed table.
+fn take_streamed(rows: &RowSource, indices: &[u32]) -> Result<RecordBatch, BuildError> {
+    let mut parts = Vec::new();
+    let (mut offset, mut next) = (0usize, 0usize);
+    rows(&mut |batch| {
+        let end = offset + batch.num_rows();
+        let local: Vec<u32> = indices[next..]
+            .iter()
+            .take_while(|&&i| (i as usize) < end)
+            .map(|&i| i - offset as u32)
+            .collect();
+        next += local.len();
+        if !local.is_empty() {
+            parts.push(dataset::take_rows(&batch, &local));
+        }
+        offset = end;
+        Ok(())
+    })?;
+    dataset::concat(&parts).map_err(BuildError::Internal)
 }
 
 fn summarize(

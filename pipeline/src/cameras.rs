@@ -11,13 +11,39 @@ use rand::RngExt;
 pub const CAMERA_NAMES: [&str; 3] = ["ego", "closeup", "overhead"];
 const FRAMING_ATTEMPTS: u32 = 8;
 
-/// Framing policy (from the `[validators]` config).
-#[derive(Debug, Clone, Copy)]
-pub struct FramingRules {
-    /// Margin kept inside the image border (fraction of the half-size).
-    pub margin: f64,
-    /// Stop checking once the hazard is this close to the observer's torso axis (m).
-    pub until_within: f64,
+pub use crate::config::FramingRules;
+
+/// The unit vector from a camera's position toward its `look_at`.
+fn forward(camera: &CameraSpec) -> Vec3 {
+    let f = sub(camera.look_at, camera.position);
+    scale(f, 1.0 / norm(f).max(1e-12))
+}
+
+/// The right-handed basis (right, up, forward) with the given `right` direction.
+fn complete_basis(f: Vec3, r: Vec3) -> (Vec3, Vec3, Vec3) {
+    let r = scale(r, 1.0 / norm(r));
+    let u = cross(r, f);
+    (r, u, f)
+}
+
+/// A camera's basis (right, up, forward) with +z up: `None` when it looks (nearly)
+/// straight up or down, where "+z up" is undefined.
+pub fn basis(camera: &CameraSpec) -> Option<(Vec3, Vec3, Vec3)> {
+    let f = forward(camera);
+    let r = cross(f, [0.0, 0.0, 1.0]);
+    if norm(r) < 1e-3 {
+        return None;
+    }
+    Some(complete_basis(f, r))
+}
+
+/// The basis the renderer draws with: [`basis`], and for a camera looking straight up or
+/// down (which the validator rejects) +y as the hint, so something sensible is drawn.
+pub fn draw_basis(camera: &CameraSpec) -> (Vec3, Vec3, Vec3) {
+    basis(camera).unwrap_or_else(|| {
+        let f = forward(camera);
+        complete_basis(f, cross(f, [0.0, 1.0, 0.0]))
+    })
 }
 
 /// A pinhole camera looking from `position` to `look_at` with +z up.
@@ -33,14 +59,7 @@ pub struct View {
 impl View {
     /// None when the camera looks (nearly) straight up or down, where "+z up" is undefined.
     pub fn new(camera: &CameraSpec) -> Option<View> {
-        let f = sub(camera.look_at, camera.position);
-        let f = scale(f, 1.0 / norm(f).max(1e-12));
-        let r = cross(f, [0.0, 0.0, 1.0]);
-        if norm(r) < 1e-3 {
-            return None;
-        }
-        let r = scale(r, 1.0 / norm(r));
-        let u = cross(r, f);
+        let (r, u, f) = basis(camera)?;
         let tan_half_y = (camera.fov_y / 2.0).tan();
         Some(View {
             position: camera.position,
@@ -106,8 +125,14 @@ pub fn hazard_in_frame(
 /// Aims a camera at `position` so that every point is in view: it looks along the
 /// bisector of the two most widely separated directions to the points, with the
 /// vertical field of view that holds them all times `slack`. None when that would need
-/// more than `MAX_FOV_Y`.
-fn fit_view(position: Vec3, points: &[Vec3], aspect: f64, slack: f64) -> Option<(Vec3, f64)> {
+/// more than `max_fov_y`.
+fn fit_view(
+    position: Vec3,
+    points: &[Vec3],
+    aspect: f64,
+    slack: f64,
+    max_fov_y: f64,
+) -> Option<(Vec3, f64)> {
     let mut dirs = Vec::with_capacity(points.len());
     for p in points {
         let d = sub(*p, position);
@@ -161,11 +186,8 @@ fn fit_view(position: Vec3, points: &[Vec3], aspect: f64, slack: f64) -> Option<
             .max((dot(d, view.right) / z).abs() / aspect);
     }
     let fov_y = 2.0 * (need * slack).max(0.2).atan();
-    (fov_y <= MAX_FOV_Y).then_some((look_at, fov_y))
+    (fov_y <= max_fov_y).then_some((look_at, fov_y))
 }
-
-/// The widest vertical field of view a camera may get (rad, about 120°).
-const MAX_FOV_Y: f64 = 2.1;
 
 /// Chooses camera poses for a simulated scene: up to eight draws from the scene's
 /// "cameras" stream; the first whose three views hold the hazard wins. None when none do.
@@ -173,14 +195,20 @@ pub fn frame(spec: &SceneSpec, sim: &Simulation, rules: &FramingRules) -> Option
     let steps = window_steps(spec, sim, rules.until_within);
     let path: Vec<Vec3> = steps.iter().map(|&k| sim.hazard_position(k)).collect();
     (0..FRAMING_ATTEMPTS).find_map(|k| {
-        let cameras = draw(spec, k, &path, rules.margin)?;
+        let cameras = draw(spec, k, &path, rules)?;
         hazard_in_frame(spec, sim, &cameras, rules).then_some(cameras)
     })
 }
 
 /// Camera draw `k`: positions from the "cameras" stream, aims and fields of view fitted
 /// to the hazard's path.
-pub fn draw(spec: &SceneSpec, k: u32, path: &[Vec3], margin: f64) -> Option<Vec<CameraSpec>> {
+pub fn draw(
+    spec: &SceneSpec,
+    k: u32,
+    path: &[Vec3],
+    rules: &FramingRules,
+) -> Option<Vec<CameraSpec>> {
+    let margin = rules.margin;
     let mut rng = crate::seeds::stream(
         spec.seed,
         spec.attempt * 1000 + k,
@@ -210,20 +238,18 @@ pub fn draw(spec: &SceneSpec, k: u32, path: &[Vec3], margin: f64) -> Option<Vec<
         rng.random_range(0.9..1.5),
     ];
     let place = |name: &str, position: Vec3, slack: f64| {
-        fit_view(position, path, aspect, slack).map(|(look_at, fov_y)| CameraSpec {
-            name: name.to_string(),
-            position,
-            look_at,
-            fov_y,
-            width,
-            height,
+        fit_view(position, path, aspect, slack, rules.max_fov_y).map(|(look_at, fov_y)| {
+            CameraSpec {
+                name: name.to_string(),
+                position,
+                look_at,
+                fov_y,
+                width,
+                height,
+            }
         })
     };
-    let ego = place("ego", [o.x, o.y, o.height - 0.08], slack[0]);
-    if std::env::var("RH_DEBUG_CAM").is_ok() {
-        eprintln!("ego {:?}", ego.as_ref().map(|c| c.fov_y));
-    }
-    let ego = ego?;
+    let ego = place("ego", [o.x, o.y, o.height - 0.08], slack[0])?;
     let closeup = place(
         "closeup",
         [
@@ -236,9 +262,6 @@ pub fn draw(spec: &SceneSpec, k: u32, path: &[Vec3], margin: f64) -> Option<Vec<
     // A cutaway view from above the ceiling line (the renderer leaves the ceiling out),
     // offset sideways so it never looks straight down.
     let mid = [(o.x + start[0]) / 2.0, (o.y + start[1]) / 2.0];
-    if std::env::var("RH_DEBUG_CAM").is_ok() {
-        eprintln!("closeup {:?}", closeup.fov_y);
-    }
     let overhead = place(
         "overhead",
         [
@@ -247,14 +270,7 @@ pub fn draw(spec: &SceneSpec, k: u32, path: &[Vec3], margin: f64) -> Option<Vec<
             spec.room.ceiling_height + over[2],
         ],
         slack[2],
-    );
-    if std::env::var("RH_DEBUG_CAM").is_ok() {
-        eprintln!(
-            "overhead {:?}",
-            overhead.as_ref().map(|c| (c.fov_y, c.position))
-        );
-    }
-    let overhead = overhead?;
+    )?;
     Some(vec![ego, closeup, overhead])
 }
 

@@ -21,6 +21,27 @@ pub const EVAL_PER_FAMILY: usize = 18;
 /// The `eval` config's Parquet file.
 pub const EVAL_FILE: &str = "eval/test-00000-of-00001.parquet";
 
+/// How to get videos from the `*_file_name` columns (plain relative paths).
+const VIDEO_NOTE: &str = r#"**Videos.** The `ego_file_name`, `closeup_file_name`, `overhead_file_name` and
+`full_event_file_name` columns hold paths relative to this folder (plain strings, so pyarrow,
+pandas, polars and duckdb read the table as is; null for invalid or unrendered scenes). To
+get decodable videos in `datasets` (decoding needs `torchcodec`), make them absolute and cast
+them to `Video`:
+
+```python
+from datasets import Video
+def media(row):
+    return {cam: os.path.join(DIR, row[f"{cam}_file_name"]) if row[f"{cam}_file_name"] else None
+            for cam in ("ego", "closeup", "overhead", "full_event")}
+scenes = scenes.map(media)
+for cam in ("ego", "closeup", "overhead", "full_event"):
+    scenes = scenes.cast_column(cam, Video())
+# scenes[0]["ego"] is a torchcodec VideoDecoder; frame k shows physics step frame_steps[k]
+```
+
+For a Hub copy, `DIR = huggingface_hub.snapshot_download("owner/name", repo_type="dataset")`
+fetches the videos too."#;
+
 /// Per-family counts of a set of rows.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct FamilyCounts {
@@ -103,6 +124,21 @@ pub fn select_eval(rows: &[(&str, u64, bool)]) -> (Vec<u32>, BTreeMap<String, us
     }
     chosen.sort_by_key(|&r| index(r));
     (chosen.into_iter().map(|r| r as u32).collect(), counts)
+}
+
+/// "object_drop 4, shelf_slide 4, …" (families in name order).
+fn eval_counts_text(eval: &BTreeMap<String, usize>) -> String {
+    let families = eval.values().filter(|&&n| n > 0).count();
+    let full = eval.values().filter(|&&n| n == EVAL_PER_FAMILY).count();
+    if families == full {
+        format!("{EVAL_PER_FAMILY} in each of {families} families")
+    } else {
+        format!(
+            "{} famil{}, {full} of them with {EVAL_PER_FAMILY}",
+            families,
+            if families == 1 { "y" } else { "ies" }
+        )
+    }
 }
 
 /// Hugging Face size category of a row count.
@@ -188,13 +224,13 @@ pub fn render(input: &CardInput) -> String {
         );
         let _ = writeln!(
             table,
-            "| `eval` | `{EVAL_FILE}` | {total_eval} | balanced evaluation subset: {EVAL_PER_FAMILY} valid scenes per family |"
+            "| `eval` | `{EVAL_FILE}` | {total_eval} | balanced evaluation subset: up to {EVAL_PER_FAMILY} valid scenes per family (whole speed-band groups first); here {} |",
+            eval_counts_text(input.eval.unwrap_or(&BTreeMap::new()))
         );
         v.insert(
             "eval_example",
             format!(
-                "subset = load_dataset(\"{}\", \"eval\", split=\"test\")  # {total_eval} scenes\n",
-                rh_hub::RELEASED_DATASET
+                "subset = load_dataset(DIR, \"eval\", split=\"test\")  # {total_eval} scenes\n"
             ),
         );
     } else {
@@ -205,12 +241,13 @@ pub fn render(input: &CardInput) -> String {
 
     let mut scope = if m.is_whole() {
         format!(
-            "This build holds **{n_rows} scenes** ({} valid) of {} famil{} in {} scene groups \
+            "This build holds **{n_rows} scenes** ({} valid) of {} famil{} in {} scene group{} \
              (four speed bands per group: slow, normal, fast, very_fast).",
             counts.values().map(|c| c.valid).sum::<usize>(),
             counts.len(),
             if counts.len() == 1 { "y" } else { "ies" },
-            m.n_groups()
+            m.n_groups(),
+            if m.n_groups() == 1 { "" } else { "s" }
         )
     } else {
         format!(
@@ -220,23 +257,44 @@ pub fn render(input: &CardInput) -> String {
             m.shard[0], m.shard[1], m.n, m.shard[1], m.shard[0]
         )
     };
+    let absent: Vec<&str> = m
+        .families
+        .iter()
+        .filter(|f| !counts.contains_key(*f))
+        .map(String::as_str)
+        .collect();
+    if !absent.is_empty() {
+        let _ =
+            write!(
+            scope,
+            "\n\nThe build was asked for {} families; {} got no scene group because the build is \
+             smaller than one group per family (families are dealt to groups in turn): {}.",
+            m.families.len(),
+            absent.len(),
+            absent.iter().map(|f| format!("`{f}`")).collect::<Vec<_>>().join(", ")
+        );
+    }
     if let Some(eval) = input.eval {
         let short: Vec<String> = m
             .families
             .iter()
+            .filter(|f| counts.contains_key(*f))
             .filter(|f| eval.get(*f).copied().unwrap_or(0) < EVAL_PER_FAMILY)
             .map(|f| format!("`{f}` ({})", eval.get(f).copied().unwrap_or(0)))
             .collect();
         if !short.is_empty() {
             let _ = write!(
                 scope,
-                "\n\n**Note:** the `eval` config should hold {EVAL_PER_FAMILY} scenes per family, but this \
-                 build has fewer valid scenes in {}; the subset holds all of them.",
+                "\n\n**Note:** the `eval` config takes up to {EVAL_PER_FAMILY} valid scenes per family; \
+                 this build has fewer in {} of its {} families, so the subset holds all valid scenes of: {}.",
+                short.len(),
+                counts.len(),
                 short.join(", ")
             );
         }
     }
     v.insert("scope", scope);
+    v.insert("video_note", VIDEO_NOTE.trim_end().to_string());
     let rendered = input
         .rows
         .column_by_name("ego_file_name")
@@ -257,98 +315,19 @@ pub fn render(input: &CardInput) -> String {
         },
     );
 
-    // Per-family table, in the build's family order.
-    let mut ft = String::from(
-        "Label counts are over valid scenes.\n\n| family | scenes | valid | CATCH | DODGE | NO_ACTION |",
-    );
-    if input.eval.is_some() {
-        ft.push_str(" eval |");
-    }
-    ft.push_str("\n|---|---|---|---|---|---|");
-    if input.eval.is_some() {
-        ft.push_str("---|");
-    }
-    ft.push('\n');
-    let mut total = FamilyCounts::default();
-    for f in &m.families {
-        let c = counts.get(f).cloned().unwrap_or_default();
-        let _ = write!(
-            ft,
-            "| {f} | {} | {} | {} | {} | {} |",
-            c.scenes, c.valid, c.catch, c.dodge, c.no_action
-        );
-        if let Some(e) = input.eval {
-            let _ = write!(ft, " {} |", e.get(f).copied().unwrap_or(0));
-        }
-        ft.push('\n');
-        total.scenes += c.scenes;
-        total.valid += c.valid;
-        total.catch += c.catch;
-        total.dodge += c.dodge;
-        total.no_action += c.no_action;
-    }
-    let _ = write!(
-        ft,
-        "| **total** | {} | {} | {} | {} | {} |",
-        total.scenes, total.valid, total.catch, total.dodge, total.no_action
-    );
-    if input.eval.is_some() {
-        let _ = write!(ft, " {total_eval} |");
-    }
-    v.insert("family_table", ft);
+    v.insert("family_table", family_table(input, &counts, total_eval));
 
-    // Features.
-    let schema = dataset::schema();
-    let mut features = String::new();
-    for field in schema.fields() {
-        let _ = writeln!(
-            features,
-            "| `{}` | {}{} | {} |",
-            field.name(),
-            type_name(field.data_type()),
-            if field.is_nullable() {
-                ", nullable"
-            } else {
-                ""
-            },
-            dataset::column_description(field.name()).unwrap_or_default()
-        );
-    }
-    v.insert("features_table", features.trim_end().to_string());
+    v.insert("features_table", features_table());
 
-    let l = &labels;
-    v.insert(
-        "label_rule",
-        format!(
-            "* **Impact point**: the hazard's centre where it first descends through the reach \
-plane z = {} m after t = 0 (interpolated within the physics step); for a body that never \
-does, its closest approach to the observer's torso axis if within {} m; else null.
-* **dangerous**: the object is sharp, hot, or large and fragile (catalog hazard flags of its \
-true physics), or its mass is ≥ {} kg, or its impact momentum is ≥ {} kg·m/s.
-* **danger_present**: in a counterfactual simulation with the observer's body (a capsule of \
-radius {} m, floor to {} m) as a static collider, the hazard touches it at ≥ {} m/s.
-* **reachable**: the hazard passes within {} m of the torso axis, or danger is present.
-* **gt_action**: `NO_ACTION` when not reachable; else `DODGE` when dangerous, or the impact \
-speed is > {} m/s, or the impact kinetic energy is > {} J; else `CATCH`.",
-            l.reach_plane_z,
-            l.closest_approach_max,
-            l.heavy_mass_kg,
-            l.heavy_momentum,
-            m.config
-                .pointer("/observer/torso_radius")
-                .and_then(|x| x.as_f64())
-                .unwrap_or(0.18),
-            m.config
-                .pointer("/observer/height")
-                .and_then(|x| x.as_f64())
-                .unwrap_or(1.32),
-            l.strike_speed_min,
-            l.reach_radius,
-            l.catch_speed_max,
-            l.catch_energy_max,
-        ),
-    );
+    v.insert("label_rule", label_rule(m, &labels));
 
+    insert_provenance(input, &mut v);
+    fill(TEMPLATE, &v)
+}
+
+/// The build summary table and the command that rebuilds this dataset.
+fn insert_provenance(input: &CardInput, v: &mut BTreeMap<&str, String>) {
+    let m = input.manifest;
     let default_config = crate::config::Config::embedded()
         .map(|c| crate::manifest::config_sha256(&c) == m.config_sha256)
         .unwrap_or(false);
@@ -397,7 +376,107 @@ speed is > {} m/s, or the impact kinetic energy is > {} J; else `CATCH`.",
             }
         ),
     );
-    fill(TEMPLATE, &v)
+}
+
+/// The per-family table, in the build's family order (label counts over valid scenes).
+fn family_table(
+    input: &CardInput,
+    counts: &BTreeMap<String, FamilyCounts>,
+    total_eval: usize,
+) -> String {
+    let m = input.manifest;
+    let mut ft = String::from(
+    "Label counts are over valid scenes.\n\n| family | scenes | valid | CATCH | DODGE | NO_ACTION |",
+);
+    if input.eval.is_some() {
+        ft.push_str(" eval |");
+    }
+    ft.push_str("\n|---|---|---|---|---|---|");
+    if input.eval.is_some() {
+        ft.push_str("---|");
+    }
+    ft.push('\n');
+    let mut total = FamilyCounts::default();
+    for f in m.families.iter().filter(|f| counts.contains_key(*f)) {
+        let c = counts.get(f).cloned().unwrap_or_default();
+        let _ = write!(
+            ft,
+            "| {f} | {} | {} | {} | {} | {} |",
+            c.scenes, c.valid, c.catch, c.dodge, c.no_action
+        );
+        if let Some(e) = input.eval {
+            let _ = write!(ft, " {} |", e.get(f).copied().unwrap_or(0));
+        }
+        ft.push('\n');
+        total.scenes += c.scenes;
+        total.valid += c.valid;
+        total.catch += c.catch;
+        total.dodge += c.dodge;
+        total.no_action += c.no_action;
+    }
+    let _ = write!(
+        ft,
+        "| **total** | {} | {} | {} | {} | {} |",
+        total.scenes, total.valid, total.catch, total.dodge, total.no_action
+    );
+    if input.eval.is_some() {
+        let _ = write!(ft, " {total_eval} |");
+    }
+    ft
+}
+
+/// The feature table: every column of the scene table with its type and meaning.
+fn features_table() -> String {
+    let schema = dataset::schema();
+    let mut features = String::new();
+    for field in schema.fields() {
+        let _ = writeln!(
+            features,
+            "| `{}` | {}{} | {} |",
+            field.name(),
+            type_name(field.data_type()),
+            if field.is_nullable() {
+                ", nullable"
+            } else {
+                ""
+            },
+            dataset::column_description(field.name()).unwrap_or_default()
+        );
+    }
+    features.trim_end().to_string()
+}
+
+/// The label rule in words, with the build's thresholds.
+fn label_rule(m: &Manifest, labels: &crate::config::LabelConfig) -> String {
+    let l = labels;
+    format!(
+        "* **Impact point**: the hazard's centre where it first descends through the reach \
+plane z = {} m after t = 0 (interpolated within the physics step); for a body that never \
+does, its closest approach to the observer's torso axis if within {} m; else null.
+* **dangerous**: the object is sharp, hot, or large and fragile (catalog hazard flags of its \
+true physics), or its mass is ≥ {} kg, or its impact momentum is ≥ {} kg·m/s.
+* **danger_present**: in a counterfactual simulation with the observer's body (a capsule of \
+radius {} m, floor to {} m) as a static collider, the hazard touches it at ≥ {} m/s.
+* **reachable**: the hazard passes within {} m of the torso axis, or danger is present.
+* **gt_action**: `NO_ACTION` when not reachable; else `DODGE` when dangerous, or the impact \
+speed is > {} m/s, or the impact kinetic energy is > {} J; else `CATCH`.",
+        l.reach_plane_z,
+        l.closest_approach_max,
+        l.heavy_mass_kg,
+        l.heavy_momentum,
+        m.config
+            .pointer("/observer/torso_radius")
+            .and_then(|x| x.as_f64())
+            .unwrap_or(0.18),
+        m.config
+            .pointer("/observer/height")
+            .and_then(|x| x.as_f64())
+            .unwrap_or(1.32),
+        l.strike_speed_min,
+        l.reach_radius,
+        l.catch_speed_max,
+        l.catch_energy_max,
+    )
 }
 
 #[cfg(test)]

@@ -3,11 +3,11 @@
 
 use crate::build::{build, BuildError, BuildOptions};
 use crate::config::Config;
-use crate::plan::{LexiconPlanner, Planner};
+use crate::selection::{LexiconPlanner, Planner};
 use crate::verify::{verify, verify_fast};
 use clap::{Parser, Subcommand};
 use rh_catalog::Catalog;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser, Debug)]
@@ -199,6 +199,150 @@ fn print_json<T: serde::Serialize>(value: &T) {
     );
 }
 
+/// `rh-pipeline sheet`: the contact sheet of a rendered dataset.
+#[cfg(feature = "render")]
+fn sheet(dir: &Path, out: &Path, json: bool) -> Result<(), Failure> {
+    if !dir.join("specs").is_dir() {
+        return Err(input(format!(
+            "{}: not a dataset directory (no specs/)",
+            dir.display()
+        )));
+    }
+    let sheet = crate::render::contact_sheet(dir, out).map_err(|e| match e {
+        crate::render::RenderError::Io(m) => input(m),
+        other => Failure {
+            code: 1,
+            message: other.to_string(),
+        },
+    })?;
+    if json {
+        let tiles: Vec<serde_json::Value> = sheet
+            .tiles
+            .iter()
+            .map(|(family, id)| serde_json::json!({ "family": family, "scene_id": id }))
+            .collect();
+        print_json(&serde_json::json!({
+            "out": out.display().to_string(),
+            "width": sheet.width,
+            "height": sheet.height,
+            "tiles": tiles,
+        }));
+    } else {
+        println!(
+            "contact sheet of {} families ({}x{}) written to {}",
+            sheet.tiles.len(),
+            sheet.width,
+            sheet.height,
+            out.display()
+        );
+    }
+    Ok(())
+}
+
+/// `rh-pipeline sheet` in a program built without the `render` feature.
+#[cfg(not(feature = "render"))]
+fn sheet(_dir: &Path, _out: &Path, _json: bool) -> Result<(), Failure> {
+    Err(input(
+        "`sheet` needs the `render` feature; this rh-pipeline was built without it \
+         (cargo build --no-default-features)",
+    ))
+}
+
+/// `rh-pipeline build`: builds, then prints the summary.
+fn run_build(
+    opts: &BuildOptions,
+    catalog: &Catalog,
+    config: &Config,
+    json: bool,
+) -> Result<(), Failure> {
+    let summary = build(opts, catalog, config).map_err(build_failure)?;
+    if json {
+        print_json(&summary);
+    } else {
+        println!(
+            "built {} scenes ({} valid) into {} — {}{}",
+            summary.scenes,
+            summary.valid,
+            summary.out,
+            summary.data_file,
+            if summary.resumed_groups > 0 {
+                format!(" (resumed {} groups)", summary.resumed_groups)
+            } else {
+                String::new()
+            }
+        );
+        let actions: Vec<String> = summary
+            .per_action
+            .iter()
+            .map(|(a, c)| format!("{a} {c}"))
+            .collect();
+        println!("labels: {}", actions.join(", "));
+        if !summary.invalid_scene_ids.is_empty() {
+            println!(
+                "warning: {} scene(s) failed validation after every attempt: {}",
+                summary.invalid_scene_ids.len(),
+                summary.invalid_scene_ids.join(", ")
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `rh-pipeline verify`: replays every spec against its stored state hash.
+fn run_verify(dir: &Path, catalog: &Catalog, fast: bool, json: bool) -> Result<(), Failure> {
+    let report = if fast {
+        verify_fast(dir)
+    } else {
+        verify(dir, catalog)
+    }
+    .map_err(input)?;
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).expect("report serializes")
+        );
+    } else {
+        for p in &report.file_problems {
+            println!("FILE {}: {}", p.file, p.problem);
+        }
+        for m in &report.mismatches {
+            println!("MISMATCH {}: {}", m.scene_id, m.problem);
+        }
+        if report.mode == "full" {
+            println!(
+                "verified {} files against build.json: {} problem(s); {} scenes derived again: {} match, {} differ",
+                report.files_checked,
+                report.file_problems.len(),
+                report.scenes,
+                report.matched,
+                report.scenes - report.matched
+            );
+        } else {
+            println!(
+                "verified {} scenes: {} match, {} mismatch",
+                report.scenes,
+                report.matched,
+                report.mismatches.len()
+            );
+        }
+    }
+    if report.ok() {
+        Ok(())
+    } else if report.mode == "full" {
+        Err(input(format!(
+            "{}: {} file problem(s), {} scene(s) differ from what their build derives",
+            dir.display(),
+            report.file_problems.len(),
+            report.scenes - report.matched
+        )))
+    } else {
+        Err(input(format!(
+            "{} scene(s) did not replay to their stored state hash",
+            report.mismatches.len()
+        )))
+    }
+}
+
 pub fn run(cli: Cli) -> Result<(), Failure> {
     // Commands that need neither the catalog nor the configuration.
     match &cli.command {
@@ -214,43 +358,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             }
             return Ok(());
         }
-        Command::Sheet { dir, out, json } => {
-            if !dir.join("specs").is_dir() {
-                return Err(input(format!(
-                    "{}: not a dataset directory (no specs/)",
-                    dir.display()
-                )));
-            }
-            let sheet = crate::render::contact_sheet(dir, out).map_err(|e| match e {
-                crate::render::RenderError::Io(m) => input(m),
-                other => Failure {
-                    code: 1,
-                    message: other.to_string(),
-                },
-            })?;
-            if *json {
-                let tiles: Vec<serde_json::Value> = sheet
-                    .tiles
-                    .iter()
-                    .map(|(family, id)| serde_json::json!({ "family": family, "scene_id": id }))
-                    .collect();
-                print_json(&serde_json::json!({
-                    "out": out.display().to_string(),
-                    "width": sheet.width,
-                    "height": sheet.height,
-                    "tiles": tiles,
-                }));
-            } else {
-                println!(
-                    "contact sheet of {} families ({}x{}) written to {}",
-                    sheet.tiles.len(),
-                    sheet.width,
-                    sheet.height,
-                    out.display()
-                );
-            }
-            return Ok(());
-        }
+        Command::Sheet { dir, out, json } => return sheet(dir, out, *json),
         Command::Download {
             repo,
             revision,
@@ -315,37 +423,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                 render: !no_render,
                 progress: !quiet,
             };
-            let summary = build(&opts, &catalog, &config).map_err(build_failure)?;
-            if json {
-                print_json(&summary);
-            } else {
-                println!(
-                    "built {} scenes ({} valid) into {} — {}{}",
-                    summary.scenes,
-                    summary.valid,
-                    summary.out,
-                    summary.data_file,
-                    if summary.resumed_groups > 0 {
-                        format!(" (resumed {} groups)", summary.resumed_groups)
-                    } else {
-                        String::new()
-                    }
-                );
-                let actions: Vec<String> = summary
-                    .per_action
-                    .iter()
-                    .map(|(a, c)| format!("{a} {c}"))
-                    .collect();
-                println!("labels: {}", actions.join(", "));
-                if !summary.invalid_scene_ids.is_empty() {
-                    println!(
-                        "warning: {} scene(s) failed validation after every attempt: {}",
-                        summary.invalid_scene_ids.len(),
-                        summary.invalid_scene_ids.join(", ")
-                    );
-                }
-            }
-            Ok(())
+            run_build(&opts, &catalog, &config, json)
         }
         Command::Balance {
             seed,
@@ -396,59 +474,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             );
             Ok(())
         }
-        Command::Verify { dir, fast, json } => {
-            let report = if fast {
-                verify_fast(&dir)
-            } else {
-                verify(&dir, &catalog)
-            }
-            .map_err(input)?;
-            if json {
-                println!(
-                    "{}",
-                    serde_json::to_string_pretty(&report).expect("report serializes")
-                );
-            } else {
-                for p in &report.file_problems {
-                    println!("FILE {}: {}", p.file, p.problem);
-                }
-                for m in &report.mismatches {
-                    println!("MISMATCH {}: {}", m.scene_id, m.problem);
-                }
-                if report.mode == "full" {
-                    println!(
-                        "verified {} files against build.json: {} problem(s); {} scenes derived again: {} match, {} differ",
-                        report.files_checked,
-                        report.file_problems.len(),
-                        report.scenes,
-                        report.matched,
-                        report.scenes - report.matched
-                    );
-                } else {
-                    println!(
-                        "verified {} scenes: {} match, {} mismatch",
-                        report.scenes,
-                        report.matched,
-                        report.mismatches.len()
-                    );
-                }
-            }
-            if report.ok() {
-                Ok(())
-            } else if report.mode == "full" {
-                Err(input(format!(
-                    "{}: {} file problem(s), {} scene(s) differ from what their build derives",
-                    dir.display(),
-                    report.file_problems.len(),
-                    report.scenes - report.matched
-                )))
-            } else {
-                Err(input(format!(
-                    "{} scene(s) did not replay to their stored state hash",
-                    report.mismatches.len()
-                )))
-            }
-        }
+        Command::Verify { dir, fast, json } => run_verify(&dir, &catalog, fast, json),
     }
 }
 

@@ -78,13 +78,33 @@ pub struct ValidatorConfig {
     pub tunnel_tolerance: f64,
     pub frame_margin: f64,
     pub frame_check_until_within: f64,
+    /// The widest vertical field of view a camera may be given (rad); a camera draw
+    /// that would need more is redrawn.
+    #[serde(default = "default_max_fov_y")]
+    pub max_fov_y: f64,
+}
+
+fn default_max_fov_y() -> f64 {
+    2.1
+}
+
+/// Framing policy (from the `[validators]` config), for `cameras::frame`.
+#[derive(Debug, Clone, Copy)]
+pub struct FramingRules {
+    /// Margin kept inside the image border (fraction of the half-size).
+    pub margin: f64,
+    /// Stop checking once the hazard is this close to the observer's torso axis (m).
+    pub until_within: f64,
+    /// The widest vertical field of view a camera may get (rad).
+    pub max_fov_y: f64,
 }
 
 impl ValidatorConfig {
-    pub fn framing(&self) -> crate::cameras::FramingRules {
-        crate::cameras::FramingRules {
+    pub fn framing(&self) -> FramingRules {
+        FramingRules {
             margin: self.frame_margin,
             until_within: self.frame_check_until_within,
+            max_fov_y: self.max_fov_y,
         }
     }
 }
@@ -271,12 +291,12 @@ impl Config {
             ));
         }
         for family in &self.build.families {
-            if !rh_catalog::FAMILIES.contains(&family.as_str()) {
+            if !rh_contract::FAMILIES.contains(&family.as_str()) {
                 return Err(fail("build.families", format!("unknown family '{family}'")));
             }
         }
         for (family, bands) in &self.speed_bands {
-            if !rh_catalog::FAMILIES.contains(&family.as_str()) {
+            if !rh_contract::FAMILIES.contains(&family.as_str()) {
                 return Err(fail("speed_bands", format!("unknown family '{family}'")));
             }
             if bands.iter().any(|v| !v.is_finite() || *v < 0.0) {

@@ -1,9 +1,7 @@
 //! Dataset writing (SPEC §8): one Parquet row per scene, `specs/<scene_id>.json`, all
 //! written atomically (temporary file, then rename), so no reader sees half a file.
 
-use crate::cameras::CAMERA_NAMES;
 use crate::scene::SceneResult;
-use crate::validate::VALIDATOR_COLUMNS;
 use arrow::array::{
     ArrayRef, BooleanBuilder, FixedSizeListBuilder, Float32Builder, Float64Builder, ListBuilder,
     RecordBatch, StringBuilder, UInt32Builder, UInt64Builder,
@@ -13,48 +11,17 @@ use parquet::arrow::ArrowWriter;
 use parquet::basic::Compression;
 use parquet::file::properties::WriterProperties;
 use rh_catalog::Catalog;
+use rh_contract::{CAMERAS as CAMERA_NAMES, VALIDATOR_COLUMNS};
 use std::fs;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Rows per Parquet row group: small enough for the Hub's dataset viewer to page.
 pub const ROW_GROUP_SIZE: usize = 1000;
 
-/// Writes `bytes` to `path` atomically: a sibling temp file, fsync, then rename.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = path.parent().unwrap_or(Path::new("."));
-    fs::create_dir_all(dir)?;
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("file");
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let mut f = fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result
-}
-
-pub fn spec_path(scene_id: &str) -> String {
-    format!("specs/{scene_id}.json")
-}
-
-/// The `data/` file name of shard `i` of `n` (Hugging Face convention).
-pub fn data_file_name(i: usize, n: usize) -> String {
-    format!("data/test-{i:05}-of-{n:05}.parquet")
-}
-
-fn vec3_field(name: &str, nullable: bool) -> Field {
-    Field::new(
-        name,
-        DataType::FixedSizeList(Arc::new(Field::new("item", DataType::Float64, false)), 3),
-        nullable,
-    )
-}
+pub use crate::dataset_stream::{project, read_columns, ParquetStream, SUMMARY_COLUMNS};
+pub use crate::fsio::write_atomic;
+pub use rh_contract::layout::{data_file_name, frame_files, spec_path};
 
 /// The Arrow schema of the scene table, in column order, with the `huggingface` metadata
 /// key (the `datasets` features) attached.
@@ -66,77 +33,9 @@ pub fn schema() -> Schema {
     plain.with_metadata(metadata)
 }
 
-/// The scene table's columns without schema metadata.
+/// The scene table's columns without schema metadata (`rh_contract::COLUMNS`).
 fn plain_schema() -> Schema {
-    let utf8 = |n: &str, nullable: bool| Field::new(n, DataType::Utf8, nullable);
-    let mut fields = vec![
-        utf8("scene_id", false),
-        utf8("group_id", false),
-        Field::new("scene_index", DataType::UInt64, false),
-        Field::new("seed", DataType::UInt64, false),
-        Field::new("attempt", DataType::UInt32, false),
-        utf8("family", false),
-        utf8("speed_band", false),
-        Field::new("speed_sweep", DataType::Boolean, false),
-        utf8("speed_parameter", false),
-        Field::new("speed_value", DataType::Float64, false),
-        utf8("object_id", false),
-        utf8("object_name", false),
-        utf8("object_category", false),
-        utf8("looks_like", true),
-        Field::new("adversarial", DataType::Boolean, false),
-        Field::new("object_mass_kg", DataType::Float64, false),
-        Field::new(
-            "hazards",
-            DataType::List(Arc::new(Field::new("item", DataType::Utf8, true))),
-            false,
-        ),
-        utf8("room", false),
-        utf8("description", true),
-        utf8("gt_action", false),
-        Field::new("dangerous", DataType::Boolean, false),
-        Field::new("danger_present", DataType::Boolean, false),
-        Field::new(
-            "danger_reasons",
-            DataType::List(Arc::new(Field::new("item", DataType::Utf8, true))),
-            false,
-        ),
-        vec3_field("impact_point", true),
-        utf8("impact_kind", true),
-        Field::new("time_to_impact", DataType::Float64, true),
-        Field::new("time_to_floor", DataType::Float64, true),
-        Field::new("impact_speed", DataType::Float64, true),
-        Field::new("closest_approach", DataType::Float64, false),
-        vec3_field("object_start", false),
-        vec3_field("observer_pose", false),
-        utf8("label_rule", false),
-        utf8("state_hash", false),
-        Field::new("sim_steps", DataType::UInt32, false),
-        Field::new("valid", DataType::Boolean, false),
-    ];
-    for v in VALIDATOR_COLUMNS {
-        fields.push(Field::new(v, DataType::Boolean, false));
-    }
-    fields.push(utf8("spec_file", false));
-    for cam in CAMERA_NAMES {
-        fields.push(utf8(&format!("{cam}_file_name"), true));
-    }
-    fields.push(utf8("full_event_file_name", true));
-    fields.push(Field::new(
-        "frame_steps",
-        DataType::List(Arc::new(Field::new("item", DataType::UInt32, true))),
-        false,
-    ));
-    fields.push(Field::new(
-        "trajectory",
-        DataType::List(Arc::new(Field::new(
-            "item",
-            DataType::FixedSizeList(Arc::new(Field::new("item", DataType::Float32, false)), 4),
-            true,
-        ))),
-        false,
-    ));
-    Schema::new(fields)
+    rh_contract::arrow_schema::schema()
 }
 
 /// The `datasets` feature of an Arrow type (the JSON that `datasets.Features.to_dict()`
@@ -181,63 +80,9 @@ pub fn huggingface_features(schema: &Schema) -> String {
     format!("{{\"info\": {{\"features\": {{{}}}}}}}", entries.join(", "))
 }
 
-/// What every column means, in one place (the dataset card's feature table is made from
-/// this and `schema()`; a test checks that every column is described).
+/// What a column means (`rh_contract::COLUMNS`; the dataset card's feature table).
 pub fn column_description(name: &str) -> Option<String> {
-    if let Some(cam) = name.strip_suffix("_file_name") {
-        return Some(if cam == "full_event" {
-            "Relative path of the full-event MP4 from an outside view, for people (never model input): `videos/full/<scene_id>.mp4`; null when not rendered (`--no-render`, or an invalid scene)".into()
-        } else {
-            format!("Relative path `videos/{cam}/<scene_id>.mp4` of the `{cam}` camera's observation-window video; null when not rendered (`--no-render`, or an invalid scene)")
-        });
-    }
-    let text = match name {
-        "scene_id" => "Stable scene id: 8 hex chars from SHA-256 of (build seed, scene index)",
-        "group_id" => "Scene group id; the four speed bands of a group share it and differ only in the speed parameter",
-        "scene_index" => "Index of the scene in the build (scene i is band i mod 4 of group i div 4)",
-        "seed" => "Build seed the scene was derived from",
-        "attempt" => "Resampling attempt that passed every validator (0 = first draw)",
-        "family" => "Event family (SPEC §4), e.g. object_drop, thrown_object",
-        "speed_band" => "slow, normal, fast or very_fast",
-        "speed_sweep" => "Whether the family's pace follows the speed parameter (false: gravity sets it; excluded from speed analyses)",
-        "speed_parameter" => "What the speed band sets for this family (e.g. launch speed)",
-        "speed_value" => "Value of the speed parameter in SI units",
-        "object_id" => "Catalog id of the hazard object",
-        "object_name" => "Display name of the hazard object",
-        "object_category" => "Catalog category of the hazard object",
-        "looks_like" => "For adversarial objects: the catalog id it is rendered exactly as; null otherwise",
-        "adversarial" => "The object looks like another one but has its own physics (e.g. a foam anvil)",
-        "object_mass_kg" => "True mass of the hazard (kg)",
-        "hazards" => "Hazard flags of the object's true physics: sharp, hot, heavy, fragile, large",
-        "room" => "Room id from the catalog",
-        "description" => "Free-text description the scene was planned from; null when none",
-        "gt_action" => "Ground-truth action: CATCH, DODGE or NO_ACTION (label rule below)",
-        "dangerous" => "The object is dangerous by its true physical properties (rule below)",
-        "danger_present" => "The hazard would strike the observer standing still (counterfactual simulation)",
-        "danger_reasons" => "Why `dangerous` holds (sharp, hot, large_fragile, heavy_mass, momentum); empty if not",
-        "impact_point" => "World [x, y, z] (m) where the hazard meets the observer: first descent through the reach plane, else closest approach within the limit; null if none",
-        "impact_kind" => "reach_plane or closest_approach: how `impact_point` was found; null if none",
-        "time_to_impact" => "Seconds from the event onset (t = 0) to the impact point; null if none",
-        "time_to_floor" => "Seconds from the onset to the hazard's first floor contact; null if it never lands",
-        "impact_speed" => "Hazard speed at the impact point (m/s); null if none",
-        "closest_approach" => "Closest distance of the hazard's centre to the observer's torso axis (m)",
-        "object_start" => "Hazard's centre at t = 0, world [x, y, z] (m)",
-        "observer_pose" => "Observer on the floor: [x (m), y (m), yaw (rad)]",
-        "label_rule" => "Version of the label rule that produced the labels",
-        "state_hash" => "SHA-256 (first 16 bytes, hex) of every dynamic body's state at every physics step; `rh-pipeline verify` replays specs against it",
-        "sim_steps" => "Physics steps simulated (240 Hz)",
-        "valid" => "Every validator passed (invalid scenes are kept, visible, and not scored)",
-        "valid_no_interpenetration" => "Validator: no two bodies overlap at t = 0 beyond tolerance",
-        "valid_energy" => "Validator: total mechanical energy never rises beyond tolerance",
-        "valid_no_tunnelling" => "Validator: the hazard never sinks through the floor",
-        "valid_in_frame" => "Validator: the hazard stays in all three cameras' frames during the observation window",
-        "valid_intended_event" => "Validator: the family's intended event really happened",
-        "spec_file" => "Relative path of the scene's full, replayable SceneSpec JSON",
-        "frame_steps" => "Physics step shown by each frame k of the camera videos (observation window, both ends included): round(k / video.fps / physics.dt), at most sim_steps",
-        "trajectory" => "Hazard centre [t (s), x, y, z (m)] at each video frame (float32)",
-        _ => return None,
-    };
-    Some(text.to_string())
+    rh_contract::columns::column(name).map(|c| c.description.to_string())
 }
 
 /// Builds the record batch of scene rows (in the order given).
@@ -419,18 +264,6 @@ pub fn referenced_files(batch: &RecordBatch) -> Vec<String> {
     files
 }
 
-/// A rendered scene's observation frames, camera-major (`frames/<id>/<cam>_t0.150.png`).
-pub fn frame_files(scene_id: &str) -> Vec<String> {
-    CAMERA_NAMES
-        .iter()
-        .flat_map(|cam| {
-            crate::render::FRAME_TIMES
-                .iter()
-                .map(move |&t| crate::render::frame_path(scene_id, cam, t))
-        })
-        .collect()
-}
-
 /// A nullable string column by name (all null when absent).
 pub fn optional_string_column(batch: &RecordBatch, name: &str) -> Vec<Option<String>> {
     use arrow::array::Array;
@@ -521,6 +354,20 @@ pub fn bool_column(batch: &RecordBatch, name: &str) -> Vec<bool> {
 /// Serialises rows to Parquet bytes (Snappy, fixed row groups, no timestamps: the same
 /// rows always give the same bytes).
 pub fn parquet_bytes(batch: &RecordBatch) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    {
+        let mut writer =
+            ArrowWriter::try_new(&mut bytes, batch.schema(), Some(writer_props(batch)))
+                .expect("valid schema");
+        writer.write(batch).expect("in-memory write");
+        writer.close().expect("in-memory close");
+    }
+    bytes
+}
+
+/// The writer settings of every scene table: Snappy, `ROW_GROUP_SIZE` rows per row group,
+/// no timestamps.
+pub(crate) fn writer_props(batch: &RecordBatch) -> WriterProperties {
     // The `huggingface` features also as a plain key-value entry of the file, for readers
     // that do not decode the embedded Arrow schema.
     let kv = batch.schema().metadata().get("huggingface").map(|v| {
@@ -529,20 +376,12 @@ pub fn parquet_bytes(batch: &RecordBatch) -> Vec<u8> {
             v.clone(),
         )]
     });
-    let props = WriterProperties::builder()
+    WriterProperties::builder()
         .set_key_value_metadata(kv)
         .set_compression(Compression::SNAPPY)
         .set_max_row_group_row_count(Some(ROW_GROUP_SIZE))
         .set_created_by("rh-pipeline".to_string())
-        .build();
-    let mut bytes = Vec::new();
-    {
-        let mut writer =
-            ArrowWriter::try_new(&mut bytes, batch.schema(), Some(props)).expect("valid schema");
-        writer.write(batch).expect("in-memory write");
-        writer.close().expect("in-memory close");
-    }
-    bytes
+        .build()
 }
 
 /// Paths of the dataset's Parquet files, in name order.
@@ -605,8 +444,8 @@ pub fn read_hashes(dir: &Path) -> Result<Vec<(String, String, String)>, String> 
 mod tests {
     use super::*;
     use crate::config::Config;
-    use crate::plan::plan_group;
     use crate::scene::produce_group;
+    use crate::selection::plan_group;
 
     #[test]
     fn every_column_is_described_and_has_a_feature() {

@@ -55,6 +55,22 @@ pub fn group_sums(root: &Path, batch: &RecordBatch) -> std::io::Result<FileSums>
     sums_of(root, &dataset::referenced_files(batch))
 }
 
+/// As `group_sums`, but files whose sums are already `known` (written from memory and
+/// perhaps not yet renamed into place) are taken from there instead of read back.
+pub fn group_sums_known(
+    root: &Path,
+    batch: &RecordBatch,
+    known: FileSums,
+) -> std::io::Result<FileSums> {
+    let rest: Vec<String> = dataset::referenced_files(batch)
+        .into_iter()
+        .filter(|f| !known.contains_key(f))
+        .collect();
+    let mut sums = sums_of(root, &rest)?;
+    sums.extend(known);
+    Ok(sums)
+}
+
 /// A file that is not what the sums say.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct FileProblem {
@@ -103,9 +119,13 @@ pub fn group_sums_path(record: &Path) -> PathBuf {
     record.with_extension("sha256.json")
 }
 
+/// The text of a group's sums file.
+pub fn sums_json(sums: &FileSums) -> String {
+    serde_json::to_string_pretty(sums).expect("sums serialize") + "\n"
+}
+
 pub fn write_group_sums(record: &Path, sums: &FileSums) -> std::io::Result<()> {
-    let text = serde_json::to_string_pretty(sums).expect("sums serialize") + "\n";
-    dataset::write_atomic(&group_sums_path(record), text.as_bytes())
+    dataset::write_atomic(&group_sums_path(record), sums_json(sums).as_bytes())
 }
 
 pub fn read_group_sums(record: &Path) -> Option<FileSums> {

@@ -8,25 +8,8 @@ use crate::simulate::{Simulation, Strike};
 use crate::spec::{SceneSpec, Vec3};
 use serde::{Deserialize, Serialize};
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Action {
-    #[serde(rename = "CATCH")]
-    Catch,
-    #[serde(rename = "DODGE")]
-    Dodge,
-    #[serde(rename = "NO_ACTION")]
-    NoAction,
-}
-
-impl Action {
-    pub fn name(self) -> &'static str {
-        match self {
-            Action::Catch => "CATCH",
-            Action::Dodge => "DODGE",
-            Action::NoAction => "NO_ACTION",
-        }
-    }
-}
+/// The action primitives (the data contract's).
+pub use rh_contract::Action;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

@@ -8,10 +8,11 @@
 //! into a hidden sibling folder and renamed onto OUT at the end, so OUT appears whole or
 //! not at all.
 
-use crate::build::{finalize, BuildError, WORK_DIR};
+use crate::build::{finalize, BuildError, RowSink, WORK_DIR};
 use crate::dataset;
 use crate::integrity::{self, FileSums};
 use crate::manifest::{Manifest, MANIFEST_FILE};
+use arrow::array::RecordBatch;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -30,7 +31,20 @@ fn input(msg: String) -> BuildError {
     BuildError::Input(msg)
 }
 
-/// Reads and checks one shard directory; returns its manifest and rows.
+/// The columns a shard's checks and file copies read (`dataset::referenced_files`); the
+/// full rows are streamed from the shard files by `finalize` instead of held in memory.
+const FILE_COLUMNS: [&str; 7] = [
+    "scene_id",
+    "scene_index",
+    "spec_file",
+    "ego_file_name",
+    "closeup_file_name",
+    "overhead_file_name",
+    "full_event_file_name",
+];
+
+/// Reads and checks one shard directory; returns its manifest and its rows' scene ids,
+/// indices and file columns.
 fn read_shard(dir: &Path) -> Result<(Manifest, arrow::array::RecordBatch), BuildError> {
     let manifest = Manifest::read(dir).map_err(input)?.ok_or_else(|| {
         input(format!(
@@ -50,7 +64,7 @@ fn read_shard(dir: &Path) -> Result<(Manifest, arrow::array::RecordBatch), Build
             manifest.shard[1]
         )));
     }
-    let rows = dataset::read_batch(&data).map_err(input)?;
+    let rows = dataset::read_columns(&data, &FILE_COLUMNS).map_err(input)?;
     let indices = dataset::u64_column(&rows, "scene_index");
     let expected: Vec<u64> = manifest
         .groups()
@@ -192,8 +206,11 @@ pub fn merge(out: &Path, shards: &[PathBuf]) -> Result<MergeSummary, BuildError>
             out.display()
         ))
     })?;
-    let rows = dataset::read_batch(&out.join(dataset::data_file_name(0, 1)))
-        .map_err(BuildError::Internal)?;
+    let rows = dataset::read_columns(
+        &out.join(dataset::data_file_name(0, 1)),
+        &dataset::SUMMARY_COLUMNS,
+    )
+    .map_err(BuildError::Internal)?;
     Ok(MergeSummary {
         out: out.display().to_string(),
         shards: read.len(),
@@ -218,7 +235,6 @@ fn write_merged(staging: &Path, whole: &Manifest, shards: &[Shard]) -> Result<()
     std::fs::create_dir_all(staging.join("specs")).map_err(|e| internal(staging, e))?;
     dataset::write_atomic(&staging.join(MANIFEST_FILE), whole.to_json().as_bytes())
         .map_err(|e| internal(staging, e))?;
-    let mut batches = Vec::new();
     let mut sums = FileSums::new();
     for (dir, (manifest, rows)) in shards {
         // Specs, videos and frames: every file a row names, with its checked checksum.
@@ -231,15 +247,80 @@ fn write_merged(staging: &Path, whole: &Manifest, shards: &[Shard]) -> Result<()
             }
             std::fs::copy(&from, &to).map_err(|e| internal(&from, e))?;
         }
-        batches.push(rows.clone());
     }
-    let all = dataset::concat(&batches).map_err(BuildError::Internal)?;
-    let index = dataset::u64_column(&all, "scene_index");
-    let mut order: Vec<u32> = (0..all.num_rows() as u32).collect();
-    order.sort_by_key(|&i| index[i as usize]);
-    let rows = dataset::take_rows(&all, &order);
+    // Shard i holds the groups g = i, i + N, … in order: the merged table takes group g's
+    // rows from shard g mod N, streaming every shard's file once per pass.
+    let mut files: Vec<PathBuf> = vec![PathBuf::new(); shards.len()];
+    for (dir, (m, _)) in shards {
+        files[m.shard[0] as usize] = dir.join(dataset::data_file_name(
+            m.shard[0] as usize,
+            m.shard[1] as usize,
+        ));
+    }
+    let rows = |sink: &mut RowSink| -> Result<(), BuildError> {
+        let mut cursors: Vec<ShardCursor> = files
+            .iter()
+            .map(|f| ShardCursor::open(f))
+            .collect::<Result<_, _>>()?;
+        let n_shards = cursors.len() as u64;
+        for g in whole.groups() {
+            sink(cursors[(g % n_shards) as usize].take(whole.group_size(g) as usize)?)?;
+        }
+        Ok(())
+    };
     finalize(staging, whole, &rows, sums)?;
     Ok(())
+}
+
+/// Reads a shard's data file front to back, a few rows at a time.
+struct ShardCursor {
+    path: PathBuf,
+    reader: parquet::arrow::arrow_reader::ParquetRecordBatchReader,
+    /// Rows read but not yet taken.
+    buffer: Option<RecordBatch>,
+}
+
+impl ShardCursor {
+    fn open(path: &Path) -> Result<ShardCursor, BuildError> {
+        use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+        let fail = |e: &dyn std::fmt::Display| input(format!("{}: {e}", path.display()));
+        let file = std::fs::File::open(path).map_err(|e| fail(&e))?;
+        let reader = ParquetRecordBatchReaderBuilder::try_new(file)
+            .and_then(|b| b.with_batch_size(1024).build())
+            .map_err(|e| fail(&e))?;
+        Ok(ShardCursor {
+            path: path.to_path_buf(),
+            reader,
+            buffer: None,
+        })
+    }
+
+    /// The next `k` rows.
+    fn take(&mut self, k: usize) -> Result<RecordBatch, BuildError> {
+        let mut parts = Vec::new();
+        let mut need = k;
+        while need > 0 {
+            let batch = match self.buffer.take() {
+                Some(b) => b,
+                None => match self.reader.next() {
+                    Some(b) => b.map_err(|e| input(format!("{}: {e}", self.path.display())))?,
+                    None => {
+                        return Err(input(format!(
+                            "{}: ended before its last scene group",
+                            self.path.display()
+                        )))
+                    }
+                },
+            };
+            let used = need.min(batch.num_rows());
+            parts.push(batch.slice(0, used));
+            if used < batch.num_rows() {
+                self.buffer = Some(batch.slice(used, batch.num_rows() - used));
+            }
+            need -= used;
+        }
+        dataset::concat(&parts).map_err(|e| input(format!("{}: {e}", self.path.display())))
+    }
 }
 
 /// Removes staging folders (`.OUT.rh-merge.PID`) that a killed merge into the same OUT

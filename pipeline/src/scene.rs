@@ -1,11 +1,15 @@
-//! One scene group through the DAG: randomize → simulate → frame cameras → validate →
-//! label, with attempt-indexed resampling when any band fails a validator.
+//! The DAG driver: one scene group through every stage, in order —
+//! plan → randomize → simulate → frame cameras → validate → (counterfactual) simulate →
+//! label → render — with attempt-indexed resampling when any band fails a validator.
+//! [`run_group`] is the one place the stages are chained; `build` runs groups in
+//! parallel and writes what it returns.
 
 use crate::cameras;
 use crate::config::Config;
 use crate::families;
 use crate::label::{label, Labels};
 use crate::randomize::{randomize, RandomizeError, SceneKey};
+use crate::selection::plan_group;
 use crate::simulate::{simulate, SimOptions, Simulation};
 use crate::spec::{SceneSpec, Selection};
 use crate::validate::{validate, Verdicts};
@@ -32,6 +36,44 @@ pub struct SceneMedia {
     pub videos: std::collections::BTreeMap<String, String>,
     /// `videos/full/<scene_id>.mp4`.
     pub full_event: String,
+}
+
+/// Stage 4 (render) as the DAG driver sees it: writes a labelled scene's videos and
+/// frames and says where (`None`: not rendered, e.g. an invalid scene). Kept behind this
+/// signature so the driver needs no GPU code (`render` is a cargo feature).
+pub type RenderStage<'a> = dyn Fn(&SceneResult) -> Result<Option<SceneMedia>, String> + Sync + 'a;
+
+/// Why a group could not be produced.
+#[derive(Debug)]
+pub enum GroupError {
+    /// Planning or sampling failed on the build's inputs (families, catalog).
+    Input(String),
+    /// The render stage failed.
+    Render(String),
+}
+
+/// The whole DAG for scene group `g` of a build (`count` speed bands, scenes
+/// `4g … 4g + count − 1`): plan the group's selection, produce its labelled scenes
+/// ([`produce_group`]), then render each (`render`; `None` for a label-only build).
+pub fn run_group(
+    catalog: &Catalog,
+    families: &[String],
+    seed: u64,
+    g: u64,
+    count: u64,
+    config: &Config,
+    render: Option<&RenderStage>,
+) -> Result<Vec<SceneResult>, GroupError> {
+    let selection =
+        plan_group(catalog, families, seed, g).map_err(|e| GroupError::Input(e.to_string()))?;
+    let mut results = produce_group(&selection, seed, g * 4, count, catalog, config)
+        .map_err(|e| GroupError::Input(e.to_string()))?;
+    if let Some(render) = render {
+        for r in results.iter_mut() {
+            r.media = render(r).map_err(GroupError::Render)?;
+        }
+    }
+    Ok(results)
 }
 
 /// Simulates one spec (plain and counterfactual), frames its cameras, validates and labels.

@@ -233,59 +233,9 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         )
         .1;
 
-    let mut body_handles = Vec::with_capacity(spec.bodies.len());
-    let mut collider_handles = Vec::with_capacity(spec.bodies.len());
-    for b in &spec.bodies {
-        let builder = match b.kind {
-            BodyKind::Fixed => RigidBodyBuilder::fixed(),
-            BodyKind::Dynamic => RigidBodyBuilder::dynamic()
-                .linvel(v3(b.linvel))
-                .angvel(v3(b.angvel))
-                .ccd_enabled(b.ccd)
-                // Never frozen by the sleep heuristic (an object balanced on an edge must
-                // tip); `simulate` stops by its own settle rule instead.
-                .can_sleep(false),
-        }
-        .pose(Pose::from_parts(v3(b.position), rot(b.rotation)));
-        let mut collider = collider_for(&b.parts)
-            .friction(b.friction as Real)
-            .restitution(b.restitution as Real)
-            .friction_combine_rule(CoefficientCombineRule::Average)
-            .restitution_combine_rule(CoefficientCombineRule::Average);
-        if b.kind == BodyKind::Dynamic {
-            collider = collider.mass(b.mass as Real);
-        }
-        let (bh, ch) = world.insert(builder, collider);
-        body_handles.push(bh);
-        collider_handles.push(ch);
-    }
+    let (body_handles, collider_handles) = insert_bodies(&mut world, spec);
 
-    // Joints; a world anchor is a fixed body at the origin.
-    let mut world_anchor = None;
-    for j in &spec.joints {
-        let a = match j.body_a {
-            Some(i) => body_handles[i],
-            None => {
-                *world_anchor.get_or_insert_with(|| world.bodies.insert(RigidBodyBuilder::fixed()))
-            }
-        };
-        let b = body_handles[j.body_b];
-        let joint: GenericJoint = match &j.kind {
-            JointKind::Revolute { axis } => RevoluteJointBuilder::new(v3(*axis).normalize())
-                .local_anchor1(v3(j.anchor_a))
-                .local_anchor2(v3(j.anchor_b))
-                .into(),
-            JointKind::Spherical => SphericalJointBuilder::new()
-                .local_anchor1(v3(j.anchor_a))
-                .local_anchor2(v3(j.anchor_b))
-                .into(),
-            JointKind::Rope { max_length } => RopeJointBuilder::new(*max_length as Real)
-                .local_anchor1(v3(j.anchor_a))
-                .local_anchor2(v3(j.anchor_b))
-                .into(),
-        };
-        world.impulse_joints.insert(a, b, joint, true);
-    }
+    insert_joints(&mut world, spec, &body_handles);
 
     let observer_collider = options.observer_collider.then(|| {
         let o = &spec.observer;
@@ -315,28 +265,7 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
 
     // Penetration at t0, by direct shape queries (a collision pass through the world
     // before the first step would disturb rapier's state).
-    let mut initial_penetration: f64 = 0.0;
-    let colliders: Vec<&Collider> = world.colliders.iter().map(|(_, c)| c).collect();
-    for (i, a) in colliders.iter().enumerate() {
-        for b in &colliders[i + 1..] {
-            let both_fixed = [a, b].iter().all(|c| {
-                c.parent()
-                    .is_none_or(|p| world.bodies[p].body_type() == RigidBodyType::Fixed)
-            });
-            if both_fixed {
-                continue;
-            }
-            if let Ok(Some(contact)) = rapier3d::parry::query::contact(
-                a.position(),
-                a.shape(),
-                b.position(),
-                b.shape(),
-                0.0,
-            ) {
-                initial_penetration = initial_penetration.max(-(contact.dist as f64));
-            }
-        }
-    }
+    let initial_penetration = initial_penetration(&world);
 
     let gravity = v3(spec.physics.gravity);
     let n_dyn = dynamic_bodies.len();
@@ -391,26 +320,13 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         sim.hazard_lowest_z
             .push(lowest_z(&world.colliders[hazard_collider]));
 
-        let mut flags = 0u8;
-        for pair in world.narrow_phase.contact_pairs_with(hazard_collider) {
-            if !pair.has_any_active_contact() {
-                continue;
-            }
-            let other = if pair.collider1 == hazard_collider {
-                pair.collider2
-            } else {
-                pair.collider1
-            };
-            flags |= if other == floor {
-                TOUCH_FLOOR
-            } else if Some(other) == source_collider {
-                TOUCH_SOURCE
-            } else if Some(other) == observer_collider {
-                TOUCH_OBSERVER
-            } else {
-                TOUCH_OTHER
-            };
-        }
+        let flags = hazard_contact_flags(
+            &world,
+            hazard_collider,
+            floor,
+            source_collider,
+            observer_collider,
+        );
         sim.hazard_contacts.push(flags);
 
         if step == 0 {
@@ -435,4 +351,125 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
     let digest = hasher.finalize();
     sim.state_hash = digest[..16].iter().map(|b| format!("{b:02x}")).collect();
     sim
+}
+
+/// Inserts every body of the spec with its collider, in spec order.
+fn insert_bodies(
+    world: &mut PhysicsWorld,
+    spec: &SceneSpec,
+) -> (Vec<RigidBodyHandle>, Vec<ColliderHandle>) {
+    let mut body_handles = Vec::with_capacity(spec.bodies.len());
+    let mut collider_handles = Vec::with_capacity(spec.bodies.len());
+    for b in &spec.bodies {
+        let builder = match b.kind {
+            BodyKind::Fixed => RigidBodyBuilder::fixed(),
+            BodyKind::Dynamic => RigidBodyBuilder::dynamic()
+                .linvel(v3(b.linvel))
+                .angvel(v3(b.angvel))
+                .ccd_enabled(b.ccd)
+                // Never frozen by the sleep heuristic (an object balanced on an edge must
+                // tip); `simulate` stops by its own settle rule instead.
+                .can_sleep(false),
+        }
+        .pose(Pose::from_parts(v3(b.position), rot(b.rotation)));
+        let mut collider = collider_for(&b.parts)
+            .friction(b.friction as Real)
+            .restitution(b.restitution as Real)
+            .friction_combine_rule(CoefficientCombineRule::Average)
+            .restitution_combine_rule(CoefficientCombineRule::Average);
+        if b.kind == BodyKind::Dynamic {
+            collider = collider.mass(b.mass as Real);
+        }
+        let (bh, ch) = world.insert(builder, collider);
+        body_handles.push(bh);
+        collider_handles.push(ch);
+    }
+    (body_handles, collider_handles)
+}
+
+/// Inserts the spec's joints, in spec order; a world anchor is a fixed body at the origin.
+fn insert_joints(world: &mut PhysicsWorld, spec: &SceneSpec, body_handles: &[RigidBodyHandle]) {
+    let mut world_anchor = None;
+    for j in &spec.joints {
+        let a = match j.body_a {
+            Some(i) => body_handles[i],
+            None => {
+                *world_anchor.get_or_insert_with(|| world.bodies.insert(RigidBodyBuilder::fixed()))
+            }
+        };
+        let b = body_handles[j.body_b];
+        let joint: GenericJoint = match &j.kind {
+            JointKind::Revolute { axis } => RevoluteJointBuilder::new(v3(*axis).normalize())
+                .local_anchor1(v3(j.anchor_a))
+                .local_anchor2(v3(j.anchor_b))
+                .into(),
+            JointKind::Spherical => SphericalJointBuilder::new()
+                .local_anchor1(v3(j.anchor_a))
+                .local_anchor2(v3(j.anchor_b))
+                .into(),
+            JointKind::Rope { max_length } => RopeJointBuilder::new(*max_length as Real)
+                .local_anchor1(v3(j.anchor_a))
+                .local_anchor2(v3(j.anchor_b))
+                .into(),
+        };
+        world.impulse_joints.insert(a, b, joint, true);
+    }
+}
+
+/// The deepest penetration between two colliders (not both fixed) before the first step.
+fn initial_penetration(world: &PhysicsWorld) -> f64 {
+    let mut initial_penetration: f64 = 0.0;
+    let colliders: Vec<&Collider> = world.colliders.iter().map(|(_, c)| c).collect();
+    for (i, a) in colliders.iter().enumerate() {
+        for b in &colliders[i + 1..] {
+            let both_fixed = [a, b].iter().all(|c| {
+                c.parent()
+                    .is_none_or(|p| world.bodies[p].body_type() == RigidBodyType::Fixed)
+            });
+            if both_fixed {
+                continue;
+            }
+            if let Ok(Some(contact)) = rapier3d::parry::query::contact(
+                a.position(),
+                a.shape(),
+                b.position(),
+                b.shape(),
+                0.0,
+            ) {
+                initial_penetration = initial_penetration.max(-(contact.dist as f64));
+            }
+        }
+    }
+    initial_penetration
+}
+
+/// The hazard's active contacts this step, as `TOUCH_*` flags.
+fn hazard_contact_flags(
+    world: &PhysicsWorld,
+    hazard_collider: ColliderHandle,
+    floor: ColliderHandle,
+    source_collider: Option<ColliderHandle>,
+    observer_collider: Option<ColliderHandle>,
+) -> u8 {
+    let mut flags = 0u8;
+    for pair in world.narrow_phase.contact_pairs_with(hazard_collider) {
+        if !pair.has_any_active_contact() {
+            continue;
+        }
+        let other = if pair.collider1 == hazard_collider {
+            pair.collider2
+        } else {
+            pair.collider1
+        };
+        flags |= if other == floor {
+            TOUCH_FLOOR
+        } else if Some(other) == source_collider {
+            TOUCH_SOURCE
+        } else if Some(other) == observer_collider {
+            TOUCH_OBSERVER
+        } else {
+            TOUCH_OTHER
+        };
+    }
+    flags
 }

@@ -5,9 +5,9 @@ use rh_catalog::Catalog;
 use rh_pipeline::config::Config;
 use rh_pipeline::families::{self, GRAVITY};
 use rh_pipeline::label::Action;
-use rh_pipeline::plan::plan_group;
 use rh_pipeline::randomize::{randomize, SceneKey};
 use rh_pipeline::scene::{produce_group, SceneResult};
+use rh_pipeline::selection::plan_group;
 use rh_pipeline::simulate::{simulate, SimOptions, Simulation};
 use rh_pipeline::spec::{SceneSpec, Selection};
 

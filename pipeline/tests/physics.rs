@@ -5,8 +5,8 @@
 use rh_catalog::Catalog;
 use rh_pipeline::config::Config;
 use rh_pipeline::label::Action;
-use rh_pipeline::plan::plan_group;
 use rh_pipeline::scene::{produce_group, run_scene, SceneResult};
+use rh_pipeline::selection::plan_group;
 use rh_pipeline::simulate::{simulate, SimOptions, Simulation, TOUCH_FLOOR, TOUCH_SOURCE};
 use rh_pipeline::spec::{quat, Selection, ShapeSpec};
 

@@ -7,12 +7,12 @@ use rh_catalog::Catalog;
 use rh_pipeline::cameras::View;
 use rh_pipeline::config::Config;
 use rh_pipeline::dataset::write_atomic;
-use rh_pipeline::plan::plan_group;
 use rh_pipeline::render::{
     contact_sheet, frame_file_name, RenderOptions, RenderedScene, Renderer, Shading, CAMERAS,
     FRAME_TIMES, HAZARD_MASK_RGB,
 };
 use rh_pipeline::scene::produce_group;
+use rh_pipeline::selection::plan_group;
 use rh_pipeline::simulate::{simulate, SimOptions, Simulation};
 use rh_pipeline::spec::SceneSpec;
 use std::path::{Path, PathBuf};

@@ -108,6 +108,25 @@ pub struct Rec {
     pub d_end: f32,
 }
 
+impl Rec {
+    /// Whether a decision was scored for this (scene, model).
+    pub fn is_scored(&self) -> bool {
+        self.state == REC_SCORED
+    }
+
+    /// The scored decision's action (`Some(None)`: no parseable plan); `None` when no
+    /// decision was scored.
+    pub fn decision(&self) -> Option<Option<Action>> {
+        self.is_scored()
+            .then(|| Action::from_index(self.action as usize))
+    }
+
+    /// The scored decision's end distance `d_end`, when it has one.
+    pub fn end_distance(&self) -> Option<f64> {
+        (self.is_scored() && !self.d_end.is_nan()).then_some(self.d_end as f64)
+    }
+}
+
 impl Default for Rec {
     fn default() -> Self {
         Rec {

@@ -13,10 +13,11 @@ use arrow::array::{
 };
 use arrow::datatypes::DataType;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+use rh_contract::columns::col;
 use std::path::{Path, PathBuf};
 
-/// The speed bands of SPEC §4, slowest first.
-pub const SPEED_BANDS: [&str; 4] = ["slow", "normal", "fast", "very_fast"];
+/// The speed bands of SPEC §4, slowest first (the data contract's).
+pub use rh_contract::SPEED_BANDS;
 
 /// One scene's ground truth, as the scorer needs it.
 #[derive(Debug, Clone)]
@@ -335,22 +336,22 @@ fn read_parquet(file: &Path) -> Result<Vec<SceneInput>> {
     let mut out = Vec::new();
     for batch in reader {
         let batch = batch.map_err(|e| InputError(format!("{}: {e}", file.display())))?;
-        let scene_id = required_strings(&batch, file, "scene_id")?;
-        let group_id = required_strings(&batch, file, "group_id")?;
-        let family = required_strings(&batch, file, "family")?;
-        let speed_band = required_strings(&batch, file, "speed_band")?;
-        let speed_sweep = bools(&batch, file, "speed_sweep")?;
-        let object_id = required_strings(&batch, file, "object_id")?;
-        let looks_like = strings(&batch, file, "looks_like")?;
-        let adversarial = bools(&batch, file, "adversarial")?;
-        let gt_action = required_strings(&batch, file, "gt_action")?;
-        let dangerous = bools(&batch, file, "dangerous")?;
-        let danger_present = bools(&batch, file, "danger_present")?;
-        let impact_point = vec3s(&batch, file, "impact_point")?;
-        let object_start = vec3s(&batch, file, "object_start")?;
-        let observer_pose = vec3s(&batch, file, "observer_pose")?;
-        let valid = if batch.column_by_name("valid").is_some() {
-            bools(&batch, file, "valid")?
+        let scene_id = required_strings(&batch, file, col::SCENE_ID)?;
+        let group_id = required_strings(&batch, file, col::GROUP_ID)?;
+        let family = required_strings(&batch, file, col::FAMILY)?;
+        let speed_band = required_strings(&batch, file, col::SPEED_BAND)?;
+        let speed_sweep = bools(&batch, file, col::SPEED_SWEEP)?;
+        let object_id = required_strings(&batch, file, col::OBJECT_ID)?;
+        let looks_like = strings(&batch, file, col::LOOKS_LIKE)?;
+        let adversarial = bools(&batch, file, col::ADVERSARIAL)?;
+        let gt_action = required_strings(&batch, file, col::GT_ACTION)?;
+        let dangerous = bools(&batch, file, col::DANGEROUS)?;
+        let danger_present = bools(&batch, file, col::DANGER_PRESENT)?;
+        let impact_point = vec3s(&batch, file, col::IMPACT_POINT)?;
+        let object_start = vec3s(&batch, file, col::OBJECT_START)?;
+        let observer_pose = vec3s(&batch, file, col::OBSERVER_POSE)?;
+        let valid = if batch.column_by_name(col::VALID).is_some() {
+            bools(&batch, file, col::VALID)?
         } else {
             vec![true; batch.num_rows()]
         };
@@ -358,7 +359,7 @@ fn read_parquet(file: &Path) -> Result<Vec<SceneInput>> {
             let gt = Action::parse(&gt_action[i]).ok_or_else(|| {
                 bad(
                     file,
-                    "gt_action",
+                    col::GT_ACTION,
                     format!(
                         "has value {:?} in row {i}, expected CATCH, DODGE or NO_ACTION",
                         gt_action[i]
@@ -366,28 +367,28 @@ fn read_parquet(file: &Path) -> Result<Vec<SceneInput>> {
                 )
             })?;
             let object_start = object_start[i]
-                .ok_or_else(|| bad(file, "object_start", format!("is null in row {i}")))?;
+                .ok_or_else(|| bad(file, col::OBJECT_START, format!("is null in row {i}")))?;
             let observer_pose = observer_pose[i]
-                .ok_or_else(|| bad(file, "observer_pose", format!("is null in row {i}")))?;
+                .ok_or_else(|| bad(file, col::OBSERVER_POSE, format!("is null in row {i}")))?;
             let finite = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
             if !finite(&object_start) {
                 return Err(bad(
                     file,
-                    "object_start",
+                    col::OBJECT_START,
                     format!("is not finite in row {i}"),
                 ));
             }
             if !finite(&observer_pose) {
                 return Err(bad(
                     file,
-                    "observer_pose",
+                    col::OBSERVER_POSE,
                     format!("is not finite in row {i}"),
                 ));
             }
             if impact_point[i].is_some_and(|p| !finite(&p)) {
                 return Err(bad(
                     file,
-                    "impact_point",
+                    col::IMPACT_POINT,
                     format!("is not finite in row {i}"),
                 ));
             }

@@ -14,9 +14,8 @@ pub fn explain(cfg: &Config) -> String {
     let a = &cfg.action_rule;
     let b = &cfg.body;
     let s = &cfg.sanity;
-    let an = &cfg.analyses;
     let aia = &cfg.aia;
-    format!(
+    let mut text = format!(
         r#"rh-score {ver} — definitions (action rule {rule})
 
 PREDICTIONS (preds.jsonl, SPEC §9)
@@ -111,7 +110,42 @@ AIA VOCABULARIES AND NEGATION
   NO_ACTION: {noact}
   Negation cues: {neg}
 
-AGGREGATION AND MISSING VALUES
+"#,
+        ver = env!("CARGO_PKG_VERSION"),
+        rule = a.version,
+        dt = b.default_keyframe_dt,
+        ms = s.max_speed,
+        my = s.max_yaw_rate,
+        md = s.max_duration,
+        mc = s.max_abs_coordinate,
+        ml = s.max_line_bytes,
+        mk = s.max_keyframes,
+        mn = s.max_nesting,
+        fill = list(&aia.coordination_fillers),
+        coord = list(&aia.coordinators),
+        ph = b.pelvis_height,
+        rl = b.rest_left,
+        rr = b.rest_right,
+        rt = a.reach_threshold,
+        rr_t = a.retreat_threshold,
+        mt = a.move_threshold,
+        breaks = list(&aia.clause_breaks),
+        win = aia.negation_window,
+        catch = list(&aia.catch),
+        dodge = list(&aia.dodge),
+        noact = list(&aia.no_action),
+        neg = list(&aia.negation),
+    );
+    text.push_str(&explain_outputs(cfg));
+    text
+}
+
+/// The second half of the explanation: aggregation, analyses, warnings, outputs.
+fn explain_outputs(cfg: &Config) -> String {
+    let an = &cfg.analyses;
+    let aia = &cfg.aia;
+    format!(
+        r#"AGGREGATION AND MISSING VALUES
   Means per model, and per model x family, x speed band, x ground-truth action, x
   adversarial; plus all models pooled (ALL). Lost decisions are counted separately and
   never enter a denominator. A metric's missing values (d_end, d_min, closing without an
@@ -161,30 +195,6 @@ EXIT STATUS
   0 success; 2 bad input or usage (unreadable predictions file, missing dataset, missing
   or mistyped dataset column — the message names the file and column); 1 internal error.
 "#,
-        ver = env!("CARGO_PKG_VERSION"),
-        rule = a.version,
-        dt = b.default_keyframe_dt,
-        ms = s.max_speed,
-        my = s.max_yaw_rate,
-        md = s.max_duration,
-        mc = s.max_abs_coordinate,
-        ml = s.max_line_bytes,
-        mk = s.max_keyframes,
-        mn = s.max_nesting,
-        fill = list(&aia.coordination_fillers),
-        coord = list(&aia.coordinators),
-        ph = b.pelvis_height,
-        rl = b.rest_left,
-        rr = b.rest_right,
-        rt = a.reach_threshold,
-        rr_t = a.retreat_threshold,
-        mt = a.move_threshold,
-        breaks = list(&aia.clause_breaks),
-        win = aia.negation_window,
-        catch = list(&aia.catch),
-        dodge = list(&aia.dodge),
-        noact = list(&aia.no_action),
-        neg = list(&aia.negation),
         mr = an.miss_radius,
         fs = an.far_standing,
         mat = list(&aia.material_doubt),

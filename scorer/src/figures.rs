@@ -1,7 +1,8 @@
 //! Figures (`--figures DIR`), each written as SVG and PNG with plotters:
 //! `disposition` (SAA on CATCH vs DODGE scenes, one point per model, dashed diagonal),
 //! `freeze_by_band` (share of NO_ACTION per speed band, speed-sweeping families),
-//! `per_family` (SAA per family and model), `safety_rules` (first-rule breakdown).
+//! `per_family` (SAA per family and model), `safety_rules` (first-rule breakdown, legend
+//! below). Percentage axes are labelled with whole numbers.
 //!
 //! Text is rendered with `ab_glyph` from a font embedded in the binary (Hack, via the
 //! `epaint_default_fonts` crate), so no system fonts or fontconfig are needed.
@@ -87,6 +88,8 @@ fn disposition<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) ->
         .configure_mesh()
         .x_desc("SAA on CATCH scenes (%)")
         .y_desc("SAA on DODGE scenes (%)")
+        .x_label_formatter(&percent_label)
+        .y_label_formatter(&percent_label)
         .label_style((FONT, 13))
         .axis_desc_style((FONT, 14))
         .draw()
@@ -138,7 +141,7 @@ fn freeze_by_band<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report)
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(55)
-        .build_cartesian_2d(-0.3f64..3.3f64, 0f64..100f64)
+        .build_cartesian_2d(-0.3f64..3.3f64, -4f64..104f64)
         .map_err(e)?;
     chart
         .configure_mesh()
@@ -151,7 +154,8 @@ fn freeze_by_band<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report)
                 String::new()
             }
         })
-        .x_desc("speed band (speed-sweeping families)")
+        .y_label_formatter(&percent_label)
+        .x_desc("speed band (speed-sweeping families; models side by side)")
         .y_desc("decisions that freeze (%)")
         .label_style((FONT, 13))
         .axis_desc_style((FONT, 14))
@@ -163,13 +167,16 @@ fn freeze_by_band<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report)
         .iter()
         .filter(|s| s.model != "ALL")
         .collect();
+    // Models side by side within each band, so equal rates (often 0 %) stay visible.
+    let k = series.len().max(1) as f64;
     for (i, s) in series.iter().enumerate() {
         let c = color(i);
+        let dx = (i as f64 - (k - 1.0) / 2.0) * (0.5 / k).min(0.08);
         let pts: Vec<(f64, f64)> = s
             .freeze_rate_by_band
             .iter()
             .enumerate()
-            .filter_map(|(b, v)| v.map(|v| (b as f64, 100.0 * v)))
+            .filter_map(|(b, v)| v.map(|v| (b as f64 + dx, 100.0 * v)))
             .collect();
         chart
             .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
@@ -209,6 +216,7 @@ fn per_family<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> 
         .y_label_formatter(&|y| category_label(&names, *y))
         .disable_y_mesh()
         .x_desc("SAA (%)")
+        .x_label_formatter(&percent_label)
         .label_style((FONT, 12))
         .axis_desc_style((FONT, 14))
         .draw()
@@ -250,7 +258,8 @@ fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -
             )
         })
         .collect();
-    let (plot, legend_area) = split_legend(root, &legend_items);
+    let (_, h) = root.dim_in_pixel();
+    let (plot, legend_area) = root.split_vertically(h as i32 - LEGEND_BELOW);
     let mut chart = ChartBuilder::on(&plot)
         .caption(
             "Safety violations by first rule (% of decisions)",
@@ -267,10 +276,28 @@ fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -
         .y_label_formatter(&|y| category_label(&names, *y))
         .disable_y_mesh()
         .x_desc("decisions (%)")
+        .x_label_formatter(&percent_label)
         .label_style((FONT, 12))
         .axis_desc_style((FONT, 14))
         .draw()
         .map_err(e)?;
+    for (i, s) in rows.iter().enumerate() {
+        let y = (n - 1 - i) as f64;
+        let label = if s.decisions == 0 {
+            "no decisions".to_string()
+        } else if s.violations == 0 {
+            "no violations".to_string()
+        } else {
+            continue;
+        };
+        chart
+            .draw_series(std::iter::once(Text::new(
+                label,
+                (1.0, y + 0.12),
+                (FONT, 12),
+            )))
+            .map_err(e)?;
+    }
     for rule in Rule::ALL {
         let c = color(rule.index() + 3);
         let bars: Vec<_> = rows
@@ -291,9 +318,27 @@ fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -
             .collect();
         chart.draw_series(bars).map_err(e)?;
     }
-    draw_legend(&legend_area, &legend_items)?;
+    for (i, (label, c)) in legend_items.iter().enumerate() {
+        let x = 160 + 480 * (i as i32 % 2);
+        let y = 10 + 22 * (i as i32 / 2);
+        legend_area
+            .draw(&Rectangle::new([(x, y), (x + 14, y + 12)], c.filled()))
+            .map_err(e)?;
+        legend_area
+            .draw(&Text::new(label.clone(), (x + 20, y - 1), (FONT, 12)))
+            .map_err(e)?;
+    }
     root.present().map_err(e)?;
     Ok(())
+}
+
+/// Height of the legend strip under the safety-rule chart (two rows of two).
+const LEGEND_BELOW: i32 = 60;
+
+/// Tick label of a percentage axis: whole numbers ("10", not "10.0", which the bitmap
+/// font spaced as "10. 0").
+fn percent_label(v: &f64) -> String {
+    format!("{v:.0}")
 }
 
 macro_rules! both {
@@ -322,11 +367,11 @@ pub fn write_figures(r: &Report, dir: &Path) -> Result<Vec<std::path::PathBuf>> 
     let fam_h = (140
         + r.dataset.families.len().max(4) as u32 * (14 + 10 * r.models.len().clamp(1, 8) as u32))
         .min(2400);
-    let safety_h = (160 + 40 * r.analyses.safety.len() as u32).max(320);
+    let safety_h = (160 + 40 * r.analyses.safety.len() as u32).max(320) + LEGEND_BELOW as u32;
     both!(dir, "disposition", (640, 600), disposition, r, out);
     both!(dir, "freeze_by_band", (900, 500), freeze_by_band, r, out);
     both!(dir, "per_family", (1080, fam_h), per_family, r, out);
-    both!(dir, "safety_rules", (1180, safety_h), safety_rules, r, out);
+    both!(dir, "safety_rules", (1000, safety_h), safety_rules, r, out);
     Ok(out)
 }
 

@@ -13,31 +13,18 @@ use arrow::array::{
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rh_contract::columns::col;
+use rh_contract::layout::{data_file_name, spec_path};
 use std::f64::consts::PI;
 use std::path::Path;
 use std::sync::Arc;
 
-/// The 17 families of SPEC §4 and whether they sweep speed.
-pub const FAMILIES: [(&str, bool); 17] = [
-    ("object_drop", false),
-    ("shelf_slide", true),
-    ("hanging_fall", false),
-    ("ceiling_drop", false),
-    ("sliding_object", true),
-    ("rolling_ball", true),
-    ("surface_cascade", true),
-    ("furniture_tip", false),
-    ("stack_collapse", true),
-    ("ladder_slip", true),
-    ("door_swing", true),
-    ("pendulum_swing", true),
-    ("thrown_object", true),
-    ("bouncing_object", true),
-    ("stair_tumble", false),
-    ("chain_reaction", true),
-    ("multi_object", true),
+/// Whether each family of `rh_contract::FAMILIES` (same order) sweeps speed in the
+/// fixture's synthetic scenes.
+const FAMILY_SWEEPS: [bool; 17] = [
+    false, true, false, false, true, true, true, false, true, true, true, true, true, true, false,
+    true, true,
 ];
-
 /// (id, name, category, looks_like, dangerous, mass)
 type ObjectRow = (
     &'static str,
@@ -115,7 +102,10 @@ pub fn synth_rows(n: usize, seed: u64) -> Vec<FixtureRow> {
     let mut g = 0u64;
     while rows.len() < n {
         let mut rng = ChaCha8Rng::seed_from_u64(splitmix(seed ^ splitmix(g)));
-        let (family, sweep) = FAMILIES[(g % 17) as usize];
+        let (family, sweep) = (
+            rh_contract::FAMILIES[(g % 17) as usize],
+            FAMILY_SWEEPS[(g % 17) as usize],
+        );
         let obj = OBJECTS[rng.random_range(0..OBJECTS.len())];
         let group_id = format!("g{:07x}", splitmix(seed.wrapping_add(g)) & 0xfff_ffff);
         let pose = [
@@ -223,7 +213,9 @@ pub fn dataset_of(rows: &[FixtureRow]) -> Dataset {
 }
 
 fn vec3_col<'a>(it: impl Iterator<Item = Option<&'a [f64; 3]>>) -> ArrayRef {
-    let mut b = FixedSizeListBuilder::new(Float64Builder::new(), 3);
+    // The contract's type: a fixed-size list of 3 non-null float64.
+    let item = arrow::datatypes::Field::new("item", arrow::datatypes::DataType::Float64, false);
+    let mut b = FixedSizeListBuilder::new(Float64Builder::new(), 3).with_field(item);
     for v in it {
         match v {
             Some(p) => {
@@ -284,64 +276,70 @@ pub fn write_dataset(dir: &Path, rows: &[FixtureRow], drop: &[&str]) -> Result<(
         hazards.append(true);
     }
     let cols: Vec<(&str, ArrayRef)> = vec![
-        ("scene_id", s(&|r| Some(r.scene.scene_id.clone()))),
-        ("group_id", s(&|r| Some(r.scene.group_id.clone()))),
-        ("scene_index", u64c(&|r| r.scene_index)),
-        ("seed", u64c(&|r| r.seed)),
-        ("attempt", Arc::new(attempt.finish())),
-        ("family", s(&|r| Some(r.scene.family.clone()))),
-        ("speed_band", s(&|r| Some(r.scene.speed_band.clone()))),
-        ("speed_sweep", bo(&|r| r.scene.speed_sweep)),
-        ("speed_parameter", s(&|_| Some("launch_speed".into()))),
-        ("speed_value", fl(&|r| Some(r.speed_value))),
-        ("object_id", s(&|r| Some(r.scene.object_id.clone()))),
-        ("object_name", s(&|r| Some(r.object_name.clone()))),
-        ("object_category", s(&|r| Some(r.object_category.clone()))),
-        ("looks_like", s(&|r| r.scene.looks_like.clone())),
-        ("adversarial", bo(&|r| r.scene.adversarial)),
-        ("object_mass_kg", fl(&|r| Some(r.mass))),
-        ("hazards", Arc::new(hazards.finish())),
-        ("room", s(&|_| Some("kitchen".into()))),
-        ("description", s(&|_| None)),
-        ("gt_action", s(&|r| Some(r.scene.gt_action.as_str().into()))),
-        ("dangerous", bo(&|r| r.scene.dangerous)),
-        ("danger_present", bo(&|r| r.scene.danger_present)),
+        (col::SCENE_ID, s(&|r| Some(r.scene.scene_id.clone()))),
+        (col::GROUP_ID, s(&|r| Some(r.scene.group_id.clone()))),
+        (col::SCENE_INDEX, u64c(&|r| r.scene_index)),
+        (col::SEED, u64c(&|r| r.seed)),
+        (col::ATTEMPT, Arc::new(attempt.finish())),
+        (col::FAMILY, s(&|r| Some(r.scene.family.clone()))),
+        (col::SPEED_BAND, s(&|r| Some(r.scene.speed_band.clone()))),
+        (col::SPEED_SWEEP, bo(&|r| r.scene.speed_sweep)),
+        (col::SPEED_PARAMETER, s(&|_| Some("launch_speed".into()))),
+        (col::SPEED_VALUE, fl(&|r| Some(r.speed_value))),
+        (col::OBJECT_ID, s(&|r| Some(r.scene.object_id.clone()))),
+        (col::OBJECT_NAME, s(&|r| Some(r.object_name.clone()))),
         (
-            "impact_point",
+            col::OBJECT_CATEGORY,
+            s(&|r| Some(r.object_category.clone())),
+        ),
+        (col::LOOKS_LIKE, s(&|r| r.scene.looks_like.clone())),
+        (col::ADVERSARIAL, bo(&|r| r.scene.adversarial)),
+        (col::OBJECT_MASS_KG, fl(&|r| Some(r.mass))),
+        (col::HAZARDS, Arc::new(hazards.finish())),
+        (col::ROOM, s(&|_| Some("kitchen".into()))),
+        (col::DESCRIPTION, s(&|_| None)),
+        (
+            col::GT_ACTION,
+            s(&|r| Some(r.scene.gt_action.as_str().into())),
+        ),
+        (col::DANGEROUS, bo(&|r| r.scene.dangerous)),
+        (col::DANGER_PRESENT, bo(&|r| r.scene.danger_present)),
+        (
+            col::IMPACT_POINT,
             vec3_col(rows.iter().map(|r| r.scene.impact_point.as_ref())),
         ),
-        ("time_to_impact", fl(&|r| r.time_to_impact)),
-        ("time_to_floor", fl(&|r| r.time_to_impact.map(|t| t + 0.3))),
+        (col::TIME_TO_IMPACT, fl(&|r| r.time_to_impact)),
         (
-            "impact_speed",
+            col::TIME_TO_FLOOR,
+            fl(&|r| r.time_to_impact.map(|t| t + 0.3)),
+        ),
+        (
+            col::IMPACT_SPEED,
             fl(&|r| r.scene.impact_point.map(|_| r.speed_value)),
         ),
         (
-            "object_start",
+            col::OBJECT_START,
             vec3_col(rows.iter().map(|r| Some(&r.scene.object_start))),
         ),
         (
-            "observer_pose",
+            col::OBSERVER_POSE,
             vec3_col(rows.iter().map(|r| Some(&r.scene.observer_pose))),
         ),
-        ("label_rule", s(&|_| Some("fixture".into()))),
-        ("state_hash", s(&|r| Some(format!("{:016x}", r.seed)))),
-        ("valid", bo(&|r| r.scene.valid)),
-        ("valid_no_interpenetration", bo(&|_| true)),
-        (
-            "spec_file",
-            s(&|r| Some(format!("specs/{}.json", r.scene.scene_id))),
-        ),
-        ("ego_file_name", s(&|_| None)),
-        ("closeup_file_name", s(&|_| None)),
-        ("overhead_file_name", s(&|_| None)),
+        (col::LABEL_RULE, s(&|_| Some("fixture".into()))),
+        (col::STATE_HASH, s(&|r| Some(format!("{:016x}", r.seed)))),
+        (col::VALID, bo(&|r| r.scene.valid)),
+        (col::VALID_NO_INTERPENETRATION, bo(&|_| true)),
+        (col::SPEC_FILE, s(&|r| Some(spec_path(&r.scene.scene_id)))),
+        (col::EGO_FILE_NAME, s(&|_| None)),
+        (col::CLOSEUP_FILE_NAME, s(&|_| None)),
+        (col::OVERHEAD_FILE_NAME, s(&|_| None)),
     ];
     let cols: Vec<(&str, ArrayRef)> = cols
         .into_iter()
         .filter(|(n, _)| !drop.contains(n))
         .collect();
     let batch = RecordBatch::try_from_iter(cols).context("building fixture batch")?;
-    let path = dir.join("data/test-00000-of-00001.parquet");
+    let path = dir.join(data_file_name(0, 1));
     let file = std::fs::File::create(&path)?;
     let mut w = parquet::arrow::ArrowWriter::try_new(file, batch.schema(), None)?;
     w.write(&batch)?;
@@ -380,6 +378,26 @@ mod tests {
             assert_eq!(a.observer_pose, b.observer_pose);
             assert_eq!(a.gt_action, b.gt_action);
             assert_eq!(a.looks_like, b.looks_like);
+        }
+    }
+
+    /// The fixture writes contract columns only, each with the contract's type.
+    #[test]
+    fn fixture_columns_are_contract_columns() {
+        let dir = tempfile::tempdir().unwrap();
+        write_dataset(dir.path(), &synth_rows(8, 3), &[]).unwrap();
+        let file = std::fs::File::open(dir.path().join(data_file_name(0, 1))).unwrap();
+        let reader =
+            parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder::try_new(file).unwrap();
+        for field in reader.schema().fields() {
+            let column = rh_contract::columns::column(field.name())
+                .unwrap_or_else(|| panic!("{} is not a contract column", field.name()));
+            assert_eq!(
+                field.data_type(),
+                &rh_contract::arrow_schema::data_type(column.ty),
+                "{}",
+                field.name()
+            );
         }
     }
 

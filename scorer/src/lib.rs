@@ -10,7 +10,7 @@
 //! [`plan`], action rule and world-frame kinematics in [`rule`], metrics in [`metrics`],
 //! AIA in [`aia`]) and folds results in file order into per-model accumulators
 //! ([`aggregate`]) → [`report::Report::build`] computes breakdowns and the paper's analyses →
-//! [`render`] (terminal, Markdown, CSV), `serde_json` (JSON) and [`figures`] (SVG + PNG).
+//! [`tables`] (terminal, Markdown, CSV), `serde_json` (JSON) and [`figures`] (SVG + PNG).
 //!
 //! Decisions recorded here and printed by `rh-score --explain` ([`explain`]):
 //! * Absurd numbers (NaN/inf, |speed| > 10 m/s, |yaw rate| > 20 rad/s, durations or
@@ -36,10 +36,13 @@ pub mod dataset;
 pub mod explain;
 pub mod figures;
 pub mod fixture;
+pub mod html;
 pub mod metrics;
 pub mod plan;
 pub mod preds;
-pub mod render;
+pub mod tables;
+/// The old name of [`tables`], kept so that code written against `render` still builds.
+pub use tables as render;
 pub mod report;
 pub mod rule;
 pub mod score;

@@ -1,6 +1,6 @@
 //! The report: aggregated metrics per model and breakdown, and the paper's analyses.
 
-use crate::aggregate::{Acc, ModelAgg, Rec, ACT_NONE, REC_SCORED};
+use crate::aggregate::{Acc, ModelAgg, Rec};
 use crate::config::Config;
 use crate::dataset::{Dataset, SPEED_BANDS};
 use crate::score::{Scoring, WarningAcc};
@@ -359,13 +359,13 @@ fn out_of_reach(
     let mut any_d = Vec::new();
     for r in recs {
         for (rec, sc) in r.iter().zip(&ds.scenes) {
-            if rec.state != REC_SCORED || rec.d_end.is_nan() {
+            let (Some(action), Some(d)) = (rec.decision(), rec.end_distance()) else {
                 continue;
-            }
-            if rec.action as usize == sc.gt_action.index() {
-                any_d.push(rec.d_end as f64);
+            };
+            if action == Some(sc.gt_action) {
+                any_d.push(d);
                 if sc.gt_action == Action::Catch {
-                    catch_d.push(rec.d_end as f64);
+                    catch_d.push(d);
                 }
             }
         }
@@ -394,26 +394,22 @@ fn speed_analysis(
     let mut decisions = 0;
     for r in recs {
         for (rec, sc) in r.iter().zip(&ds.scenes) {
-            let (Some(b), true, REC_SCORED) = (sc.speed_band, sc.speed_sweep, rec.state) else {
+            let (Some(b), true, Some(action)) = (sc.speed_band, sc.speed_sweep, rec.decision())
+            else {
                 continue;
             };
             decisions += 1;
             n_band[b as usize] += 1;
-            freeze[b as usize] += (rec.action == Action::NoAction.index() as u8) as u64;
-            saa[b as usize] += (rec.action as usize == sc.gt_action.index()) as u64;
+            freeze[b as usize] += (action == Some(Action::NoAction)) as u64;
+            saa[b as usize] += (action == Some(sc.gt_action)) as u64;
         }
     }
     let (mut complete, mut consistent, mut ends_agree) = (0u64, 0u64, 0u64);
     for r in recs {
         for g in groups {
-            let acts: Option<Vec<u8>> = g
+            let acts: Option<Vec<Option<Action>>> = g
                 .iter()
-                .map(|s| {
-                    s.and_then(|i| {
-                        let rec = r[i as usize];
-                        (rec.state == REC_SCORED).then_some(rec.action)
-                    })
-                })
+                .map(|s| s.and_then(|i| r[i as usize].decision()))
                 .collect();
             let Some(acts) = acts else { continue };
             complete += 1;
@@ -460,27 +456,28 @@ fn voting(models: &[&ModelAgg], ds: &Dataset) -> Voting {
     let mut per_model_right = vec![0u64; k];
     if k >= 1 {
         for (i, sc) in ds.scenes.iter().enumerate() {
-            if !models.iter().all(|m| m.records[i].state == REC_SCORED) {
+            if !models.iter().all(|m| m.records[i].is_scored()) {
                 continue;
             }
             scenes += 1;
-            let gt = sc.gt_action.index() as u8;
+            let gt = sc.gt_action;
+            // Votes per action, and for "no parseable plan" last.
             let mut votes = [0u32; 4];
+            let decision = |m: &ModelAgg| m.records[i].decision().flatten();
             for (j, m) in models.iter().enumerate() {
-                let a = m.records[i].action;
-                votes[a as usize] += 1;
-                per_model_right[j] += (a == gt) as u64;
+                let a = decision(m);
+                votes[a.map_or(3, Action::index)] += 1;
+                per_model_right[j] += (a == Some(gt)) as u64;
             }
-            let first = models[0].records[i].action;
-            if models.iter().all(|m| m.records[i].action == first) && first != ACT_NONE {
+            let first = decision(models[0]);
+            if first.is_some() && models.iter().all(|m| decision(m) == first) {
                 unanimous += 1;
-                unanimous_right += (first == gt) as u64;
+                unanimous_right += (first == Some(gt)) as u64;
             }
-            // Tie order: DODGE(1), NO_ACTION(2), CATCH(0).
-            let mut best: Option<u8> = None;
-            for a in [1u8, 2, 0] {
-                if votes[a as usize] > 0
-                    && best.is_none_or(|b| votes[a as usize] > votes[b as usize])
+            // Tie order: DODGE, NO_ACTION, CATCH.
+            let mut best: Option<Action> = None;
+            for a in [Action::Dodge, Action::NoAction, Action::Catch] {
+                if votes[a.index()] > 0 && best.is_none_or(|b| votes[a.index()] > votes[b.index()])
                 {
                     best = Some(a);
                 }
@@ -512,13 +509,13 @@ fn lookalikes(models: &[&ModelAgg], ds: &Dataset) -> Vec<LookalikeComparison> {
     let mut by_obj: HashMap<&str, (u64, u64, u64)> = HashMap::new();
     for m in models {
         for (rec, sc) in m.records.iter().zip(&ds.scenes) {
-            if rec.state != REC_SCORED {
+            let Some(action) = rec.decision() else {
                 continue;
-            }
+            };
             let e = by_obj.entry(sc.object_id.as_str()).or_default();
             e.0 += 1;
-            e.1 += (rec.action == 0) as u64;
-            e.2 += (rec.action == 1) as u64;
+            e.1 += (action == Some(Action::Catch)) as u64;
+            e.2 += (action == Some(Action::Dodge)) as u64;
         }
     }
     let mut pairs: Vec<(String, String)> = ds

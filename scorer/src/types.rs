@@ -2,56 +2,8 @@
 
 use serde::Serialize;
 
-/// The three action primitives (SPEC §10).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
-pub enum Action {
-    #[serde(rename = "CATCH")]
-    Catch,
-    #[serde(rename = "DODGE")]
-    Dodge,
-    #[serde(rename = "NO_ACTION")]
-    NoAction,
-}
-
-impl Action {
-    pub const ALL: [Action; 3] = [Action::Catch, Action::Dodge, Action::NoAction];
-
-    pub fn parse(s: &str) -> Option<Action> {
-        match s
-            .trim()
-            .to_ascii_uppercase()
-            .replace([' ', '-'], "_")
-            .as_str()
-        {
-            "CATCH" | "EXECUTE_CATCH" => Some(Action::Catch),
-            "DODGE" | "TRIGGER_DODGE" => Some(Action::Dodge),
-            "NO_ACTION" | "NOACTION" | "NONE" => Some(Action::NoAction),
-            _ => None,
-        }
-    }
-
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Action::Catch => "CATCH",
-            Action::Dodge => "DODGE",
-            Action::NoAction => "NO_ACTION",
-        }
-    }
-
-    pub fn index(self) -> usize {
-        self as usize
-    }
-
-    pub fn from_index(i: usize) -> Option<Action> {
-        Action::ALL.get(i).copied()
-    }
-}
-
-impl std::fmt::Display for Action {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
+/// The three action primitives (SPEC §10; the data contract's).
+pub use rh_contract::Action;
 
 /// The safety rules of SPEC §11, in precedence order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]

@@ -4,6 +4,8 @@
 //! `cargo test --release` runs; a test binary lives in `target/<profile>/deps/`, so the
 //! programs sit one directory up.
 
+pub mod cdp;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

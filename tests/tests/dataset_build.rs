@@ -101,10 +101,50 @@ fn dataset_build_layout_card_and_manifest() {
         "@inproceedings{li2027reacthuman",
         "Bang",
         "| build seed | 11 |",
-        "fewer valid scenes",
+        "takes up to 18 valid scenes per family",
+        "up to 18 valid scenes per family (whole speed-band groups first)",
+        "over the whole simulation",
+        "cast_column",
     ] {
         assert!(card.contains(needle), "card lacks {needle:?}:\n{card}");
     }
+    // The card describes this build: its scope line counts the families that have scenes,
+    // and its example code loads this folder, not the released dataset.
+    let families_built: std::collections::BTreeSet<&str> = FAMILIES.split(',').collect();
+    assert!(
+        card.contains(&format!("of {} families", families_built.len())),
+        "{card}"
+    );
+    assert!(!card.contains("load_dataset(\"Alan123"), "{card}");
+
+    // A build smaller than one group per family says which families got no scene and
+    // leaves them out of its tables.
+    let tmp = tempfile::tempdir().unwrap();
+    let small = tmp.path().join("small");
+    run_ok(
+        "rh-pipeline",
+        &[
+            "build",
+            "--n",
+            "4",
+            "--no-render",
+            "--quiet",
+            "--families",
+            "object_drop,rolling_ball",
+            "--out",
+            small.to_str().unwrap(),
+        ],
+    );
+    let card = std::fs::read_to_string(small.join("README.md")).unwrap();
+    assert!(card.contains("of 1 family in 1 scene group "), "{card}");
+    assert!(
+        card.contains("got no scene group") && card.contains("`rolling_ball`"),
+        "{card}"
+    );
+    assert!(
+        card.contains("| object_drop |") && !card.contains("| rolling_ball |"),
+        "{card}"
+    );
     let manifest: serde_json::Value = serde_json::from_slice(&files["build.json"]).unwrap();
     assert_eq!(manifest["seed"], 11);
     assert_eq!(manifest["n"], 40);
@@ -239,6 +279,12 @@ t = pq.read_table(d + "/data/test-00000-of-00001.parquet")
 e = pq.read_table(d + "/eval/test-00000-of-00001.parquet")
 hf = json.loads(pq.read_schema(d + "/data/test-00000-of-00001.parquet").metadata[b"huggingface"])
 pf = pq.ParquetFile(d + "/data/test-00000-of-00001.parquet")
+# The card's first Python example, run from the dataset's folder as it says.
+card = open(d + "/README.md").read()
+example = card.split("```python\n")[1].split("```")[0]
+os.chdir(d)
+ns = {{}}
+exec(example, ns)
 default = datasets.load_dataset(d, "default", split="test")
 ev = datasets.load_dataset(d, "eval", split="test")
 print(json.dumps({{
@@ -253,6 +299,7 @@ print(json.dumps({{
   "row_group_rows": pf.metadata.row_group(0).num_rows,
   "eval_all_valid": all(ev["valid"]),
   "first": default[0]["scene_id"] == t.column("scene_id")[0].as_py(),
+  "card_example_rows": [ns["scenes"].num_rows, ns["subset"].num_rows],
 }}))
 "#,
         home = hf_home.path().to_str().unwrap(),
@@ -265,6 +312,11 @@ print(json.dumps({{
     assert_eq!(out["columns"], out["ds_columns"], "{out}");
     assert!(out["eval_rows"].as_u64().unwrap() > 0, "{out}");
     assert_eq!(out["ds_eval_rows"], out["eval_rows"], "{out}");
+    assert_eq!(
+        out["card_example_rows"],
+        serde_json::json!([out["rows"], out["eval_rows"]]),
+        "the card's example code loads this dataset: {out}"
+    );
     assert_eq!(out["eval_all_valid"], true, "{out}");
     assert_eq!(out["first"], true, "{out}");
     assert_eq!(out["row_group_rows"], 40, "{out}");

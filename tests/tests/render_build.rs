@@ -98,6 +98,18 @@ fn rendered_build_has_probed_videos_frames_columns_and_merges_byte_equal() {
     let config = small_config(tmp.path());
     let single = tmp.path().join("single");
     build(&config, &single, &["--jobs", "2"]);
+    // Rerunning the finished build does nothing, and says only that (no renderer banner).
+    let args: Vec<&str> = build_args(&config, &single, &[])
+        .into_iter()
+        .filter(|a| *a != "--quiet")
+        .collect();
+    let rerun = run("rh-pipeline", &args);
+    let err = String::from_utf8_lossy(&rerun.stderr);
+    assert!(rerun.status.success(), "{err}");
+    assert!(
+        err.contains("nothing to do") && !err.contains("rendering on"),
+        "{err}"
+    );
 
     // Per row: scene id, validity, the four video columns (pyarrow reads the table).
     let rows = python(&format!(

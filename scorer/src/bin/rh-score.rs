@@ -52,6 +52,11 @@ struct Cli {
     #[arg(long, value_name = "DIR")]
     figures: Option<PathBuf>,
 
+    /// Write a self-contained static site into this directory (leaderboard, figures,
+    /// scene browser with videos and every model's decision; opens from file://).
+    #[arg(long, value_name = "DIR")]
+    html: Option<PathBuf>,
+
     /// Write one JSON line per decision (its action, rules and metrics).
     #[arg(long, value_name = "FILE")]
     decisions: Option<PathBuf>,
@@ -186,6 +191,12 @@ fn score(cli: Cli) -> Result<()> {
         )
         .into());
     };
+    if cli.html.is_some() && preds.as_os_str() == "-" {
+        return Err(InputError(
+            "--html reads the predictions twice (per-decision details for the scene pages): give a file, not stdin".into(),
+        )
+        .into());
+    }
     let ds = Dataset::load(&dataset_dir(cli.dataset)?)?;
     let mut scoring = Scoring::new(&ds, &cfg);
     if let Some(p) = &cli.decisions {
@@ -211,20 +222,39 @@ fn score(cli: Cli) -> Result<()> {
         }
     }
     if let Some(p) = &cli.csv {
-        write_file(p, "the CSV report", &rh_score::render::csv(&report))?;
+        write_file(p, "the CSV report", &rh_score::tables::csv(&report))?;
     }
     if let Some(p) = &cli.markdown {
         write_file(
             p,
             "the Markdown report",
-            &rh_score::render::markdown(&report),
+            &rh_score::tables::markdown(&report),
         )?;
     }
     if let Some(d) = &cli.figures {
         rh_score::figures::write_figures(&report, d)?;
     }
+    let site = match &cli.html {
+        Some(dir) => Some(rh_score::html::write_site(&report, &ds, &cfg, &preds, dir)?),
+        None => None,
+    };
     if !cli.quiet && !json_stdout {
-        print_out(&rh_score::render::terminal(&report))?;
+        print_out(&rh_score::tables::terminal(&report))?;
+    }
+    if let Some(site) = site {
+        let index = site
+            .dir
+            .canonicalize()
+            .unwrap_or(site.dir.clone())
+            .join("index.html");
+        eprintln!(
+            "rh-score: site with {} models and {} scenes ({} video files) in {}; open file://{}",
+            site.models,
+            site.scenes,
+            site.media_files,
+            site.dir.display(),
+            index.display()
+        );
     }
     let warned: u64 = report.input.warnings.iter().map(|w| w.count).sum();
     if warned > 0 {

@@ -1,4 +1,5 @@
-//! Stage 1 — plan: choose *what* happens (family, object, room), never a number.
+//! Stage 1 — plan, the scene-selection planner: choose *what* happens (family, object,
+//! room), never a number. (Not a model's reaction plan: that is `rh-score`'s `plan`.)
 //!
 //! Two planners share the `Planner` trait's output type, `Selection`:
 //! * `plan_group` is the embedded planner of `build --n N`: a pure function of the
@@ -250,7 +251,7 @@ impl Planner for LexiconPlanner<'_> {
             (None, Some(o)) => o.families[rng.random_range(0..o.families.len())].clone(),
             (None, None) => {
                 let r = room.expect("checked above");
-                let hosted: Vec<&str> = rh_catalog::FAMILIES
+                let hosted: Vec<&str> = rh_contract::FAMILIES
                     .iter()
                     .copied()
                     .filter(|f| r.hosts(f))

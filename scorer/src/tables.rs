@@ -1,4 +1,5 @@
-//! Report renderings: terminal table, Markdown, CSV (JSON is `serde_json` of [`Report`]).
+//! Report text tables: terminal table, Markdown, CSV (JSON is `serde_json` of [`Report`]).
+//! (Named `tables`, not `render`, which in this project means the video renderer.)
 
 use crate::report::{MetricsRow, ModelReport, Report};
 use crate::types::Rule;
@@ -93,6 +94,15 @@ impl Table {
     }
 }
 
+/// The CATCH row of a per-GT-action breakdown.
+fn catch_row(rows: &[MetricsRow]) -> Option<&MetricsRow> {
+    rows.iter()
+        .find(|g| g.group == crate::types::Action::Catch.as_str())
+}
+
+const MAIN_NOTE: &str = "d_end and HDE (hand-distance error: d_min and d1-d_min over the keyframes) are over CATCH scenes, \
+where meeting the object is the right action; n = CATCH decisions with a distance. They are per GT action below.";
+
 fn main_table(r: &Report) -> Table {
     let mut t = Table::new(&[
         "Model",
@@ -100,41 +110,132 @@ fn main_table(r: &Report) -> Table {
         "Lost",
         "SAA %",
         "Safety %",
-        "d_end (m)",
-        "d_end n/missing",
         "AIA",
-        "d_min (m)",
-        "d1-d_min (m)",
+        "d_end CATCH (m)",
+        "HDE d_min CATCH (m)",
+        "HDE d1-d_min CATCH (m)",
+        "n CATCH",
         "R1",
         "R2",
         "R3",
         "R4",
     ]);
-    let mut add = |name: &str, lost: u64, m: &MetricsRow| {
+    let mut add = |name: &str, lost: u64, m: &ModelReport| {
+        let o = &m.overall;
+        let c = catch_row(&m.by_gt_action);
         t.row(vec![
             name.to_string(),
-            m.decisions.to_string(),
+            o.decisions.to_string(),
             lost.to_string(),
-            pct(m.saa),
-            pct(m.safety),
-            num(m.d_end, 2),
-            format!("{}/{}", m.d_end_n, m.d_end_missing),
-            num(m.aia, 2),
-            num(m.d_min, 2),
-            num(m.closing, 2),
-            m.first_rule.r1.to_string(),
-            m.first_rule.r2.to_string(),
-            m.first_rule.r3.to_string(),
-            m.first_rule.r4.to_string(),
+            pct(o.saa),
+            pct(o.safety),
+            num(o.aia, 2),
+            num(c.and_then(|c| c.d_end), 2),
+            num(c.and_then(|c| c.d_min), 2),
+            num(c.and_then(|c| c.closing), 2),
+            c.map_or(0, |c| c.d_end_n).to_string(),
+            o.first_rule.r1.to_string(),
+            o.first_rule.r2.to_string(),
+            o.first_rule.r3.to_string(),
+            o.first_rule.r4.to_string(),
         ]);
     };
     for m in &r.models {
-        add(&m.model, m.lost, &m.overall);
+        add(&m.model, m.lost, m);
     }
     if r.models.len() > 1 {
-        add("ALL (pooled)", r.pooled.lost, &r.pooled.overall);
+        add("ALL (pooled)", r.pooled.lost, &r.pooled);
     }
     t
+}
+
+/// d_end and HDE per model and GT action (scenes with an impact point).
+fn distance_table(r: &Report) -> Table {
+    let mut t = Table::new(&[
+        "Model",
+        "GT action",
+        "Decisions",
+        "d_end (m)",
+        "HDE d_min (m)",
+        "HDE d1-d_min (m)",
+        "n/missing",
+    ]);
+    for m in r
+        .models
+        .iter()
+        .chain((r.models.len() > 1).then_some(&r.pooled))
+    {
+        for g in &m.by_gt_action {
+            if g.decisions == 0 {
+                continue;
+            }
+            t.row(vec![
+                if m.model == "ALL" {
+                    "ALL (pooled)".into()
+                } else {
+                    m.model.clone()
+                },
+                g.group.clone(),
+                g.decisions.to_string(),
+                num(g.d_end, 2),
+                num(g.d_min, 2),
+                num(g.closing, 2),
+                format!("{}/{}", g.d_end_n, g.d_end_missing),
+            ]);
+        }
+    }
+    t
+}
+
+/// d_end and AIA per group (family or speed band) and model: "d_end / AIA (n)".
+fn distance_aia_table(
+    r: &Report,
+    title: &str,
+    pick: fn(&ModelReport) -> &Vec<MetricsRow>,
+) -> Table {
+    let models: Vec<&ModelReport> = r
+        .models
+        .iter()
+        .chain((r.models.len() > 1).then_some(&r.pooled))
+        .collect();
+    let mut head = vec![title.to_string()];
+    for m in &models {
+        head.push(format!("{} d_end m / AIA", m.model));
+    }
+    let mut t = Table {
+        head,
+        rows: Vec::new(),
+    };
+    let groups: Vec<String> = pick(&r.pooled).iter().map(|g| g.group.clone()).collect();
+    for (gi, g) in groups.iter().enumerate() {
+        let mut row = vec![g.clone()];
+        for m in &models {
+            let x = &pick(m)[gi];
+            row.push(if x.decisions == 0 {
+                "—".into()
+            } else {
+                format!("{} / {} (n={})", num(x.d_end, 2), num(x.aia, 2), x.d_end_n)
+            });
+        }
+        t.row(row);
+    }
+    t
+}
+
+type Pick = fn(&ModelReport) -> &Vec<MetricsRow>;
+
+/// The per-family and per-band d_end / AIA tables: (title, first column, picker).
+fn distance_breakdowns() -> [(&'static str, &'static str, Pick); 2] {
+    [
+        (
+            "d_end and AIA by family (d_end over all scenes of the family with an impact point)",
+            "Family",
+            |m| &m.by_family,
+        ),
+        ("d_end and AIA by speed band", "Speed band", |m| {
+            &m.by_speed_band
+        }),
+    ]
 }
 
 fn breakdown_table(r: &Report, title: &str, pick: fn(&ModelReport) -> &Vec<MetricsRow>) -> Table {
@@ -167,9 +268,19 @@ fn breakdown_table(r: &Report, title: &str, pick: fn(&ModelReport) -> &Vec<Metri
     t
 }
 
-fn analyses_tables(r: &Report) -> Vec<(String, Table, Option<String>)> {
-    let a = &r.analyses;
+/// A titled table with an optional note below it.
+type TitledTable = (String, Table, Option<String>);
+
+fn analyses_tables(r: &Report) -> Vec<TitledTable> {
     let mut out = Vec::new();
+    safety_and_reach_tables(r, &mut out);
+    speed_vote_and_adversarial_tables(r, &mut out);
+    out
+}
+
+/// Safety-rule breakdown, disposition, and correct but out of reach.
+fn safety_and_reach_tables(r: &Report, out: &mut Vec<TitledTable>) {
+    let a = &r.analyses;
 
     let mut t = Table::new(&[
         "Model",
@@ -256,7 +367,11 @@ fn analyses_tables(r: &Report) -> Vec<(String, Table, Option<String>)> {
         ]);
     }
     out.push(("Correct but out of reach".into(), t, Some("Correct CATCH decisions with an impact point. Miss: d_end above the miss radius; falling short: the final hands are closer (horizontally) to the final pelvis than the impact point is; standing far: the final pelvis is farther than the far-standing distance from the impact point (horizontal).".into())));
+}
 
+/// Speed bands, majority vote, adversarial probes and look-alikes.
+fn speed_vote_and_adversarial_tables(r: &Report, out: &mut Vec<TitledTable>) {
+    let a = &r.analyses;
     let mut t = Table::new(&[
         "Model",
         "Decisions",
@@ -351,7 +466,6 @@ fn analyses_tables(r: &Report) -> Vec<(String, Table, Option<String>)> {
             None,
         ));
     }
-    out
 }
 
 fn header(r: &Report) -> String {
@@ -396,6 +510,13 @@ pub fn terminal(r: &Report) -> String {
     let mut s = header(r);
     s.push('\n');
     s.push_str(&main_table(r).text());
+    let _ = writeln!(s, "({MAIN_NOTE})");
+    s.push_str("\nd_end and HDE per ground-truth action (scenes with an impact point)\n");
+    s.push_str(&distance_table(r).text());
+    for (title, column, pick) in distance_breakdowns() {
+        let _ = write!(s, "\n{title}\n");
+        s.push_str(&distance_aia_table(r, column, pick).text());
+    }
     for (title, t, note) in analyses_tables(r) {
         let _ = write!(s, "\n{title}\n");
         if let Some(n) = note {
@@ -418,6 +539,15 @@ pub fn markdown(r: &Report) -> String {
     }
     s.push_str("\nRates in %, distances in metres. Missing values (no impact point, no plan) leave the denominator; their counts are shown.\n\n## Main results\n\n");
     s.push_str(&main_table(r).markdown());
+    let _ = write!(
+        s,
+        "\n{MAIN_NOTE}\n\n## d_end and HDE per ground-truth action\n\n"
+    );
+    s.push_str(&distance_table(r).markdown());
+    for (title, column, pick) in distance_breakdowns() {
+        let _ = write!(s, "\n## {title}\n\n");
+        s.push_str(&distance_aia_table(r, column, pick).markdown());
+    }
     for (title, column, pick) in [
         (
             "By family",

@@ -1,0 +1,77 @@
+//! The three action primitives (SPEC §10): the dataset's `gt_action` values and what a
+//! model's plan chooses.
+
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum Action {
+    #[serde(rename = "CATCH")]
+    Catch,
+    #[serde(rename = "DODGE")]
+    Dodge,
+    #[serde(rename = "NO_ACTION")]
+    NoAction,
+}
+
+impl Action {
+    pub const ALL: [Action; 3] = [Action::Catch, Action::Dodge, Action::NoAction];
+
+    /// Lenient parse of a model's answer: case, spaces and dashes are ignored, and the
+    /// primitive names (`EXECUTE_CATCH`, `TRIGGER_DODGE`) are accepted.
+    pub fn parse(s: &str) -> Option<Action> {
+        match s
+            .trim()
+            .to_ascii_uppercase()
+            .replace([' ', '-'], "_")
+            .as_str()
+        {
+            "CATCH" | "EXECUTE_CATCH" => Some(Action::Catch),
+            "DODGE" | "TRIGGER_DODGE" => Some(Action::Dodge),
+            "NO_ACTION" | "NOACTION" | "NONE" => Some(Action::NoAction),
+            _ => None,
+        }
+    }
+
+    /// The dataset's spelling: `CATCH`, `DODGE`, `NO_ACTION`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Action::Catch => "CATCH",
+            Action::Dodge => "DODGE",
+            Action::NoAction => "NO_ACTION",
+        }
+    }
+
+    /// Same as [`Action::as_str`].
+    pub fn name(self) -> &'static str {
+        self.as_str()
+    }
+
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    pub fn from_index(i: usize) -> Option<Action> {
+        Action::ALL.get(i).copied()
+    }
+}
+
+impl std::fmt::Display for Action {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for a in Action::ALL {
+            assert_eq!(Action::parse(a.as_str()), Some(a));
+            assert_eq!(Action::from_index(a.index()), Some(a));
+        }
+        assert_eq!(Action::parse(" trigger-dodge "), Some(Action::Dodge));
+        assert_eq!(Action::parse("jump"), None);
+    }
+}

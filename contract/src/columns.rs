@@ -1,0 +1,429 @@
+//! The scene table (SPEC §8): one row per scene, its columns in order, each with its
+//! type, nullability and meaning. The dataset writer builds its schema from [`COLUMNS`],
+//! the dataset card its feature table, and both readers (builder and scorer) look
+//! columns up by the names in [`col`].
+
+/// A column's value type (see `arrow_schema` for the Arrow types).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ColumnType {
+    Utf8,
+    Bool,
+    UInt64,
+    UInt32,
+    Float64,
+    /// Fixed-size list of 3 non-null float64: a point or pose.
+    Vec3,
+    /// List of strings.
+    Utf8List,
+    /// List of uint32.
+    UInt32List,
+    /// List of fixed-size lists of 4 non-null float32 (`[t, x, y, z]` samples).
+    Vec4F32List,
+}
+
+/// One column of the scene table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Column {
+    pub name: &'static str,
+    pub ty: ColumnType,
+    pub nullable: bool,
+    /// What the column means (the dataset card's feature table).
+    pub description: &'static str,
+}
+
+/// Column names, for readers and writers (`col::SCENE_ID == "scene_id"`).
+pub mod col {
+    pub const SCENE_ID: &str = "scene_id";
+    pub const GROUP_ID: &str = "group_id";
+    pub const SCENE_INDEX: &str = "scene_index";
+    pub const SEED: &str = "seed";
+    pub const ATTEMPT: &str = "attempt";
+    pub const FAMILY: &str = "family";
+    pub const SPEED_BAND: &str = "speed_band";
+    pub const SPEED_SWEEP: &str = "speed_sweep";
+    pub const SPEED_PARAMETER: &str = "speed_parameter";
+    pub const SPEED_VALUE: &str = "speed_value";
+    pub const OBJECT_ID: &str = "object_id";
+    pub const OBJECT_NAME: &str = "object_name";
+    pub const OBJECT_CATEGORY: &str = "object_category";
+    pub const LOOKS_LIKE: &str = "looks_like";
+    pub const ADVERSARIAL: &str = "adversarial";
+    pub const OBJECT_MASS_KG: &str = "object_mass_kg";
+    pub const HAZARDS: &str = "hazards";
+    pub const ROOM: &str = "room";
+    pub const DESCRIPTION: &str = "description";
+    pub const GT_ACTION: &str = "gt_action";
+    pub const DANGEROUS: &str = "dangerous";
+    pub const DANGER_PRESENT: &str = "danger_present";
+    pub const DANGER_REASONS: &str = "danger_reasons";
+    pub const IMPACT_POINT: &str = "impact_point";
+    pub const IMPACT_KIND: &str = "impact_kind";
+    pub const TIME_TO_IMPACT: &str = "time_to_impact";
+    pub const TIME_TO_FLOOR: &str = "time_to_floor";
+    pub const IMPACT_SPEED: &str = "impact_speed";
+    pub const CLOSEST_APPROACH: &str = "closest_approach";
+    pub const OBJECT_START: &str = "object_start";
+    pub const OBSERVER_POSE: &str = "observer_pose";
+    pub const LABEL_RULE: &str = "label_rule";
+    pub const STATE_HASH: &str = "state_hash";
+    pub const SIM_STEPS: &str = "sim_steps";
+    pub const VALID: &str = "valid";
+    pub const VALID_NO_INTERPENETRATION: &str = "valid_no_interpenetration";
+    pub const VALID_ENERGY: &str = "valid_energy";
+    pub const VALID_NO_TUNNELLING: &str = "valid_no_tunnelling";
+    pub const VALID_IN_FRAME: &str = "valid_in_frame";
+    pub const VALID_INTENDED_EVENT: &str = "valid_intended_event";
+    pub const SPEC_FILE: &str = "spec_file";
+    pub const EGO_FILE_NAME: &str = "ego_file_name";
+    pub const CLOSEUP_FILE_NAME: &str = "closeup_file_name";
+    pub const OVERHEAD_FILE_NAME: &str = "overhead_file_name";
+    pub const FULL_EVENT_FILE_NAME: &str = "full_event_file_name";
+    pub const FRAME_STEPS: &str = "frame_steps";
+    pub const TRAJECTORY: &str = "trajectory";
+}
+
+/// The validator verdict columns, in column order (each `true` when that check passed).
+pub const VALIDATOR_COLUMNS: [&str; 5] = [
+    col::VALID_NO_INTERPENETRATION,
+    col::VALID_ENERGY,
+    col::VALID_NO_TUNNELLING,
+    col::VALID_IN_FRAME,
+    col::VALID_INTENDED_EVENT,
+];
+
+/// The `<cam>_file_name` column of a camera (`CAMERAS`) or of `full_event`.
+pub fn video_column(camera: &str) -> String {
+    format!("{camera}_file_name")
+}
+
+const fn c(
+    name: &'static str,
+    ty: ColumnType,
+    nullable: bool,
+    description: &'static str,
+) -> Column {
+    Column {
+        name,
+        ty,
+        nullable,
+        description,
+    }
+}
+
+use ColumnType::*;
+
+/// Every column of the scene table, in order.
+pub const COLUMNS: &[Column] = &[
+    c(
+        col::SCENE_ID,
+        Utf8,
+        false,
+        "Stable scene id: 8 hex chars from SHA-256 of (build seed, scene index)",
+    ),
+    c(
+        col::GROUP_ID,
+        Utf8,
+        false,
+        "Scene group id; the four speed bands of a group share it and differ only in the speed parameter",
+    ),
+    c(
+        col::SCENE_INDEX,
+        UInt64,
+        false,
+        "Index of the scene in the build (scene i is band i mod 4 of group i div 4)",
+    ),
+    c(
+        col::SEED,
+        UInt64,
+        false,
+        "Build seed the scene was derived from",
+    ),
+    c(
+        col::ATTEMPT,
+        UInt32,
+        false,
+        "Resampling attempt that passed every validator (0 = first draw)",
+    ),
+    c(
+        col::FAMILY,
+        Utf8,
+        false,
+        "Event family (SPEC §4), e.g. object_drop, thrown_object",
+    ),
+    c(
+        col::SPEED_BAND,
+        Utf8,
+        false,
+        "slow, normal, fast or very_fast",
+    ),
+    c(
+        col::SPEED_SWEEP,
+        Bool,
+        false,
+        "Whether the family's pace follows the speed parameter (false: gravity sets it; excluded from speed analyses)",
+    ),
+    c(
+        col::SPEED_PARAMETER,
+        Utf8,
+        false,
+        "What the speed band sets for this family (e.g. launch speed)",
+    ),
+    c(
+        col::SPEED_VALUE,
+        Float64,
+        false,
+        "Value of the speed parameter in SI units",
+    ),
+    c(
+        col::OBJECT_ID,
+        Utf8,
+        false,
+        "Catalog id of the hazard object",
+    ),
+    c(
+        col::OBJECT_NAME,
+        Utf8,
+        false,
+        "Display name of the hazard object",
+    ),
+    c(
+        col::OBJECT_CATEGORY,
+        Utf8,
+        false,
+        "Catalog category of the hazard object",
+    ),
+    c(
+        col::LOOKS_LIKE,
+        Utf8,
+        true,
+        "For adversarial objects: the catalog id it is rendered exactly as; null otherwise",
+    ),
+    c(
+        col::ADVERSARIAL,
+        Bool,
+        false,
+        "The object looks like another one but has its own physics (e.g. a foam anvil)",
+    ),
+    c(
+        col::OBJECT_MASS_KG,
+        Float64,
+        false,
+        "True mass of the hazard (kg)",
+    ),
+    c(
+        col::HAZARDS,
+        Utf8List,
+        false,
+        "Hazard flags of the object's true physics: sharp, hot, heavy, fragile, large",
+    ),
+    c(
+        col::ROOM,
+        Utf8,
+        false,
+        "Room id from the catalog",
+    ),
+    c(
+        col::DESCRIPTION,
+        Utf8,
+        true,
+        "Free-text description the scene was planned from; null when none",
+    ),
+    c(
+        col::GT_ACTION,
+        Utf8,
+        false,
+        "Ground-truth action: CATCH, DODGE or NO_ACTION (label rule below)",
+    ),
+    c(
+        col::DANGEROUS,
+        Bool,
+        false,
+        "The object is dangerous by its true physical properties (rule below)",
+    ),
+    c(
+        col::DANGER_PRESENT,
+        Bool,
+        false,
+        "The hazard would strike the observer standing still (counterfactual simulation)",
+    ),
+    c(
+        col::DANGER_REASONS,
+        Utf8List,
+        false,
+        "Why `dangerous` holds (sharp, hot, large_fragile, heavy_mass, momentum); empty if not",
+    ),
+    c(
+        col::IMPACT_POINT,
+        Vec3,
+        true,
+        "World [x, y, z] (m) where the hazard meets the observer: first descent through the reach plane, else closest approach within the limit; null if none",
+    ),
+    c(
+        col::IMPACT_KIND,
+        Utf8,
+        true,
+        "reach_plane or closest_approach: how `impact_point` was found; null if none",
+    ),
+    c(
+        col::TIME_TO_IMPACT,
+        Float64,
+        true,
+        "Seconds from the event onset (t = 0) to the impact point; null if none",
+    ),
+    c(
+        col::TIME_TO_FLOOR,
+        Float64,
+        true,
+        "Seconds from the onset to the hazard's first floor contact; null if it never lands",
+    ),
+    c(
+        col::IMPACT_SPEED,
+        Float64,
+        true,
+        "Hazard speed at the impact point (m/s); null if none",
+    ),
+    c(
+        col::CLOSEST_APPROACH,
+        Float64,
+        false,
+        "Closest distance of the hazard's centre to the observer's torso axis (m)",
+    ),
+    c(
+        col::OBJECT_START,
+        Vec3,
+        false,
+        "Hazard's centre at t = 0, world [x, y, z] (m)",
+    ),
+    c(
+        col::OBSERVER_POSE,
+        Vec3,
+        false,
+        "Observer on the floor: [x (m), y (m), yaw (rad)]",
+    ),
+    c(
+        col::LABEL_RULE,
+        Utf8,
+        false,
+        "Version of the label rule that produced the labels",
+    ),
+    c(
+        col::STATE_HASH,
+        Utf8,
+        false,
+        "SHA-256 (first 16 bytes, hex) of every dynamic body's state at every physics step; `rh-pipeline verify` replays specs against it",
+    ),
+    c(
+        col::SIM_STEPS,
+        UInt32,
+        false,
+        "Physics steps simulated (240 Hz)",
+    ),
+    c(
+        col::VALID,
+        Bool,
+        false,
+        "Every validator passed (invalid scenes are kept, visible, and not scored)",
+    ),
+    c(
+        col::VALID_NO_INTERPENETRATION,
+        Bool,
+        false,
+        "Validator: no two bodies overlap at t = 0 beyond tolerance",
+    ),
+    c(
+        col::VALID_ENERGY,
+        Bool,
+        false,
+        "Validator: total mechanical energy never rises beyond tolerance",
+    ),
+    c(
+        col::VALID_NO_TUNNELLING,
+        Bool,
+        false,
+        "Validator: the hazard never sinks through the floor",
+    ),
+    c(
+        col::VALID_IN_FRAME,
+        Bool,
+        false,
+        "Validator: the hazard stays in all three cameras' frames during the observation window",
+    ),
+    c(
+        col::VALID_INTENDED_EVENT,
+        Bool,
+        false,
+        "Validator: the family's intended event really happened",
+    ),
+    c(
+        col::SPEC_FILE,
+        Utf8,
+        false,
+        "Relative path of the scene's full, replayable SceneSpec JSON",
+    ),
+    c(
+        col::EGO_FILE_NAME,
+        Utf8,
+        true,
+        "Relative path `videos/ego/<scene_id>.mp4` of the `ego` camera's observation-window video; null when not rendered (`--no-render`, or an invalid scene)",
+    ),
+    c(
+        col::CLOSEUP_FILE_NAME,
+        Utf8,
+        true,
+        "Relative path `videos/closeup/<scene_id>.mp4` of the `closeup` camera's observation-window video; null when not rendered (`--no-render`, or an invalid scene)",
+    ),
+    c(
+        col::OVERHEAD_FILE_NAME,
+        Utf8,
+        true,
+        "Relative path `videos/overhead/<scene_id>.mp4` of the `overhead` camera's observation-window video; null when not rendered (`--no-render`, or an invalid scene)",
+    ),
+    c(
+        col::FULL_EVENT_FILE_NAME,
+        Utf8,
+        true,
+        "Relative path of the full-event MP4 from an outside view, for people (never model input): `videos/full/<scene_id>.mp4`; null when not rendered (`--no-render`, or an invalid scene)",
+    ),
+    c(
+        col::FRAME_STEPS,
+        UInt32List,
+        false,
+        "Physics step shown by each frame k of the camera videos (observation window, both ends included): round(k / video.fps / physics.dt), at most sim_steps",
+    ),
+    c(
+        col::TRAJECTORY,
+        Vec4F32List,
+        false,
+        "Hazard centre [t (s), x, y, z (m)] over the whole simulation (t = 0 to its last step), sampled at the video rate (every 1/fps s, physics step round(t / dt)); the first entries, t ≤ the observation window, match the camera videos' frames (float32)",
+    ),
+];
+
+/// The column called `name`.
+pub fn column(name: &str) -> Option<&'static Column> {
+    COLUMNS.iter().find(|c| c.name == name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::layout::CAMERAS;
+
+    #[test]
+    fn names_are_unique_and_every_video_and_validator_column_exists() {
+        for (i, a) in COLUMNS.iter().enumerate() {
+            assert!(
+                COLUMNS[i + 1..].iter().all(|b| b.name != a.name),
+                "{}",
+                a.name
+            );
+            assert!(!a.description.is_empty(), "{}", a.name);
+        }
+        for cam in CAMERAS.iter().chain(&["full_event"]) {
+            let c = column(&video_column(cam)).unwrap();
+            assert!(c.nullable && c.ty == Utf8);
+        }
+        for v in VALIDATOR_COLUMNS {
+            assert_eq!(column(v).unwrap().ty, Bool);
+        }
+    }
+}

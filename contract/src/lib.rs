@@ -1,0 +1,25 @@
+//! The ReactHuman data contract (SPEC §4, §8, §10), defined once and shared by the
+//! builder (`rh-pipeline`: dataset writer and reader, dataset card) and the scorer
+//! (`rh-score`: dataset reader, fixture, actions):
+//!
+//! * [`families`] — the seventeen event families, in canonical order;
+//! * [`columns`] — the scene table's columns, their types, nullability and meaning;
+//! * [`action`] — the three action primitives;
+//! * [`layout`] — where files live in a dataset directory (specs, videos, frames, data).
+//!
+//! With the `arrow` feature, [`arrow_schema`] gives the Arrow schema of the scene table.
+//! The crate has no heavy dependencies (serde; Arrow only behind the feature), so both
+//! programs can depend on it without pulling in anything else.
+
+pub mod action;
+pub mod columns;
+pub mod families;
+pub mod layout;
+
+#[cfg(feature = "arrow")]
+pub mod arrow_schema;
+
+pub use action::Action;
+pub use columns::{Column, ColumnType, COLUMNS, VALIDATOR_COLUMNS};
+pub use families::FAMILIES;
+pub use layout::{CAMERAS, FRAME_TIMES, FULL_EVENT, SPEED_BANDS};

@@ -1,0 +1,320 @@
+//! Opening the GPU and building the render pipelines (`Gpu::new`).
+
+use super::*;
+
+/// What differs between the render pipelines.
+struct PipelineDesc<'a> {
+    label: &'static str,
+    layout: &'a wgpu::PipelineLayout,
+    vertex: &'static str,
+    vertex_buffer: bool,
+    fragment: Option<&'static str>,
+    depth_compare: wgpu::CompareFunction,
+    depth_write: bool,
+    color_writes: wgpu::ColorWrites,
+    depth_bias: wgpu::DepthBiasState,
+    samples: u32,
+}
+
+const VERTEX_ATTRS: [wgpu::VertexAttribute; 3] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4];
+
+/// The device and queue of the adapter, its name, and the MSAA sample count to use
+/// (`samples` on a hardware GPU, `cpu_samples` on a CPU rasterizer; 4 or 1).
+fn open_device(
+    samples: u32,
+    cpu_samples: u32,
+) -> Result<(wgpu::Device, wgpu::Queue, String, u32), RenderError> {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        // Silences a harmless probe error of the Vulkan loader on headless machines.
+        // SAFETY: called before any other thread of ours reads the environment here.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir()) };
+    }
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    if std::env::var_os("WGPU_BACKEND").is_none() {
+        desc.backends = wgpu::Backends::VULKAN;
+    }
+    let instance = wgpu::Instance::new(desc);
+    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        force_fallback_adapter: false,
+        compatible_surface: None,
+        ..Default::default()
+    }))
+    .map_err(|e| {
+        RenderError::NoAdapter(format!(
+            "{e} (install a Vulkan driver: Mesa's lavapipe, package mesa-vulkan-drivers)"
+        ))
+    })?;
+    let info = adapter.get_info();
+    let adapter_name = info.name;
+    let samples = if info.device_type == wgpu::DeviceType::Cpu {
+        cpu_samples
+    } else {
+        samples
+    };
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        label: Some("rh-render"),
+        required_features: wgpu::Features::empty(),
+        required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+        ..Default::default()
+    }))
+    .map_err(|e| RenderError::NoAdapter(format!("request device on {adapter_name}: {e}")))?;
+    let samples = if samples >= 4 { 4 } else { 1 };
+    Ok((device, queue, adapter_name, samples))
+}
+
+/// The bind group layouts: the shadow pass's (uniforms) and the lit passes' (uniforms,
+/// shadow map, comparison sampler).
+fn bind_group_layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::BindGroupLayout) {
+    let uniform_entry = wgpu::BindGroupLayoutEntry {
+        binding: 0,
+        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let shadow_bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("shadow-bgl"),
+        entries: &[uniform_entry],
+    });
+    let main_bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("main-bgl"),
+        entries: &[
+            uniform_entry,
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Depth,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                count: None,
+            },
+        ],
+    });
+    (shadow_bgl, main_bgl)
+}
+
+/// One render pipeline of the shader.
+fn make_pipeline(
+    device: &wgpu::Device,
+    shader: &wgpu::ShaderModule,
+    p: PipelineDesc,
+) -> wgpu::RenderPipeline {
+    let vlayout = [Some(wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &VERTEX_ATTRS,
+    })];
+    let targets = [Some(wgpu::ColorTargetState {
+        format: COLOR_FORMAT,
+        blend: None,
+        write_mask: p.color_writes,
+    })];
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(p.label),
+        layout: Some(p.layout),
+        vertex: wgpu::VertexState {
+            module: shader,
+            entry_point: Some(p.vertex),
+            compilation_options: Default::default(),
+            buffers: if p.vertex_buffer { &vlayout } else { &[] },
+        },
+        primitive: wgpu::PrimitiveState {
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(p.depth_write),
+            depth_compare: Some(p.depth_compare),
+            stencil: Default::default(),
+            bias: p.depth_bias,
+        }),
+        multisample: wgpu::MultisampleState {
+            count: p.samples,
+            ..Default::default()
+        },
+        fragment: p.fragment.map(|entry| wgpu::FragmentState {
+            module: shader,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            targets: &targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The pipelines: (main, depth-only, main-over, fill, shadow).
+fn pipelines(
+    device: &wgpu::Device,
+    main_layout: &wgpu::PipelineLayout,
+    shadow_layout: &wgpu::PipelineLayout,
+    samples: u32,
+) -> [wgpu::RenderPipeline; 5] {
+    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("rh-shader"),
+        source: wgpu::ShaderSource::Wgsl(include_str!("../shader.wgsl").into()),
+    });
+    let pipeline = |p: PipelineDesc| make_pipeline(device, &shader, p);
+    let main = pipeline(PipelineDesc {
+        label: "main",
+        layout: main_layout,
+        vertex: "vs_main",
+        vertex_buffer: true,
+        fragment: Some("fs_main"),
+        depth_compare: wgpu::CompareFunction::Less,
+        depth_write: true,
+        color_writes: wgpu::ColorWrites::ALL,
+        depth_bias: Default::default(),
+        samples,
+    });
+    // Moving bodies are drawn twice: depth only, then shaded where their depth won,
+    // so overlapping and back-facing surfaces (meshes are not closed: a pan is an
+    // open disc) are shaded once per pixel instead of in draw order.
+    let depth_only = pipeline(PipelineDesc {
+        label: "depth-only",
+        layout: main_layout,
+        vertex: "vs_main",
+        vertex_buffer: true,
+        fragment: Some("fs_fill"),
+        depth_compare: wgpu::CompareFunction::Less,
+        depth_write: true,
+        color_writes: wgpu::ColorWrites::empty(),
+        depth_bias: Default::default(),
+        samples,
+    });
+    let main_over = pipeline(PipelineDesc {
+        label: "main-over",
+        layout: main_layout,
+        vertex: "vs_main",
+        vertex_buffer: true,
+        fragment: Some("fs_main"),
+        depth_compare: wgpu::CompareFunction::LessEqual,
+        depth_write: false,
+        color_writes: wgpu::ColorWrites::ALL,
+        depth_bias: Default::default(),
+        samples,
+    });
+    // Re-clears a scissored region (depth 1, background colour) before it is redrawn.
+    let fill = pipeline(PipelineDesc {
+        label: "fill",
+        layout: main_layout,
+        vertex: "vs_fill",
+        vertex_buffer: false,
+        fragment: Some("fs_fill"),
+        depth_compare: wgpu::CompareFunction::Always,
+        depth_write: true,
+        color_writes: wgpu::ColorWrites::ALL,
+        depth_bias: Default::default(),
+        samples,
+    });
+    let shadow = pipeline(PipelineDesc {
+        label: "shadow",
+        layout: shadow_layout,
+        vertex: "vs_shadow",
+        vertex_buffer: true,
+        fragment: None,
+        depth_compare: wgpu::CompareFunction::Less,
+        depth_write: true,
+        color_writes: wgpu::ColorWrites::ALL,
+        depth_bias: wgpu::DepthBiasState {
+            constant: 2,
+            slope_scale: 2.0,
+            clamp: 0.0,
+        },
+        samples: 1,
+    });
+    [main, depth_only, main_over, fill, shadow]
+}
+
+impl Gpu {
+    /// Opens the adapter and builds the pipelines with `samples` MSAA samples on a
+    /// hardware GPU, `cpu_samples` on a CPU rasterizer (4 or 1 each).
+    pub fn new(samples: u32, cpu_samples: u32) -> Result<Gpu, RenderError> {
+        let (device, queue, adapter_name, samples) = open_device(samples, cpu_samples)?;
+        let (shadow_bgl, main_bgl) = bind_group_layouts(&device);
+        let layout = |bgl: &wgpu::BindGroupLayout| {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: None,
+                bind_group_layouts: &[Some(bgl)],
+                immediate_size: 0,
+            })
+        };
+        let main_layout = layout(&main_bgl);
+        let shadow_layout = layout(&shadow_bgl);
+        let [main, depth_only, main_over, fill, shadow] =
+            pipelines(&device, &main_layout, &shadow_layout, samples);
+        let shadow_map = |label| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: extent(SHADOW_SIZE, SHADOW_SIZE),
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: DEPTH_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC
+                    | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            })
+        };
+        let shadow_tex = shadow_map("shadow-map");
+        let static_shadow = shadow_map("static-shadow-map");
+        let shadow_view = shadow_tex.create_view(&Default::default());
+        let shadow_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow-sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        let shadow_uniform = uniform_buffer(&device);
+        let shadow_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &shadow_bgl,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: shadow_uniform.as_entire_binding(),
+            }],
+        });
+        let vcap = 1 << 20;
+        let vbuf = vertex_buffer(&device, vcap);
+        Ok(Gpu {
+            device,
+            queue,
+            adapter_name,
+            samples,
+            main,
+            depth_only,
+            main_over,
+            fill,
+            shadow,
+            main_bgl,
+            shadow_tex,
+            shadow_view,
+            static_shadow,
+            shadow_sampler,
+            shadow_uniform,
+            shadow_bind,
+            vbuf,
+            vcap,
+            static_len: 0,
+            targets: Vec::new(),
+            frames: Default::default(),
+        })
+    }
+}

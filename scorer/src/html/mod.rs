@@ -1,0 +1,432 @@
+//! `rh-score PREDS --dataset D --html DIR`: a self-contained static site (opens from
+//! `file://`, can be hosted as is; no server, no CDN, nothing fetched).
+//!
+//! ```text
+//! DIR/index.html              leaderboard (one row per model, sortable) and the figures (SVG inline)
+//! DIR/scenes.html             scene browser: filters, paginated list (index: data/index.js)
+//! DIR/scene.html#<scene_id>   one scene: synced videos, labels, every model's decision and
+//!                             planned hand path drawn over the overhead view
+//! DIR/data/index.js           compact per-scene index for the browser's filters
+//! DIR/data/scenes/<id>.js     one scene's row, cameras and decisions, loaded by a <script> tag
+//!                             (file:// forbids fetch() in Chromium, so data are JS, not JSON)
+//! DIR/assets/site.{css,js}    the page code, embedded in rh-score
+//! DIR/figures/*.svg|png       the report's figures
+//! DIR/media/videos/...        the dataset's videos (hard links when possible, else copies)
+//! ```
+//!
+//! Each page stays small whatever the dataset's size: the browser lists 50 scenes a page
+//! from the index (about 25 bytes per scene plus 3 per model), and a scene page loads only
+//! its own file. The planned hands are projected in the page from the spec's stored camera
+//! with the pinhole model of `rh_pipeline::cameras::View` (same basis, same normalised
+//! coordinates).
+//!
+//! Execution (`--execute`, SPEC §12) does not exist yet: the leaderboard rows and scene
+//! decisions carry an `execution` field that is always null today; the pages show
+//! outcome columns and execution videos only when it is present.
+
+mod collect;
+mod rows;
+
+use crate::config::Config;
+use crate::dataset::{Dataset, SPEED_BANDS};
+use crate::report::{MetricsRow, Report};
+use crate::types::{Action, InputError, Rule};
+use anyhow::{anyhow, Context, Result};
+use serde::Serialize;
+use serde_json::{json, Value};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+const CSS: &str = include_str!("assets/site.css");
+const JS: &str = include_str!("assets/site.js");
+/// Marks a directory as a site written by rh-score (only such a directory is replaced).
+const MARKER: &str = ".rh-score-site";
+/// The video columns and the camera each shows (`full_event` is the outside view).
+const VIDEO_COLUMNS: [&str; 4] = [
+    "ego_file_name",
+    "closeup_file_name",
+    "overhead_file_name",
+    "full_event_file_name",
+];
+
+/// What was written.
+#[derive(Debug, Clone, Serialize)]
+pub struct SiteSummary {
+    pub dir: PathBuf,
+    pub models: usize,
+    pub scenes: usize,
+    pub media_files: usize,
+}
+
+/// One leaderboard row.
+#[derive(Serialize)]
+struct LeaderRow<'a> {
+    model: &'a str,
+    decisions: u64,
+    lost: u64,
+    saa: Option<f64>,
+    safety: Option<f64>,
+    /// d_end over CATCH scenes (the paper reports distances where catching is right).
+    d_end_catch: Option<f64>,
+    d_end_catch_n: u64,
+    aia: Option<f64>,
+    /// HDE on CATCH scenes: d_min and d_1 − d_min.
+    hde_d_min_catch: Option<f64>,
+    hde_closing_catch: Option<f64>,
+    first_rule: [u64; 4],
+    prompt_versions: Vec<String>,
+    /// Outcome rates of `--execute` (SPEC §12); null until execution exists.
+    execution: Option<Value>,
+}
+
+fn catch_row<'a>(rows: &'a [MetricsRow]) -> Option<&'a MetricsRow> {
+    rows.iter().find(|r| r.group == Action::Catch.as_str())
+}
+
+/// Writes the site for `report` into `out` (replacing an earlier site there; refusing
+/// any other non-empty directory). `preds` is read once more for per-decision details.
+pub fn write_site(
+    report: &Report,
+    ds: &Dataset,
+    cfg: &Config,
+    preds: &Path,
+    out: &Path,
+) -> Result<SiteSummary> {
+    if out.exists() && !out.join(MARKER).exists() {
+        let empty = std::fs::read_dir(out)
+            .map(|mut d| d.next().is_none())
+            .unwrap_or(false);
+        if !empty {
+            return Err(InputError(format!(
+                "--html {}: the directory exists and is not a site written by rh-score; give a new or empty directory",
+                out.display()
+            ))
+            .into());
+        }
+    }
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent)
+        .map_err(|e| InputError(format!("cannot create {}: {e}", parent.display())))?;
+    let name = out.file_name().and_then(|n| n.to_str()).unwrap_or("site");
+    let tmp = parent.join(format!(".{name}.{}.tmp", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    let result = write_into(report, ds, cfg, preds, &tmp).and_then(|summary| {
+        if out.exists() {
+            let old = parent.join(format!(".{name}.{}.old", std::process::id()));
+            std::fs::rename(out, &old)
+                .with_context(|| format!("moving the old {} away", out.display()))?;
+            let _ = std::fs::remove_dir_all(&old);
+        }
+        std::fs::rename(&tmp, out)
+            .with_context(|| format!("renaming the site into {}", out.display()))?;
+        Ok(SiteSummary {
+            dir: out.to_path_buf(),
+            ..summary
+        })
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_dir_all(&tmp);
+    }
+    result
+}
+
+fn write(path: &Path, text: &str) -> Result<()> {
+    if let Some(p) = path.parent() {
+        std::fs::create_dir_all(p).with_context(|| format!("creating {}", p.display()))?;
+    }
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}
+
+/// JSON safe inside a `<script>` element.
+fn script_json(v: &impl Serialize) -> Result<String> {
+    Ok(serde_json::to_string(v)?.replace("</", "<\\/"))
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+fn page(title: &str, body_id: &str, body: &str, scripts: &[&str]) -> String {
+    let mut s = format!(
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
+         <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
+         <title>{}</title>\n<link rel=\"stylesheet\" href=\"assets/site.css\">\n</head>\n\
+         <body id=\"{body_id}\">\n<header><a class=\"brand\" href=\"index.html\">ReactHuman</a>\
+         <nav><a href=\"index.html\">Leaderboard</a><a href=\"index.html#figures\">Figures</a>\
+         <a href=\"scenes.html\">Scenes</a></nav></header>\n<main>\n{body}\n</main>\n",
+        esc(title)
+    );
+    // The page code first: data scripts call into it (`RH.index(...)`).
+    s.push_str("<script src=\"assets/site.js\"></script>\n");
+    for src in scripts {
+        let _ = writeln!(s, "<script src=\"{src}\"></script>");
+    }
+    s.push_str("</body>\n</html>\n");
+    s
+}
+
+fn write_into(
+    report: &Report,
+    ds: &Dataset,
+    cfg: &Config,
+    preds: &Path,
+    dir: &Path,
+) -> Result<SiteSummary> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    write(
+        &dir.join(MARKER),
+        "written by rh-score --html; rerunning replaces this directory\n",
+    )?;
+    write(&dir.join("assets/site.css"), CSS)?;
+    write(&dir.join("assets/site.js"), JS)?;
+
+    let models: Vec<String> = report.models.iter().map(|m| m.model.clone()).collect();
+    let collected = collect::collect(preds, ds, cfg, &models)?;
+
+    let figures_html = figures_html(report, dir)?;
+    write_board(report, &collected, &figures_html, dir)?;
+    let (scenes, media_files) = write_scenes(ds, &models, &collected, dir)?;
+    write_static_pages(dir)?;
+
+    Ok(SiteSummary {
+        dir: dir.to_path_buf(),
+        models: models.len(),
+        scenes,
+        media_files,
+    })
+}
+
+/// Writes the figures into `dir/figures/` and returns their SVG markup, inlined into the
+/// leaderboard page (the PNGs stay beside them).
+fn figures_html(report: &Report, dir: &Path) -> Result<String> {
+    let fig_dir = dir.join("figures");
+    let figs = crate::figures::write_figures(report, &fig_dir)?;
+    let mut figures_html = String::new();
+    for svg in figs
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "svg"))
+    {
+        let text = std::fs::read_to_string(svg)?;
+        let body = text.find("<svg").map_or(text.as_str(), |i| &text[i..]);
+        let stem = svg.file_stem().and_then(|s| s.to_str()).unwrap_or("figure");
+        let _ = write!(
+            figures_html,
+            "<figure id=\"fig-{stem}\">{body}<figcaption><a href=\"figures/{stem}.svg\">{stem}.svg</a> · \
+             <a href=\"figures/{stem}.png\">PNG</a></figcaption></figure>\n"
+        );
+    }
+
+    Ok(figures_html)
+}
+
+/// `index.html`: the leaderboard and the figures.
+fn write_board(
+    report: &Report,
+    collected: &collect::Collected,
+    figures_html: &str,
+    dir: &Path,
+) -> Result<()> {
+    let rows: Vec<LeaderRow> = report
+        .models
+        .iter()
+        .zip(&collected.prompt_versions)
+        .map(|(m, pv)| {
+            let c = catch_row(&m.by_gt_action);
+            LeaderRow {
+                model: &m.model,
+                decisions: m.overall.decisions,
+                lost: m.lost,
+                saa: m.overall.saa,
+                safety: m.overall.safety,
+                d_end_catch: c.and_then(|c| c.d_end),
+                d_end_catch_n: c.map_or(0, |c| c.d_end_n),
+                aia: m.overall.aia,
+                hde_d_min_catch: c.and_then(|c| c.d_min),
+                hde_closing_catch: c.and_then(|c| c.closing),
+                first_rule: Rule::ALL.map(|r| m.overall.first_rule.get(r)),
+                prompt_versions: pv.iter().cloned().collect(),
+                execution: None,
+            }
+        })
+        .collect();
+    let rules: Vec<Value> = Rule::ALL
+        .iter()
+        .map(|r| json!({"id": r.as_str(), "text": r.describe()}))
+        .collect();
+    let board = json!({
+        "rows": rows,
+        "rules": rules,
+        "action_rule": report.action_rule,
+        "dataset": {"dir": report.dataset.dir, "scenes": report.dataset.scenes,
+                    "invalid": report.dataset.invalid_scenes, "families": report.dataset.families},
+        "input": {"file": report.input.file, "scored": report.input.decisions_scored,
+                  "lost": report.input.decisions_lost},
+        "version": report.version,
+    });
+    let body = format!(
+        "<h1>Leaderboard</h1>\n<p id=\"board-note\"></p>\n\
+         <table id=\"leaderboard\" class=\"sortable\"><thead></thead><tbody></tbody></table>\n\
+         <p class=\"note\" id=\"board-defs\"></p>\n\
+         <h2 id=\"figures\">Figures</h2>\n<div class=\"figures\">\n{figures_html}</div>\n\
+         <script>window.RH_BOARD = {};</script>",
+        script_json(&board)?
+    );
+    write(
+        &dir.join("index.html"),
+        &page("ReactHuman — leaderboard", "page-board", &body, &[]),
+    )?;
+
+    Ok(())
+}
+
+/// `data/index.js`, `data/scenes/<id>.js` and `media/`: returns (scenes, media files).
+fn write_scenes(
+    ds: &Dataset,
+    models: &[String],
+    collected: &collect::Collected,
+    dir: &Path,
+) -> Result<(usize, usize)> {
+    let ds_rows = rows::read_rows(&ds.dir)?;
+    let families = &ds.families;
+    let mut index_rows = Vec::new();
+    let mut media_files = 0usize;
+    let mut scenes = 0usize;
+    let empty = std::collections::BTreeMap::new();
+    for (si, sc) in ds.scenes.iter().enumerate() {
+        if !sc.valid {
+            continue;
+        }
+        let Some(row) = ds_rows.get(&sc.scene_id) else {
+            continue;
+        };
+        scenes += 1;
+        let decisions = collected.decisions.get(&(si as u32)).unwrap_or(&empty);
+        let codes: Vec<u32> = (0..models.len())
+            .map(|mi| {
+                decisions
+                    .get(&mi)
+                    .map_or(5 * 16, |d| d.action_code() * 16 + d.rule_bits())
+            })
+            .collect();
+        let gt = Action::ALL
+            .iter()
+            .position(|a| *a == sc.gt_action)
+            .unwrap_or(0);
+        index_rows.push(json!([
+            sc.scene_id,
+            sc.family,
+            sc.speed_band.map_or(-1, |b| b as i64),
+            gt,
+            sc.adversarial as u8,
+            codes
+        ]));
+        let mut media = serde_json::Map::new();
+        for col in VIDEO_COLUMNS {
+            if let Some(Value::String(rel)) = row.get(col) {
+                if link_media(&ds.dir, rel, &dir.join("media"))? {
+                    media_files += 1;
+                    media.insert(
+                        col.trim_end_matches("_file_name").to_string(),
+                        json!(format!("media/{rel}")),
+                    );
+                }
+            }
+        }
+        let spec: Value = row
+            .get("spec_file")
+            .and_then(Value::as_str)
+            .and_then(|f| std::fs::read(ds.dir.join(f)).ok())
+            .and_then(|b| serde_json::from_slice(&b).ok())
+            .unwrap_or(Value::Null);
+        let per_model: Vec<Value> = (0..models.len())
+            .map(|mi| match decisions.get(&mi) {
+                Some(d) => json!({"model": models[mi], "decision": d, "execution": null}),
+                None => json!({"model": models[mi], "decision": null, "execution": null}),
+            })
+            .collect();
+        let scene = json!({
+            "scene_id": sc.scene_id,
+            "row": row,
+            "cameras": spec.get("cameras").cloned().unwrap_or(json!([])),
+            "video": spec.get("video").cloned().unwrap_or(Value::Null),
+            "window_s": spec.get("observation_window_s").cloned().unwrap_or(Value::Null),
+            "media": media,
+            "models": per_model,
+        });
+        write(
+            &dir.join(format!("data/scenes/{}.js", sc.scene_id)),
+            &format!("RH.scene({});\n", script_json(&scene)?),
+        )?;
+    }
+    let index = json!({
+        "families": families,
+        "bands": SPEED_BANDS,
+        "actions": Action::ALL.map(|a| a.as_str()),
+        "models": models,
+        "rules": Rule::ALL.map(|r| r.as_str()),
+        "scenes": index_rows,
+    });
+    write(
+        &dir.join("data/index.js"),
+        &format!("RH.index({});\n", script_json(&index)?),
+    )?;
+
+    Ok((scenes, media_files))
+}
+
+/// `scenes.html` and `scene.html` (their content comes from the data files).
+fn write_static_pages(dir: &Path) -> Result<()> {
+    let browser = "<h1>Scenes</h1>\n<form id=\"filters\" class=\"filters\"></form>\n\
+        <p id=\"count\"></p>\n<nav class=\"pager\" id=\"pager\"></nav>\n\
+        <table id=\"scene-list\"><thead></thead><tbody></tbody></table>";
+    write(
+        &dir.join("scenes.html"),
+        &page(
+            "ReactHuman — scenes",
+            "page-scenes",
+            browser,
+            &["data/index.js"],
+        ),
+    )?;
+    let scene_page = "<h1 id=\"scene-title\">Scene</h1>\n<p id=\"scene-nav\"></p>\n\
+        <section class=\"videos\"><div class=\"cams\" id=\"cams\"></div>\n\
+        <div class=\"controls\"><button id=\"play\" type=\"button\">Play</button>\
+        <input id=\"scrub\" type=\"range\" min=\"0\" max=\"1000\" value=\"0\"><span id=\"clock\"></span></div>\n\
+        </section>\n\
+        <section><h2>Decisions</h2><table id=\"decisions\"><thead></thead><tbody></tbody></table></section>\n\
+        <div class=\"pair\"><section class=\"facts\"><h2>Labels and physics</h2><table id=\"labels\"></table></section>\n\
+        <section><h2>Full event</h2><div id=\"full\"></div></section></div>\n\
+        <details><summary>Every column of this row</summary><pre id=\"raw\"></pre></details>";
+    write(
+        &dir.join("scene.html"),
+        &page("ReactHuman — scene", "page-scene", scene_page, &[]),
+    )?;
+
+    Ok(())
+}
+
+/// Puts the dataset file `rel` under `media/rel`: a hard link when the file system
+/// allows it, else a copy. False when the dataset lacks the file.
+fn link_media(dataset: &Path, rel: &str, media: &Path) -> Result<bool> {
+    if rel.split('/').any(|c| c == ".." || c.is_empty()) || rel.starts_with('/') {
+        return Err(InputError(format!("dataset names a media file outside itself: {rel}")).into());
+    }
+    let Ok(src) = dataset.join(rel).canonicalize() else {
+        return Ok(false);
+    };
+    let dst = media.join(rel);
+    if let Some(p) = dst.parent() {
+        std::fs::create_dir_all(p).with_context(|| format!("creating {}", p.display()))?;
+    }
+    if std::fs::hard_link(&src, &dst).is_err() {
+        std::fs::copy(&src, &dst)
+            .map_err(|e| anyhow!("copying {} to {}: {e}", src.display(), dst.display()))?;
+    }
+    Ok(true)
+}

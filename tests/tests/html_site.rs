@@ -1,0 +1,319 @@
+//! End-to-end test of `rh-score --html`: a small rendered build (quick-start-like: the
+//! quick start's five baselines, three families, every scene rendered at a small size) is
+//! scored into a static site, which real headless Chromium (Debian's `chromium`, from
+//! scripts/setup.sh) opens from file:// over the DevTools pipe: no console errors, one
+//! leaderboard row per model, sortable, a filter changes the number of listed scenes, a
+//! scene page's videos decode (readyState ≥ 2) and play in sync, and the planned-hands
+//! overlay is drawn. The screenshots in the README come from this test
+//! (`RH_UPDATE_SCREENSHOTS=1` writes them to docs/screenshots/).
+
+use rh_e2e::cdp::{chromium_path, Browser};
+use rh_e2e::run_ok;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+const W: u32 = 320;
+const H: u32 = 180;
+const FAMILIES: &str = "object_drop,sliding_object,thrown_object";
+const BASELINES: [&str; 5] = ["oracle", "majority", "random", "always-catch", "freeze"];
+
+fn small_config(dir: &Path) -> PathBuf {
+    let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs");
+    for name in ["labels.toml", "scoring.toml"] {
+        std::fs::copy(configs.join(name), dir.join(name)).unwrap();
+    }
+    let default = std::fs::read_to_string(configs.join("default.toml")).unwrap();
+    let small = default
+        .replace("\nwidth = 1280\n", &format!("\nwidth = {W}\n"))
+        .replace("\nheight = 720\n", &format!("\nheight = {H}\n"))
+        .replace("\nfull_width = 640\n", &format!("\nfull_width = {W}\n"))
+        .replace("\nfull_height = 360\n", &format!("\nfull_height = {H}\n"));
+    assert_ne!(small, default, "the [render] keys moved; update this test");
+    let path = dir.join("small.toml");
+    std::fs::write(&path, small).unwrap();
+    path
+}
+
+fn url(site: &Path, page: &str) -> String {
+    format!("file://{}/{page}", site.canonicalize().unwrap().display())
+}
+
+fn count(b: &mut Browser) -> u64 {
+    b.eval("+document.getElementById('count').dataset.count")
+        .as_u64()
+        .expect("count")
+}
+
+#[test]
+fn html_site_opens_in_headless_chromium() {
+    let chromium = chromium_path().expect("chromium is installed by scripts/setup.sh");
+    let tmp = tempfile::tempdir().unwrap();
+    let config = small_config(tmp.path());
+    let dataset = tmp.path().join("dataset");
+    run_ok(
+        "rh-pipeline",
+        &[
+            "--config",
+            config.to_str().unwrap(),
+            "build",
+            "--n",
+            "12",
+            "--seed",
+            "0",
+            "--quiet",
+            "--families",
+            FAMILIES,
+            "--out",
+            dataset.to_str().unwrap(),
+        ],
+    );
+    let ds = dataset.to_str().unwrap();
+    let mut preds = String::new();
+    for b in BASELINES {
+        preds += &run_ok("rh-score", &["baseline", b, "--dataset", ds, "--model", b]);
+    }
+    let preds_file = tmp.path().join("preds.jsonl");
+    std::fs::write(&preds_file, preds).unwrap();
+    let site = tmp.path().join("site");
+    let out = rh_e2e::run(
+        "rh-score",
+        &[
+            preds_file.to_str().unwrap(),
+            "--dataset",
+            ds,
+            "--quiet",
+            "--html",
+            site.to_str().unwrap(),
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("index.html"),
+        "says where to open it: {stderr}"
+    );
+    for f in [
+        "index.html",
+        "scenes.html",
+        "scene.html",
+        "data/index.js",
+        "assets/site.js",
+    ] {
+        assert!(site.join(f).is_file(), "{f}");
+    }
+    // Self-contained: nothing is fetched from another origin.
+    for f in ["index.html", "scenes.html", "scene.html", "assets/site.js"] {
+        let text = std::fs::read_to_string(site.join(f)).unwrap();
+        for pat in ["src=\"http", "href=\"http", "url(http", "import "] {
+            assert!(
+                !text.contains(pat),
+                "{f} loads something from the network: {pat}"
+            );
+        }
+    }
+
+    let profile = tmp.path().join("chromium-profile");
+    let mut b = Browser::launch(&chromium, &profile, 1200, 800);
+
+    // Leaderboard: one row per model, sortable.
+    b.goto(&url(&site, "index.html"));
+    let rows = b.eval("document.querySelectorAll('#leaderboard tbody tr').length");
+    assert_eq!(rows.as_u64(), Some(BASELINES.len() as u64));
+    let figures = b.eval("document.querySelectorAll('.figures svg').length");
+    assert_eq!(figures.as_u64(), Some(4), "the four figures inline as SVG");
+    let first = b.eval(
+        "document.querySelector('#leaderboard th[data-col=model]').click(); \
+         document.querySelector('#leaderboard tbody tr').dataset.model",
+    );
+    let mut sorted = BASELINES.to_vec();
+    sorted.sort();
+    assert_eq!(first.as_str(), Some(sorted[0]), "sorting by model name");
+    let shot_board = b.screenshot();
+
+    // Scene browser: a filter changes the number of listed scenes.
+    b.goto(&url(&site, "scenes.html"));
+    let all = count(&mut b);
+    assert_eq!(all, 12, "every valid scene is listed");
+    let listed = b.eval("document.querySelectorAll('#scene-list tbody tr').length");
+    assert_eq!(listed.as_u64(), Some(12));
+    b.eval(
+        "(() => { const s = document.getElementById('f-family'); s.value = 'thrown_object'; \
+         s.dispatchEvent(new Event('change', {bubbles: true})); })()",
+    );
+    let family = count(&mut b);
+    assert!(
+        family > 0 && family < all,
+        "family filter: {family} of {all}"
+    );
+    let model_rule = b.eval(
+        "(() => { const f = document.getElementById('f-family'); f.value = ''; \
+         const m = document.getElementById('f-model'); m.value = 'oracle'; \
+         const r = document.getElementById('f-rule'); r.value = 'unsafe'; \
+         r.dispatchEvent(new Event('change', {bubbles: true})); \
+         return +document.getElementById('count').dataset.count; })()",
+    );
+    assert_eq!(
+        model_rule.as_u64(),
+        Some(0),
+        "the oracle never fires a safety rule"
+    );
+    // A CATCH scene for the scene page (the oracle reaches for it), else the first one.
+    let scene = b.eval(
+        "(() => { const r = document.getElementById('f-rule'); r.value = ''; \
+         const m = document.getElementById('f-model'); m.value = ''; \
+         const g = document.getElementById('f-gt'); g.value = 'CATCH'; \
+         g.dispatchEvent(new Event('change', {bubbles: true})); \
+         let a = document.querySelector('#scene-list tbody a'); \
+         if (!a) { g.value = ''; g.dispatchEvent(new Event('change', {bubbles: true})); \
+                   a = document.querySelector('#scene-list tbody a'); } \
+         return a.getAttribute('href'); })()",
+    );
+    let scene = scene.as_str().expect("a scene link").to_string();
+
+    // Scene page: videos decode and play in sync; the overlay is drawn.
+    b.goto(&url(&site, &scene));
+    let states = b.eval(
+        "new Promise(done => { const t0 = Date.now(); (function poll() { \
+           const v = [...document.querySelectorAll('video')]; \
+           if ((v.length && v.every(x => x.readyState >= 2)) || Date.now() - t0 > 30000) \
+             done(v.map(x => [x.dataset.cam, x.readyState, x.error ? x.error.code : 0])); \
+           else setTimeout(poll, 100); })(); })",
+    );
+    let states = states.as_array().expect("video states").clone();
+    assert_eq!(
+        states.len(),
+        4,
+        "three observation videos and the full event: {states:?}"
+    );
+    for s in &states {
+        assert!(
+            s[1].as_u64().unwrap() >= 2,
+            "video not decodable: {states:?}"
+        );
+    }
+    let paths = b.eval("+document.getElementById('overlay').dataset.paths");
+    assert_eq!(
+        paths.as_u64(),
+        Some(BASELINES.len() as u64),
+        "one hand path per model"
+    );
+    // Pixels in the models' colours (the site's palette) on the overlay canvas.
+    let coloured = b.eval(
+        "(() => { const c = document.getElementById('overlay'); \
+         const pal = [[31,119,180],[255,127,14],[44,160,44],[214,39,40],[148,103,189]]; \
+         const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; let n = 0; \
+         for (let i = 0; i < d.length; i += 4) \
+           if (d[i+3] > 200 && pal.some(p => Math.abs(d[i]-p[0]) < 20 && Math.abs(d[i+1]-p[1]) < 20 && Math.abs(d[i+2]-p[2]) < 20)) n++; \
+         return n; })()",
+    );
+    assert!(
+        coloured.as_u64().unwrap() >= 10,
+        "the planned hands are drawn: {coloured}"
+    );
+    let decisions = b.eval("document.querySelectorAll('#decisions tbody tr').length");
+    assert_eq!(decisions.as_u64(), Some(BASELINES.len() as u64));
+    // Screenshot mid-window (paused), then play.
+    b.eval(
+        "(() => { const s = document.getElementById('scrub'); s.value = '500'; \
+         s.dispatchEvent(new Event('input')); \
+         return new Promise(d => setTimeout(d, 500)); })()",
+    );
+    let shot_scene = b.screenshot();
+    b.eval(
+        "(() => { const s = document.getElementById('scrub'); s.value = '0'; \
+         s.dispatchEvent(new Event('input')); \
+         return new Promise(d => setTimeout(d, 300)); })()",
+    );
+    b.eval("document.getElementById('play').click()");
+    b.pause(Duration::from_millis(300));
+    let times = b.eval("[...document.querySelectorAll('.cams video')].map(v => v.currentTime)");
+    let times: Vec<f64> = times
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_f64().unwrap())
+        .collect();
+    assert_eq!(times.len(), 3);
+    let (lo, hi) = times
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &t| (a.min(t), b.max(t)));
+    assert!(
+        lo > 0.05 && hi - lo < 0.1,
+        "videos play (from 0) in sync: {times:?}"
+    );
+
+    assert!(b.errors.is_empty(), "console errors: {:#?}", b.errors);
+
+    // Predictions that carry a prompt version show it on the leaderboard; rewriting a
+    // site replaces it, and a directory that is not a site is refused (exit 2).
+    let tagged: String = std::fs::read_to_string(&preds_file)
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let mut v: serde_json::Value = serde_json::from_str(l).unwrap();
+            if v["model"] == "oracle" {
+                v["prompt_version"] = serde_json::json!("rh-prompt-test-7");
+            }
+            v.to_string() + "\n"
+        })
+        .collect();
+    std::fs::write(&preds_file, tagged).unwrap();
+    run_ok(
+        "rh-score",
+        &[
+            preds_file.to_str().unwrap(),
+            "--dataset",
+            ds,
+            "--quiet",
+            "--html",
+            site.to_str().unwrap(),
+        ],
+    );
+    let index = std::fs::read_to_string(site.join("index.html")).unwrap();
+    assert!(
+        index.contains("\"prompt_versions\":[\"rh-prompt-test-7\"]"),
+        "prompt version on the board"
+    );
+    let scene_js = std::fs::read_to_string(site.join(format!(
+        "data/{}",
+        scene.replace("scene.html#", "scenes/") + ".js"
+    )))
+    .unwrap();
+    assert!(
+        scene_js.contains("rh-prompt-test-7"),
+        "prompt version on the scene page"
+    );
+    let refused = rh_e2e::run(
+        "rh-score",
+        &[
+            preds_file.to_str().unwrap(),
+            "--dataset",
+            ds,
+            "--quiet",
+            "--html",
+            dataset.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(
+        refused.status.code(),
+        Some(2),
+        "a non-site directory is not replaced"
+    );
+    assert!(dataset.join("README.md").exists());
+
+    let shots = Path::new(env!("CARGO_TARGET_TMPDIR")).join("screenshots");
+    std::fs::create_dir_all(&shots).unwrap();
+    std::fs::write(shots.join("leaderboard.png"), &shot_board).unwrap();
+    std::fs::write(shots.join("scene.png"), &shot_scene).unwrap();
+    assert_eq!(&shot_board[1..4], b"PNG");
+    if std::env::var_os("RH_UPDATE_SCREENSHOTS").is_some() {
+        let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/screenshots");
+        std::fs::create_dir_all(&docs).unwrap();
+        std::fs::write(docs.join("leaderboard.png"), &shot_board).unwrap();
+        std::fs::write(docs.join("scene.png"), &shot_scene).unwrap();
+    }
+}
