@@ -551,7 +551,6 @@ fn corrupt_bodies_never_enter_the_cache_and_bad_blobs_are_refetched() {
     let data = files.keys().find(|k| k.ends_with(".parquet") && k.starts_with("data/")).unwrap().clone();
     let spec = files.keys().find(|k| k.starts_with("specs/")).unwrap().clone();
     let home = tmp.path().join("home");
-    let blobs = home.join("hub/datasets--rh-test--tiny/blobs");
 
     // An LFS file (hash: SHA-256) and a plain one (git blob SHA-1) served altered.
     // (Each into a fresh cache: the other files are stored meanwhile.)
