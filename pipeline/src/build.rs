@@ -42,6 +42,9 @@ pub struct BuildOptions {
     pub out: PathBuf,
     pub seed: u64,
     pub families: Vec<String>,
+    /// Planned selections (from descriptions): group `g` takes `selections[g mod len]`
+    /// instead of the embedded round-robin planner.
+    pub selections: Option<Vec<crate::spec::Selection>>,
     pub jobs: usize,
     /// `(i, N)`: build only the groups `g` with `g mod N == i`.
     pub shard: (u64, u64),
@@ -429,7 +432,7 @@ pub fn build(
     // Fail before any work when there is nothing to render with; say what renders only
     // once there is something to render (not before "nothing to do").
     let render_banner = check_render_stage(opts, config)?;
-    let manifest = Manifest::new(
+    let mut manifest = Manifest::new(
         opts.seed,
         opts.n,
         &opts.families,
@@ -438,6 +441,7 @@ pub fn build(
         catalog,
         config,
     );
+    manifest.selections = opts.selections.clone();
     let out = &opts.out;
     std::fs::create_dir_all(out)
         .map_err(|e| BuildError::Input(format!("cannot write to --out {}: {e}", out.display())))?;
@@ -494,7 +498,7 @@ pub fn build(
             .try_for_each(|&g| -> Result<(), BuildError> {
                 let count = manifest.group_size(g);
                 let results =
-                    run_group(catalog, &opts.families, opts.seed, g, count, config, render)
+                    run_group(catalog, &opts.families, opts.selections.as_deref(), opts.seed, g, count, config, render)
                         .map_err(|e| match e {
                             GroupError::Input(m) => BuildError::Input(m),
                             GroupError::Render(m) => BuildError::Internal(m),

@@ -291,6 +291,7 @@ mod tests {
             object_id: "apple".into(),
             room_id: "kitchen".into(),
             description: None,
+            planner: None,
         };
         let spec = randomize(&selection, &SceneKey::new(0, 0, 0), &catalog, &config).unwrap();
         let table = &spec.bodies[spec.source_support.unwrap()];

@@ -32,9 +32,19 @@ pub struct Cli {
 pub enum Command {
     /// Build N scenes into a Hugging Face-style dataset directory.
     Build {
-        /// Number of scenes (four speed bands per scene group).
-        #[arg(long)]
-        n: u64,
+        /// Number of scenes (four speed bands per scene group). With --descriptions it
+        /// defaults to four per description (group g takes description g mod D).
+        #[arg(long, required_unless_present = "descriptions")]
+        n: Option<u64>,
+        /// Plan the scene groups from these descriptions (a text file, one a line; blank
+        /// lines and lines starting with # are skipped) instead of round-robin families.
+        #[arg(long, value_name = "FILE")]
+        descriptions: Option<PathBuf>,
+        /// Which planner reads the descriptions.
+        #[arg(long, value_enum, default_value = "lexicon", requires = "descriptions")]
+        planner: PlannerKind,
+        #[command(flatten)]
+        llm: LlmArgs,
         /// Output directory (created if missing).
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
@@ -67,6 +77,11 @@ pub enum Command {
         /// Seed for choices the description leaves open.
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// Ask a language model (OpenAI-compatible API; --model) instead of the lexicon.
+        #[arg(long, requires = "model")]
+        llm: bool,
+        #[command(flatten)]
+        llm_args: LlmArgs,
     },
     /// Combine the outputs of `build --shard i/N` (all N of them) into one dataset equal to
     /// the unsharded build.
@@ -136,6 +151,89 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+}
+
+/// Which planner turns descriptions into selections.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PlannerKind {
+    Lexicon,
+    Llm,
+}
+
+/// The language model of the LLM planner (same client as `rh-score predict`).
+#[derive(clap::Args, Debug, Clone)]
+pub struct LlmArgs {
+    /// Model id for the LLM planner.
+    #[arg(long)]
+    pub model: Option<String>,
+    /// OpenAI-compatible endpoint (default: $OPENAI_BASE_URL, else configs/planner.toml).
+    #[arg(long, value_name = "URL")]
+    pub base_url: Option<String>,
+    /// Environment variable holding the API key (unset is fine for local servers).
+    #[arg(long, value_name = "VAR", default_value = "OPENAI_API_KEY")]
+    pub api_key_env: String,
+    /// Do not read or write the response cache.
+    #[arg(long)]
+    pub no_cache: bool,
+}
+
+fn llm_planner<'a>(
+    catalog: &'a Catalog,
+    args: &LlmArgs,
+) -> Result<crate::llm_plan::LlmPlanner<'a>, Failure> {
+    let model = args
+        .model
+        .as_deref()
+        .ok_or_else(|| input("the LLM planner needs --model ID"))?;
+    let cfg = crate::llm_plan::PlannerConfig::embedded();
+    let mut client = cfg.client.clone();
+    if let Some(u) = args
+        .base_url
+        .clone()
+        .or_else(|| std::env::var("OPENAI_BASE_URL").ok().filter(|s| !s.is_empty()))
+    {
+        client.base_url = u;
+    }
+    client.api_key = std::env::var(&args.api_key_env).ok().filter(|k| !k.is_empty());
+    let cache = (!args.no_cache).then(|| rh_llm::cache::Cache::new(rh_llm::cache::default_dir()));
+    crate::llm_plan::LlmPlanner::new(catalog, client, cache, model, cfg).map_err(|m| Failure {
+        code: 1,
+        message: m,
+    })
+}
+
+/// Reads a descriptions file: one a line; blank lines and `#` comments skipped.
+fn read_descriptions(path: &std::path::Path) -> Result<Vec<String>, Failure> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| input(format!("cannot read --descriptions {}: {e}", path.display())))?;
+    let lines: Vec<String> = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with('#'))
+        .map(str::to_string)
+        .collect();
+    if lines.is_empty() {
+        return Err(input(format!("{}: no descriptions", path.display())));
+    }
+    Ok(lines)
+}
+
+/// One selection per description; description `i` plans with group `i`'s seed.
+fn plan_descriptions(
+    planner: &dyn Planner,
+    descriptions: &[String],
+    path: &std::path::Path,
+    build_seed: u64,
+) -> Result<Vec<crate::spec::Selection>, Failure> {
+    descriptions
+        .iter()
+        .enumerate()
+        .map(|(i, d)| {
+            planner
+                .plan(d, crate::seeds::group_seed(build_seed, i as u64))
+                .map_err(|e| input(format!("{}: description {}: {e}", path.display(), i + 1)))
+        })
+        .collect()
 }
 
 /// A failure with its exit code.
@@ -400,6 +498,9 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         }
         Command::Build {
             n,
+            descriptions,
+            planner,
+            llm,
             out,
             seed,
             families,
@@ -409,11 +510,48 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             json,
             quiet,
         } => {
+            let seed = seed.unwrap_or(config.build.seed);
+            let selections = match &descriptions {
+                None => None,
+                Some(path) => {
+                    let texts = read_descriptions(path)?;
+                    let sel = match planner {
+                        PlannerKind::Lexicon => plan_descriptions(
+                            &LexiconPlanner::new(&catalog),
+                            &texts,
+                            path,
+                            seed,
+                        )?,
+                        PlannerKind::Llm => {
+                            plan_descriptions(&llm_planner(&catalog, &llm)?, &texts, path, seed)?
+                        }
+                    };
+                    Some(sel)
+                }
+            };
+            let n = match (n, &selections) {
+                (Some(n), _) => n,
+                (None, Some(s)) => 4 * s.len() as u64,
+                (None, None) => unreachable!("clap requires --n without --descriptions"),
+            };
+            let families = match &selections {
+                Some(s) => {
+                    let mut f: Vec<String> = Vec::new();
+                    for x in s {
+                        if !f.contains(&x.family) {
+                            f.push(x.family.clone());
+                        }
+                    }
+                    f
+                }
+                None => families.unwrap_or_else(|| config.build.families.clone()),
+            };
             let opts = BuildOptions {
                 n,
                 out,
-                seed: seed.unwrap_or(config.build.seed),
-                families: families.unwrap_or_else(|| config.build.families.clone()),
+                seed,
+                families,
+                selections,
                 jobs: jobs
                     .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
                 shard: match shard {
@@ -461,12 +599,20 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             }
             Ok(())
         }
-        Command::Plan { description, seed } => {
-            let planner = LexiconPlanner::new(&catalog);
-            let selection = planner
-                .plan(&description, seed)
-                .map_err(|e| input(e.to_string()))?;
-            let matches = planner.matches(&description);
+        Command::Plan {
+            description,
+            seed,
+            llm,
+            llm_args,
+        } => {
+            let lexicon = LexiconPlanner::new(&catalog);
+            let selection = if llm {
+                llm_planner(&catalog, &llm_args)?.plan(&description, seed)
+            } else {
+                lexicon.plan(&description, seed)
+            }
+            .map_err(|e| input(e.to_string()))?;
+            let matches = lexicon.matches(&description);
             let out = serde_json::json!({ "selection": selection, "matched": matches });
             println!(
                 "{}",

@@ -176,6 +176,7 @@ mod tests {
             object_id: object.into(),
             room_id: "kitchen".into(),
             description: None,
+            planner: None,
         };
         let mut spec = randomize(&selection, &SceneKey::new(0, 1, 0), &catalog, &config).unwrap();
         spec.observer.x = 0.0;

@@ -23,6 +23,7 @@ pub mod families;
 pub mod fsio;
 pub mod integrity;
 pub mod label;
+pub mod llm_plan;
 pub mod manifest;
 pub mod merge;
 pub mod selection;

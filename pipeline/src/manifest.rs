@@ -40,6 +40,10 @@ pub struct Manifest {
     /// build is finished (`build::finalize`); absent while it runs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub files: Option<crate::integrity::FileSums>,
+    /// The planned selections of a build from descriptions (`--descriptions`), one per
+    /// description with its planner record; group g takes selection g mod len.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub selections: Option<Vec<crate::spec::Selection>>,
 }
 
 fn sha256_hex(bytes: &[u8]) -> String {
@@ -85,6 +89,7 @@ impl Manifest {
             catalog_sha256: catalog_sha256(catalog),
             config: serde_json::to_value(config).expect("config serializes"),
             files: None,
+            selections: None,
         }
     }
 
@@ -145,6 +150,11 @@ impl Manifest {
             other.rh_pipeline_version.clone(),
         );
         cmp("seed", self.seed.to_string(), other.seed.to_string());
+        cmp(
+            "planned selections (--descriptions)",
+            serde_json::to_string(&self.selections).unwrap_or_default(),
+            serde_json::to_string(&other.selections).unwrap_or_default(),
+        );
         cmp("n", self.n.to_string(), other.n.to_string());
         cmp(
             "families",

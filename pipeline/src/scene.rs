@@ -58,14 +58,19 @@ pub enum GroupError {
 pub fn run_group(
     catalog: &Catalog,
     families: &[String],
+    planned: Option<&[Selection]>,
     seed: u64,
     g: u64,
     count: u64,
     config: &Config,
     render: Option<&RenderStage>,
 ) -> Result<Vec<SceneResult>, GroupError> {
-    let selection =
-        plan_group(catalog, families, seed, g).map_err(|e| GroupError::Input(e.to_string()))?;
+    // Selections planned from descriptions (`build --descriptions`): group g takes g mod D.
+    let selection = match planned {
+        Some(s) if !s.is_empty() => s[(g % s.len() as u64) as usize].clone(),
+        _ => plan_group(catalog, families, seed, g)
+            .map_err(|e| GroupError::Input(e.to_string()))?,
+    };
     let mut results = produce_group(&selection, seed, g * 4, count, catalog, config)
         .map_err(|e| GroupError::Input(e.to_string()))?;
     if let Some(render) = render {

@@ -62,6 +62,7 @@ pub fn plan_group(
         object_id: object.id.clone(),
         room_id: room.id.clone(),
         description: None,
+        planner: None,
     })
 }
 
@@ -294,6 +295,7 @@ impl Planner for LexiconPlanner<'_> {
             room_id: room.id.clone(),
             family,
             description: Some(description.to_string()),
+            planner: None,
         })
     }
 }

@@ -56,6 +56,28 @@ pub struct Selection {
     /// The free-text description the selection came from, if any.
     #[serde(default)]
     pub description: Option<String>,
+    /// Which planner chose it from the description, when a model was asked (absent for
+    /// the embedded and the plain lexicon planner, so their specs are unchanged).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub planner: Option<PlannerRecord>,
+}
+
+/// How an LLM-planned selection came about (stored in the spec).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlannerRecord {
+    /// "llm" when the model's selection was used; "lexicon" when the lexicon planner
+    /// decided after the model gave no valid selection.
+    pub planner: String,
+    /// The model asked.
+    pub model: Option<String>,
+    /// The planner prompt's version (configs/planner.toml).
+    pub version: Option<String>,
+    /// Requests made to reach the answer (or given up after).
+    pub tries: u32,
+    /// Why the lexicon planner decided instead of the model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback: Option<String>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -145,8 +145,13 @@ pub fn verify(dir: &Path, catalog: &Catalog) -> Result<VerifyReport, String> {
     let per_group: Vec<Result<(usize, Vec<Mismatch>), String>> = groups
         .par_iter()
         .map(|&g| {
-            let selection = plan_group(catalog, &manifest.families, manifest.seed, g)
-                .map_err(|e| e.to_string())?;
+            // As `scene::run_group`: a build from descriptions stored its planned
+            // selections (group g takes g mod len); else the lexicon plans the group.
+            let selection = match manifest.selections.as_deref() {
+                Some(s) if !s.is_empty() => s[(g % s.len() as u64) as usize].clone(),
+                _ => plan_group(catalog, &manifest.families, manifest.seed, g)
+                    .map_err(|e| e.to_string())?,
+            };
             let mut results = produce_group(
                 &selection,
                 manifest.seed,

@@ -46,6 +46,7 @@ fn custom_scene(family: &str, object: &str, room: &str, bands: [f64; 4], index: 
         object_id: object.into(),
         room_id: room.into(),
         description: None,
+        planner: None,
     };
     randomize(&selection, &SceneKey::new(3, index, 0), &catalog, &config).unwrap()
 }

@@ -265,6 +265,7 @@ fn twin_labels(family: &str, real: &str, twin: &str) -> Option<(SceneResult, Sce
                 object_id: object.into(),
                 room_id: room.clone(),
                 description: None,
+                planner: None,
             };
             // The normal band of group 0.
             produce_group(&selection, seed, 0, 2, &catalog, &config)

@@ -174,6 +174,8 @@ pub struct ModelAgg {
     pub adv_decisions: u64,
     pub adv_questions: u64,
     pub records: Vec<Rec>,
+    /// Prompt versions of the model's lines (`-` for lines without one).
+    pub prompt_versions: std::collections::BTreeSet<String>,
 }
 
 impl ModelAgg {
@@ -192,6 +194,7 @@ impl ModelAgg {
             adv_decisions: 0,
             adv_questions: 0,
             records: vec![Rec::default(); ds.scenes.len()],
+            prompt_versions: Default::default(),
         }
     }
 

@@ -141,6 +141,9 @@ impl Dataset {
             ))
             .into());
         }
+        if !data.is_dir() {
+            return Err(InputError(crate::layout::missing_parquet_message(dir)).into());
+        }
         let mut files: Vec<PathBuf> = std::fs::read_dir(&data)
             .map_err(|e| {
                 InputError(format!(
@@ -153,11 +156,7 @@ impl Dataset {
             .collect();
         files.sort();
         if files.is_empty() {
-            return Err(InputError(format!(
-                "dataset {} has no data/*.parquet files",
-                dir.display()
-            ))
-            .into());
+            return Err(InputError(crate::layout::missing_parquet_message(dir)).into());
         }
         let mut ds = Dataset {
             dir: dir.to_path_buf(),

@@ -37,8 +37,10 @@ pub mod explain;
 pub mod figures;
 pub mod fixture;
 pub mod html;
+pub mod layout;
 pub mod metrics;
 pub mod plan;
+pub mod predict;
 pub mod preds;
 pub mod tables;
 /// The old name of [`tables`], kept so that code written against `render` still builds.

@@ -96,6 +96,8 @@ pub enum LineOutcome {
         result: Option<DecisionResult>,
         /// Non-fatal warnings (also the reason for R1, if any).
         notes: Vec<&'static str>,
+        /// The line's `prompt_version` (rh-score predict), if any.
+        prompt_version: Option<String>,
     },
 }
 
@@ -146,6 +148,8 @@ struct FastLine<'a> {
     response: Option<&'a RawValue>,
     #[serde(borrow)]
     error: Option<&'a RawValue>,
+    #[serde(default)]
+    prompt_version: Option<String>,
 }
 
 fn raw_present(v: Option<&RawValue>) -> Option<&str> {
@@ -213,7 +217,8 @@ pub fn process_line(raw: &RawLine, ds: &Dataset, cfg: &Config, aia: &AiaMatcher)
             .is_some_and(|v| is_error_value(&v));
         let plan = raw_present(line.plan);
         let response = raw_present(line.response);
-        return decide(ds, cfg, aia, scene_id, model, error, || {
+        let version = line.prompt_version;
+        return decide(ds, cfg, aia, scene_id, model, error, version, || {
             let none = plan.is_none() && response.is_none();
             (plan_of_raw(plan, response, cfg), none)
         });
@@ -239,7 +244,11 @@ pub fn process_line(raw: &RawLine, ds: &Dataset, cfg: &Config, aia: &AiaMatcher)
         _ => return skip("missing_model"),
     };
     let error = obj.get("error").is_some_and(is_error_value);
-    decide(ds, cfg, aia, scene_id, model, error, || {
+    let version = obj
+        .get("prompt_version")
+        .and_then(Value::as_str)
+        .map(str::to_string);
+    decide(ds, cfg, aia, scene_id, model, error, version, || {
         let none = obj.get("plan").is_none_or(Value::is_null)
             && obj.get("response").is_none_or(Value::is_null);
         (plan_of(&obj, cfg), none)
@@ -253,6 +262,7 @@ fn decide(
     scene_id: String,
     model: String,
     error: bool,
+    prompt_version: Option<String>,
     plan: impl FnOnce() -> (Result<Plan, PlanError>, bool),
 ) -> LineOutcome {
     let Some((idx, scene)) = ds.get(&scene_id) else {
@@ -273,6 +283,7 @@ fn decide(
             model,
             result: None,
             notes: Vec::new(),
+            prompt_version,
         };
     }
     let (plan, none) = plan();
@@ -298,6 +309,7 @@ fn decide(
         model,
         result: Some(result),
         notes,
+        prompt_version,
     }
 }
 

@@ -101,6 +101,9 @@ impl MetricsRow {
 #[derive(Debug, Clone, Serialize)]
 pub struct ModelReport {
     pub model: String,
+    /// The prompt version(s) of the model's lines (rh-score predict records it; `-` for
+    /// lines without one). More than one means the rows mix prompts.
+    pub prompt_version: String,
     pub lost: u64,
     pub duplicates: u64,
     pub overall: MetricsRow,
@@ -277,6 +280,11 @@ const BAND_GROUPS: [&str; 5] = ["slow", "normal", "fast", "very_fast", "other"];
 fn model_report(m: &ModelAgg, ds: &Dataset) -> ModelReport {
     ModelReport {
         model: m.name.clone(),
+        prompt_version: if m.prompt_versions.is_empty() {
+            "-".to_string()
+        } else {
+            m.prompt_versions.iter().cloned().collect::<Vec<_>>().join("+")
+        },
         lost: m.lost,
         duplicates: m.duplicates,
         overall: MetricsRow::from_acc("all", &m.overall),

@@ -162,6 +162,7 @@ impl<'a> Scoring<'a> {
                 model,
                 result,
                 notes,
+                prompt_version,
             } => {
                 for n in notes {
                     self.warn(n, line, None);
@@ -180,6 +181,10 @@ impl<'a> Scoring<'a> {
                 let m = &mut self.models[mi];
                 let lost_before = m.lost;
                 let counted = m.add(scene, sc, result.as_ref(), a.miss_radius, a.far_standing);
+                if counted {
+                    m.prompt_versions
+                        .insert(prompt_version.unwrap_or_else(|| "-".to_string()));
+                }
                 if !counted {
                     self.duplicates += 1;
                     self.warn(

@@ -106,6 +106,7 @@ where meeting the object is the right action; n = CATCH decisions with a distanc
 fn main_table(r: &Report) -> Table {
     let mut t = Table::new(&[
         "Model",
+        "Prompt",
         "Decisions",
         "Lost",
         "SAA %",
@@ -120,11 +121,12 @@ fn main_table(r: &Report) -> Table {
         "R3",
         "R4",
     ]);
-    let mut add = |name: &str, lost: u64, m: &ModelReport| {
+    let mut add = |name: &str, prompt: &str, lost: u64, m: &ModelReport| {
         let o = &m.overall;
         let c = catch_row(&m.by_gt_action);
         t.row(vec![
             name.to_string(),
+            prompt.to_string(),
             o.decisions.to_string(),
             lost.to_string(),
             pct(o.saa),
@@ -141,10 +143,10 @@ fn main_table(r: &Report) -> Table {
         ]);
     };
     for m in &r.models {
-        add(&m.model, m.lost, m);
+        add(&m.model, &m.prompt_version, m.lost, m);
     }
     if r.models.len() > 1 {
-        add("ALL (pooled)", r.pooled.lost, &r.pooled);
+        add("ALL (pooled)", "", r.pooled.lost, &r.pooled);
     }
     t
 }

@@ -100,6 +100,11 @@ enum Cmd {
         #[arg(long, value_name = "FILE")]
         config: Option<PathBuf>,
     },
+    /// Run a model over a dataset through the OpenAI-compatible chat API with the
+    /// canonical prompt (configs/prompt.toml) and write preds.jsonl. Resumes: run it again
+    /// with the same arguments after a crash, a kill or --max-cost and it does only what is
+    /// missing.
+    Predict(Box<PredictArgs>),
     /// Write a synthetic dataset with the rh-pipeline column contract (tests).
     #[command(hide = true)]
     MakeFixture {
@@ -113,6 +118,200 @@ enum Cmd {
         #[arg(long = "drop-column")]
         drop: Vec<String>,
     },
+}
+
+#[derive(clap::Args, Debug)]
+struct PredictArgs {
+    /// Dataset directory (data/*.parquet + frames/) or Hub dataset id owner/name[@revision].
+    /// Default: $RH_DATASET, else the released dataset.
+    #[arg(long, value_name = "DIR|owner/name")]
+    dataset: Option<String>,
+    /// Model id as the server knows it (e.g. gpt-4o, Qwen/Qwen2.5-VL-7B-Instruct).
+    #[arg(long)]
+    model: String,
+    /// Predictions file (JSON Lines), appended to and resumed.
+    #[arg(long, value_name = "FILE", required_unless_present = "dry_run")]
+    out: Option<PathBuf>,
+    /// OpenAI-compatible endpoint, e.g. http://127.0.0.1:8000/v1 (default: $OPENAI_BASE_URL,
+    /// else configs/predict.toml).
+    #[arg(long, value_name = "URL")]
+    base_url: Option<String>,
+    /// Environment variable holding the API key (unset is fine for local servers).
+    #[arg(long, value_name = "VAR", default_value = "OPENAI_API_KEY")]
+    api_key_env: String,
+    /// Which scenes: the balanced eval subset or every valid scene.
+    #[arg(long, value_enum, default_value = "eval")]
+    subset: rh_score::predict::Subset,
+    /// Only the first N scenes of the subset (dataset order).
+    #[arg(long, value_name = "N")]
+    limit: Option<usize>,
+    /// Most requests in flight (adaptive: halves on HTTP 429, grows back).
+    #[arg(long, value_name = "N")]
+    concurrency: Option<usize>,
+    /// Sampling temperature (default: configs/predict.toml).
+    #[arg(long)]
+    temperature: Option<f64>,
+    /// Most completion tokens per answer (default: configs/predict.toml).
+    #[arg(long)]
+    max_tokens: Option<u32>,
+    /// Stop cleanly before the requests recorded in --out cost more than this (USD); run
+    /// again with a higher value to resume.
+    #[arg(long, value_name = "USD")]
+    max_cost: Option<f64>,
+    /// Price of input tokens, USD per million (overrides the price table).
+    #[arg(long, value_name = "USD")]
+    price_in: Option<f64>,
+    /// Price of output tokens, USD per million (overrides the price table).
+    #[arg(long, value_name = "USD")]
+    price_out: Option<f64>,
+    /// Ask again for the scenes whose line in --out is an `error` line (lost decisions);
+    /// their old lines are removed.
+    #[arg(long)]
+    retry_errors: bool,
+    /// Do not read or write the response cache.
+    #[arg(long)]
+    no_cache: bool,
+    /// Response cache directory (default: $RH_LLM_CACHE, else ~/.cache/reacthuman/llm).
+    #[arg(long, value_name = "DIR")]
+    cache_dir: Option<PathBuf>,
+    /// Index of this independent sample (for several samples at temperature > 0; part of
+    /// the cache key).
+    #[arg(long, default_value_t = 0)]
+    sample_index: u32,
+    /// Per-request timeout in seconds (default: configs/predict.toml).
+    #[arg(long, value_name = "S")]
+    timeout: Option<f64>,
+    /// Retries of a transient failure (default: configs/predict.toml).
+    #[arg(long, value_name = "N")]
+    max_retries: Option<u32>,
+    /// Runner configuration (client defaults, generation, prices); default: the embedded
+    /// configs/predict.toml.
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
+    /// Prompt template; default: the embedded canonical configs/prompt.toml. A changed
+    /// prompt must carry its own version.
+    #[arg(long, value_name = "FILE")]
+    prompt: Option<PathBuf>,
+    /// Print the first scene's full request (images elided) and exit without sending it.
+    #[arg(long)]
+    dry_run: bool,
+    /// Print the run summary as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+    /// No progress bar.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+fn predict(a: PredictArgs) -> Result<()> {
+    use rh_score::predict::config::{Generation, PredictConfig, Price, PromptConfig};
+    let cfg = PredictConfig::load(a.config.as_deref())?;
+    let prompt = PromptConfig::load(a.prompt.as_deref())?;
+    let mut client = cfg.client.clone();
+    if let Some(u) = a
+        .base_url
+        .clone()
+        .or_else(|| std::env::var("OPENAI_BASE_URL").ok().filter(|s| !s.is_empty()))
+    {
+        client.base_url = u;
+    }
+    client.api_key = std::env::var(&a.api_key_env).ok().filter(|k| !k.is_empty());
+    if let Some(c) = a.concurrency {
+        if c == 0 {
+            return Err(InputError("--concurrency must be at least 1".into()).into());
+        }
+        client.concurrency = c;
+    }
+    if let Some(t) = a.timeout {
+        if !(t > 0.0) {
+            return Err(InputError("--timeout must be positive".into()).into());
+        }
+        client.timeout_s = t;
+    }
+    if let Some(r) = a.max_retries {
+        client.max_retries = r;
+    }
+    if a.max_cost.is_some_and(|c| !(c >= 0.0)) {
+        return Err(InputError("--max-cost must be a non-negative number of USD".into()).into());
+    }
+    let table = cfg.price(&a.model);
+    let price = match (a.price_in, a.price_out, table) {
+        (None, None, t) => t,
+        (i, o, t) => Some(Price {
+            input: i.or(t.map(|p| p.input)).unwrap_or(0.0),
+            output: o.or(t.map(|p| p.output)).unwrap_or(0.0),
+        }),
+    };
+    let dataset = dataset_dir(a.dataset.clone())?;
+    let ds = Dataset::load(&dataset)?;
+    let scenes = rh_score::predict::select_scenes(&ds, a.subset, a.limit)?;
+    let opts = rh_score::predict::PredictOptions {
+        dataset,
+        model: a.model.clone(),
+        out: a.out.clone().unwrap_or_default(),
+        subset: a.subset,
+        limit: a.limit,
+        client,
+        generation: Generation {
+            temperature: a.temperature.unwrap_or(cfg.generation.temperature),
+            max_tokens: a.max_tokens.unwrap_or(cfg.generation.max_tokens),
+        },
+        price,
+        max_cost: a.max_cost,
+        retry_errors: a.retry_errors,
+        cache_dir: (!a.no_cache)
+            .then(|| a.cache_dir.clone().unwrap_or_else(rh_llm::cache::default_dir)),
+        sample: a.sample_index,
+        prompt,
+        progress: !a.quiet && !a.json,
+    };
+    if a.dry_run {
+        let req = rh_score::predict::dry_run(&opts, &scenes[0])?;
+        return print_out(&(serde_json::to_string_pretty(&req)? + "\n"));
+    }
+    let s = rh_score::predict::run(&opts, &scenes)?;
+    if a.json {
+        print_out(&(serde_json::to_string_pretty(&s)? + "\n"))?;
+    } else {
+        eprintln!(
+            "rh-score predict: {} of {} scenes in {} ({} already there, {} new: {} answered, \
+             {} lost as error lines, {} refusals, {} without a parseable plan); {} requests, \
+             {} retries, {} rate-limited, {} from the cache; cost ${:.4} (file total ${:.4}); \
+             {:.1} decisions/s; prompt {}",
+            s.scenes - s.remaining,
+            s.scenes,
+            s.out,
+            s.already_done,
+            s.written,
+            s.answered,
+            s.lost,
+            s.refusals,
+            s.unparseable,
+            s.requests,
+            s.retries,
+            s.rate_limited,
+            s.cache_hits,
+            s.cost_usd,
+            s.total_cost_usd,
+            s.decisions_per_s,
+            s.prompt_version
+        );
+    }
+    if s.stopped == "max_cost" {
+        eprintln!(
+            "rh-score predict: stopped by --max-cost {:.4} USD with {} scene(s) left; run again \
+             with a higher --max-cost to resume",
+            a.max_cost.unwrap_or(0.0),
+            s.remaining
+        );
+    }
+    if s.lost > 0 {
+        eprintln!(
+            "rh-score predict: {} decision(s) lost; `--retry-errors` asks for them again",
+            s.lost
+        );
+    }
+    Ok(())
 }
 
 /// Resolves `--dataset` / `$RH_DATASET` / the released dataset to a local directory: an
@@ -312,6 +511,7 @@ fn run(cli: Cli) -> Result<()> {
                 r => r,
             }
         }
+        Some(Cmd::Predict(a)) => predict(*a),
         Some(Cmd::MakeFixture { out, n, seed, drop }) => {
             let rows = rh_score::fixture::synth_rows(n, seed);
             let drop: Vec<&str> = drop.iter().map(String::as_str).collect();

@@ -1,0 +1,156 @@
+//! Configuration of `rh-score predict`: the canonical prompt (`configs/prompt.toml`, part
+//! of the benchmark's definition) and the runner's settings (`configs/predict.toml`:
+//! client defaults, generation parameters, the price table). Both are embedded; `--prompt`
+//! and `--config` replace them.
+
+use crate::types::InputError;
+use anyhow::Result;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+pub const PROMPT_TOML: &str = include_str!("../../../configs/prompt.toml");
+pub const PREDICT_TOML: &str = include_str!("../../../configs/predict.toml");
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PromptConfig {
+    pub version: String,
+    pub images: ImageOptions,
+    pub text: PromptText,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImageOptions {
+    pub cameras: Vec<String>,
+    pub times: Vec<f64>,
+    pub max_side: u32,
+    pub jpeg_quality: u8,
+    pub detail: String,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PromptText {
+    pub system: String,
+    pub user_intro: String,
+    pub frame_label: String,
+    pub user_outro: String,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PredictConfig {
+    pub client: rh_llm::ClientConfig,
+    pub generation: Generation,
+    pub prices: BTreeMap<String, Price>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, serde::Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Generation {
+    pub temperature: f64,
+    pub max_tokens: u32,
+}
+
+/// USD per million tokens.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Price {
+    pub input: f64,
+    pub output: f64,
+}
+
+fn parse<T: serde::de::DeserializeOwned>(text: &str, origin: &str) -> Result<T> {
+    toml::from_str(text).map_err(|e| InputError(format!("{origin}: {e}")).into())
+}
+
+fn read(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path)
+        .map_err(|e| InputError(format!("cannot read {}: {e}", path.display())).into())
+}
+
+impl PromptConfig {
+    pub fn load(path: Option<&Path>) -> Result<PromptConfig> {
+        let cfg: PromptConfig = match path {
+            Some(p) => parse(&read(p)?, &p.display().to_string())?,
+            None => parse(PROMPT_TOML, "configs/prompt.toml (embedded)")?,
+        };
+        let origin = path.map_or("configs/prompt.toml".into(), |p| p.display().to_string());
+        let bad = |m: String| -> anyhow::Error { InputError(format!("{origin}: {m}")).into() };
+        if cfg.images.cameras.is_empty() || cfg.images.times.is_empty() {
+            return Err(bad("[images] cameras and times must not be empty".into()));
+        }
+        if !(1..=100).contains(&cfg.images.jpeg_quality) {
+            return Err(bad("[images] jpeg_quality must be 1-100".into()));
+        }
+        if cfg.images.max_side < 16 {
+            return Err(bad("[images] max_side must be at least 16".into()));
+        }
+        if !["low", "high", "auto"].contains(&cfg.images.detail.as_str()) {
+            return Err(bad("[images] detail must be \"low\", \"high\" or \"auto\"".into()));
+        }
+        if cfg.version.trim().is_empty() {
+            return Err(bad("version must not be empty".into()));
+        }
+        Ok(cfg)
+    }
+}
+
+impl PredictConfig {
+    pub fn load(path: Option<&Path>) -> Result<PredictConfig> {
+        let cfg: PredictConfig = match path {
+            Some(p) => parse(&read(p)?, &p.display().to_string())?,
+            None => parse(PREDICT_TOML, "configs/predict.toml (embedded)")?,
+        };
+        if cfg.client.concurrency == 0 || cfg.client.timeout_s <= 0.0 {
+            return Err(InputError(
+                "predict config: [client] concurrency and timeout_s must be positive".into(),
+            )
+            .into());
+        }
+        Ok(cfg)
+    }
+
+    /// The price of `model`: an exact entry, else the longest entry that prefixes it
+    /// (so `gpt-4o-2024-08-06` costs as `gpt-4o`), else free.
+    pub fn price(&self, model: &str) -> Option<Price> {
+        if let Some(p) = self.prices.get(model) {
+            return Some(*p);
+        }
+        self.prices
+            .iter()
+            .filter(|(k, _)| model.starts_with(k.as_str()))
+            .max_by_key(|(k, _)| k.len())
+            .map(|(_, p)| *p)
+    }
+}
+
+impl Price {
+    pub fn cost(&self, usage: rh_llm::Usage) -> f64 {
+        (usage.prompt_tokens as f64 * self.input + usage.completion_tokens as f64 * self.output)
+            / 1e6
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn embedded_configs_load_and_prices_match_by_prefix() {
+        let p = PromptConfig::load(None).unwrap();
+        assert_eq!(p.images.times, vec![0.0, 0.15, 0.30, 0.45, 0.60]);
+        assert_eq!(p.images.cameras, vec!["ego".to_string()]);
+        let c = PredictConfig::load(None).unwrap();
+        assert_eq!(c.price("gpt-4o-mini").unwrap().input, 0.15);
+        assert_eq!(c.price("gpt-4o-2024-08-06").unwrap().input, 2.50);
+        assert!(c.price("llama3.2-vision").is_none());
+        let cost = c.price("gpt-4o").unwrap().cost(rh_llm::Usage {
+            prompt_tokens: 1_000_000,
+            completion_tokens: 100_000,
+        });
+        assert!((cost - 3.5).abs() < 1e-12);
+    }
+}

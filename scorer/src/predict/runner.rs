@@ -1,0 +1,361 @@
+//! The async loop of `rh-score predict`.
+//!
+//! At most `concurrency` scenes are in progress at once (memory stays flat in the number
+//! of scenes: a scene's frames are encoded when it starts, on the blocking pool, and
+//! dropped when its line is written); the shared [`rh_llm::Client`] bounds the requests in
+//! flight adaptively. Lines are appended as decisions finish (completion order). The cost
+//! budget (`--max-cost`) caps the cost of the requests recorded in the output file: a new
+//! scene starts only while `spent + (in flight + 1) × mean cost per request` stays within
+//! it (one scene at a time until the first paid answer gives a mean), so the run stops
+//! before exceeding it, and a later run with a higher cap resumes.
+
+use super::config::Price;
+use super::output::{prepare, Appender};
+use super::{prompt, PredictOptions};
+use crate::config::Config;
+use crate::plan::{plan_from_text, Plan};
+use crate::types::InputError;
+use anyhow::Result;
+use futures_util::stream::{FuturesUnordered, StreamExt};
+use rh_llm::{ChatRequest, Client, LlmError, Reply};
+use serde::Serialize;
+use serde_json::{json, Value};
+use std::time::Instant;
+
+/// What a run did (printed, or `--json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    pub model: String,
+    pub out: String,
+    pub prompt_version: String,
+    /// Scenes selected.
+    pub scenes: usize,
+    /// Scenes already in the output file when the run started.
+    pub already_done: usize,
+    /// Lines written by this run.
+    pub written: usize,
+    pub answered: usize,
+    /// Decisions lost (written as `error` lines).
+    pub lost: usize,
+    pub refusals: usize,
+    pub unparseable: usize,
+    /// Scenes still to run (stopped by the cost budget, or by a fatal error).
+    pub remaining: usize,
+    /// "complete", or "max_cost".
+    pub stopped: String,
+    pub requests: u64,
+    pub retries: u64,
+    pub rate_limited: u64,
+    pub cache_hits: u64,
+    /// Cost of this run's requests (USD; answers from the cache cost nothing).
+    pub cost_usd: f64,
+    /// Cost of every request recorded in the output file.
+    pub total_cost_usd: f64,
+    pub wall_s: f64,
+    pub decisions_per_s: f64,
+    /// Seconds spent decoding, scaling and JPEG-encoding frames (summed over scenes).
+    pub encode_s: f64,
+    pub torn_line_dropped: bool,
+    pub error_lines_retried: usize,
+}
+
+/// The chat request of one scene.
+pub fn request(opts: &PredictOptions, messages: Value) -> ChatRequest {
+    let mut params = serde_json::Map::new();
+    params.insert("temperature".into(), json!(opts.generation.temperature));
+    params.insert("max_tokens".into(), json!(opts.generation.max_tokens));
+    ChatRequest::new(&opts.model, messages, params, opts.sample)
+}
+
+/// A plan as the scorer reads it, in the canonical object form.
+fn plan_json(p: &Plan) -> Value {
+    json!({
+        "intent": p.intent,
+        "confidence": p.confidence,
+        "walking_cmd": p.walking_cmd,
+        "walking_duration": p.walking_duration,
+        "keyframes": p.keyframes.iter().map(|k| json!({
+            "t": k.t, "left_hand": k.left, "right_hand": k.right, "knee_bend": k.knee_bend,
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// One finished scene.
+struct Done {
+    line: Value,
+    paid: f64,
+    lost: bool,
+    refusal: bool,
+    unparseable: bool,
+    encode_s: f64,
+}
+
+enum Stop {
+    Input(String),
+    Fatal(String),
+}
+
+fn answer_line(
+    opts: &PredictOptions,
+    scene: &str,
+    hash: &str,
+    reply: &Reply,
+    price: Option<Price>,
+    scoring: &Config,
+) -> (Value, Option<Plan>) {
+    let plan = plan_from_text(&reply.text, scoring).ok();
+    let cost = price.map_or(0.0, |p| p.cost(reply.usage));
+    let mut line = json!({
+        "scene_id": scene,
+        "model": opts.model,
+        "response": reply.text,
+        "usage": {
+            "prompt_tokens": reply.usage.prompt_tokens,
+            "completion_tokens": reply.usage.completion_tokens,
+            "cost": cost,
+        },
+        "latency_s": (reply.latency_s * 1000.0).round() / 1000.0,
+        "prompt_version": opts.prompt.version,
+        "prompt_hash": hash,
+        "error": null,
+    });
+    let m = line.as_object_mut().expect("object");
+    if let Some(p) = &plan {
+        m.insert("plan".into(), plan_json(p));
+    }
+    if reply.refusal {
+        m.insert("refusal".into(), json!(true));
+    }
+    if reply.cached {
+        m.insert("cached".into(), json!(true));
+    }
+    if opts.sample != 0 {
+        m.insert("sample".into(), json!(opts.sample));
+    }
+    m.insert("attempts".into(), json!(reply.attempts));
+    (line, plan)
+}
+
+async fn one(
+    opts: &PredictOptions,
+    client: &Client,
+    scoring: &Config,
+    scene: String,
+) -> Result<Done, Stop> {
+    let (p, dir, id) = (opts.prompt.clone(), opts.dataset.clone(), scene.clone());
+    let built = tokio::task::spawn_blocking(move || prompt::build(&p, &dir, &id))
+        .await
+        .map_err(|e| Stop::Fatal(format!("frame encoding failed: {e}")))?
+        .map_err(Stop::Input)?;
+    let encode_s = built.encode_s;
+    let req = request(opts, built.messages);
+    let hash = req.prompt_hash().to_string();
+    let started = Instant::now();
+    match client.chat(&req).await {
+        Ok(reply) => {
+            let (line, plan) = answer_line(opts, &scene, &hash, &reply, opts.price, scoring);
+            let paid = if reply.cached {
+                0.0
+            } else {
+                line["usage"]["cost"].as_f64().unwrap_or(0.0)
+            };
+            Ok(Done {
+                line,
+                paid,
+                lost: false,
+                refusal: reply.refusal,
+                unparseable: plan.is_none(),
+                encode_s,
+            })
+        }
+        Err(e) if e.is_fatal() => Err(Stop::Fatal(client.redact(&e.to_string()))),
+        Err(e) => Ok(Done {
+            line: error_line(opts, &scene, &hash, &e, client, started),
+            paid: 0.0,
+            lost: true,
+            refusal: false,
+            unparseable: false,
+            encode_s,
+        }),
+    }
+}
+
+fn error_line(
+    opts: &PredictOptions,
+    scene: &str,
+    hash: &str,
+    e: &LlmError,
+    client: &Client,
+    started: Instant,
+) -> Value {
+    json!({
+        "scene_id": scene,
+        "model": opts.model,
+        "response": null,
+        "error": client.redact(&e.to_string()),
+        "latency_s": (started.elapsed().as_secs_f64() * 1000.0).round() / 1000.0,
+        "prompt_version": opts.prompt.version,
+        "prompt_hash": hash,
+    })
+}
+
+/// The cost budget: `spent` over the whole output file; the mean cost per request over
+/// the file's paid lines and this run's requests.
+struct Budget {
+    max: Option<f64>,
+    spent: f64,
+    spent_run: f64,
+    paid_requests: u64,
+    /// Paid lines already in the file when the run started.
+    paid_before: u64,
+}
+
+impl Budget {
+    fn allows(&self, in_flight: usize) -> bool {
+        let Some(max) = self.max else { return true };
+        if self.spent >= max {
+            return false;
+        }
+        let requests = self.paid_requests + self.paid_before;
+        if requests == 0 {
+            return in_flight == 0;
+        }
+        let mean = self.spent / requests as f64;
+        self.spent + (in_flight as f64 + 1.0) * mean <= max
+    }
+}
+
+pub fn run(opts: &PredictOptions, scenes: &[String]) -> Result<Summary> {
+    let existing = prepare(&opts.out, &opts.model, opts.retry_errors)?;
+    let todo: Vec<String> = scenes
+        .iter()
+        .filter(|s| !existing.done.contains(*s))
+        .cloned()
+        .collect();
+    let already_done = scenes.len() - todo.len();
+    let cache = opts.cache_dir.clone().map(rh_llm::cache::Cache::new);
+    let client = Client::new(opts.client.clone(), cache).map_err(anyhow::Error::msg)?;
+    let scoring = Config::default();
+    let mut out = Appender::open(&opts.out)?;
+    let bar = progress_bar(opts.progress, scenes.len(), already_done);
+    let mut s = Summary {
+        model: opts.model.clone(),
+        out: opts.out.display().to_string(),
+        prompt_version: opts.prompt.version.clone(),
+        scenes: scenes.len(),
+        already_done,
+        written: 0,
+        answered: 0,
+        lost: 0,
+        refusals: 0,
+        unparseable: 0,
+        remaining: todo.len(),
+        stopped: "complete".into(),
+        requests: 0,
+        retries: 0,
+        rate_limited: 0,
+        cache_hits: 0,
+        cost_usd: 0.0,
+        total_cost_usd: existing.paid_cost,
+        wall_s: 0.0,
+        decisions_per_s: 0.0,
+        encode_s: 0.0,
+        torn_line_dropped: existing.torn_bytes > 0,
+        error_lines_retried: existing.removed_errors,
+    };
+    let mut budget = Budget {
+        max: opts.max_cost,
+        spent: existing.paid_cost,
+        spent_run: 0.0,
+        paid_requests: 0,
+        paid_before: existing.paid_lines,
+    };
+    let rt = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .max_blocking_threads(std::thread::available_parallelism().map_or(2, |n| n.get()))
+        .enable_all()
+        .build()?;
+    let start = Instant::now();
+    let slots = opts.client.concurrency.max(1);
+    let result: Result<(), Stop> = rt.block_on(async {
+        let mut pending = FuturesUnordered::new();
+        let mut next = 0;
+        loop {
+            while pending.len() < slots && next < todo.len() && budget.allows(pending.len()) {
+                pending.push(one(opts, &client, &scoring, todo[next].clone()));
+                next += 1;
+            }
+            let Some(done) = pending.next().await else {
+                break;
+            };
+            let done = done?;
+            out.write(&done.line).map_err(|e| Stop::Fatal(format!("{e:#}")))?;
+            s.written += 1;
+            s.remaining -= 1;
+            s.encode_s += done.encode_s;
+            if done.lost {
+                s.lost += 1;
+            } else {
+                s.answered += 1;
+                s.refusals += done.refusal as usize;
+                s.unparseable += done.unparseable as usize;
+            }
+            if !done.lost && done.line.get("cached").is_none() {
+                budget.spent += done.paid;
+                budget.spent_run += done.paid;
+                budget.paid_requests += 1;
+            }
+            bar.inc(1);
+            bar.set_message(format!(
+                "lost {} · ${:.4} · limit {}",
+                s.lost,
+                budget.spent,
+                client.limiter().limit()
+            ));
+        }
+        if next < todo.len() {
+            s.stopped = "max_cost".into();
+        }
+        Ok(())
+    });
+    bar.finish_and_clear();
+    let stats = client.stats();
+    s.requests = stats.requests;
+    s.retries = stats.retries;
+    s.rate_limited = stats.rate_limited;
+    s.cache_hits = stats.cache_hits;
+    s.cost_usd = budget.spent_run;
+    s.total_cost_usd = budget.spent;
+    s.wall_s = start.elapsed().as_secs_f64();
+    s.decisions_per_s = if s.wall_s > 0.0 {
+        s.written as f64 / s.wall_s
+    } else {
+        0.0
+    };
+    match result {
+        Ok(()) => Ok(s),
+        Err(Stop::Input(m)) => Err(InputError(m).into()),
+        Err(Stop::Fatal(m)) => Err(InputError(format!(
+            "stopped after {} new lines: the server refused the request ({m}); check \
+             --base-url, --model and the API key variable",
+            s.written
+        ))
+        .into()),
+    }
+}
+
+fn progress_bar(show: bool, total: usize, done: usize) -> indicatif::ProgressBar {
+    if !show {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(total as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:30} {pos}/{len} scenes · {per_sec} · ETA {eta} · {msg}",
+        )
+        .expect("valid template"),
+    );
+    bar.set_position(done as u64);
+    bar.reset_eta();
+    bar
+}
