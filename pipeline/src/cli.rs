@@ -441,6 +441,77 @@ fn run_verify(dir: &Path, catalog: &Catalog, fast: bool, json: bool) -> Result<(
     }
 }
 
+/// `download`: the dataset from the Hub (or a complete cached copy), checked; prints
+/// its path.
+fn download(repo: &str, revision: Option<&str>, out: Option<&Path>) -> Result<(), Failure> {
+    let snapshot = rh_hub::fetch(repo, revision).map_err(|e| Failure {
+        code: e.exit_code(),
+        message: e.to_string(),
+    })?;
+    if snapshot.from_cache_only {
+        eprintln!(
+            "the Hub at {} was not used ({}); {repo} comes from the Hugging Face cache, all {} files checked",
+            rh_hub::endpoint(),
+            snapshot.cache_reason.as_deref().unwrap_or("offline"),
+            snapshot.files
+        );
+    }
+    let path = match out {
+        Some(dir) => {
+            let files =
+                rh_hub::copy_snapshot(&snapshot.path, dir).map_err(|e| Failure {
+                    code: 1,
+                    message: format!("cannot copy {repo} into {}: {e}", dir.display()),
+                })?;
+            eprintln!("copied {files} files into {}", dir.display());
+            dir.to_path_buf()
+        }
+        None => snapshot.path,
+    };
+    println!("{}", path.display());
+    Ok(())
+}
+
+/// `balance`: label counts per family over `per_family` scenes each, built in memory.
+fn balance(
+    catalog: &Catalog,
+    config: &Config,
+    seed: Option<u64>,
+    per_family: usize,
+    families: Option<Vec<String>>,
+    json: bool,
+) -> Result<(), Failure> {
+    if per_family == 0 {
+        return Err(input("--per-family must be at least 1"));
+    }
+    let families = families.unwrap_or_default();
+    for f in &families {
+        if crate::families::get(f).is_none() {
+            return Err(input(format!(
+                "unknown or unimplemented family '{f}' (implemented: {})",
+                crate::randomize::implemented_families()
+            )));
+        }
+    }
+    let rows = crate::balance::label_balance(
+        catalog,
+        config,
+        seed.unwrap_or(config.build.seed),
+        &families,
+        per_family,
+    )
+    .map_err(|e| Failure {
+        code: 1,
+        message: format!("{e:#}"),
+    })?;
+    if json {
+        print_json(&rows);
+    } else {
+        print!("{}", crate::balance::format_table(&rows));
+    }
+    Ok(())
+}
+
 pub fn run(cli: Cli) -> Result<(), Failure> {
     // Commands that need neither the catalog nor the configuration.
     match &cli.command {
@@ -461,34 +532,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             repo,
             revision,
             out,
-        } => {
-            let snapshot = rh_hub::fetch(repo, revision.as_deref()).map_err(|e| Failure {
-                code: e.exit_code(),
-                message: e.to_string(),
-            })?;
-            if snapshot.from_cache_only {
-                eprintln!(
-                    "the Hub at {} was not used ({}); {repo} comes from the Hugging Face cache, all {} files checked",
-                    rh_hub::endpoint(),
-                    snapshot.cache_reason.as_deref().unwrap_or("offline"),
-                    snapshot.files
-                );
-            }
-            let path = match out {
-                Some(dir) => {
-                    let files =
-                        rh_hub::copy_snapshot(&snapshot.path, dir).map_err(|e| Failure {
-                            code: 1,
-                            message: format!("cannot copy {repo} into {}: {e}", dir.display()),
-                        })?;
-                    eprintln!("copied {files} files into {}", dir.display());
-                    dir.clone()
-                }
-                None => snapshot.path,
-            };
-            println!("{}", path.display());
-            return Ok(());
-        }
+        } => return download(repo, revision.as_deref(), out.as_deref()),
         _ => {}
     }
     let (catalog, config) = load(&cli)?;
@@ -568,37 +612,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             per_family,
             families,
             json,
-        } => {
-            if per_family == 0 {
-                return Err(input("--per-family must be at least 1"));
-            }
-            let families = families.unwrap_or_default();
-            for f in &families {
-                if crate::families::get(f).is_none() {
-                    return Err(input(format!(
-                        "unknown or unimplemented family '{f}' (implemented: {})",
-                        crate::randomize::implemented_families()
-                    )));
-                }
-            }
-            let rows = crate::balance::label_balance(
-                &catalog,
-                &config,
-                seed.unwrap_or(config.build.seed),
-                &families,
-                per_family,
-            )
-            .map_err(|e| Failure {
-                code: 1,
-                message: format!("{e:#}"),
-            })?;
-            if json {
-                print_json(&rows);
-            } else {
-                print!("{}", crate::balance::format_table(&rows));
-            }
-            Ok(())
-        }
+        } => balance(&catalog, &config, seed, per_family, families, json),
         Command::Plan {
             description,
             seed,
