@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job on the embedded defaults: install what is missing, build, make a small
 # dataset, verify its replay, and score baseline predictions against it.
-# Output goes to ${RH_OUT:-out/quickstart}.
+# Output goes to ${RH_OUT:-out/quickstart}; RH_QUICKSTART_N scenes (default 60; CI runs
+# it with fewer, from scripts/test.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -12,7 +13,7 @@ out="${RH_OUT:-out/quickstart}"
 dataset="$out/dataset"
 rm -rf "$dataset"
 mkdir -p "$out"
-./target/release/rh-pipeline build --n 60 --out "$dataset"
+./target/release/rh-pipeline build --n "${RH_QUICKSTART_N:-60}" --out "$dataset"
 ./target/release/rh-pipeline verify "$dataset"
 ./target/release/rh-pipeline sheet "$dataset" --out "$out/sheet.png"
 

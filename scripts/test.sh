@@ -6,3 +6,8 @@ bash scripts/setup.sh
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
 cargo build --release --workspace --bins
 cargo test --release --workspace
+# The quick start's main job, end to end on a reduced size (8 rendered scenes).
+qs_out="$(mktemp -d)"
+RH_QUICKSTART_N=8 RH_OUT="$qs_out" bash scripts/quickstart.sh
+test -s "$qs_out/report.md" && test -s "$qs_out/sheet.png"
+rm -rf "$qs_out"

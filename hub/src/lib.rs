@@ -1,5 +1,5 @@
 //! The ReactHuman dataset on the Hugging Face Hub (SPEC §8, §14): download a dataset
-//! repository into the standard Hugging Face cache with the `hf-hub` crate, and resolve it
+//! repository into the standard Hugging Face cache, checking every file, and resolve it
 //! from that cache when the Hub cannot be reached.
 //!
 //! The cache is the one Python's `huggingface_hub` uses (`$HF_HUB_CACHE`, else
@@ -8,8 +8,21 @@
 //! dataset downloaded by either side is found by the other. `HF_ENDPOINT` selects the
 //! server, `HF_TOKEN` / `HF_TOKEN_PATH` / `$HF_HOME/token` the token, and
 //! `HF_HUB_OFFLINE=1` skips the network.
+//!
+//! Integrity (README "Reliability"): every request has a connect and a read timeout
+//! (`configs/hub.toml`, `HF_HUB_ETAG_TIMEOUT`, `HF_HUB_DOWNLOAD_TIMEOUT`); every file is
+//! checked against the size and hash the Hub's listing states before it enters `blobs/`;
+//! every cached blob is checked against its name before it is used (fetched again online,
+//! reported offline); a snapshot is only returned when every file it should hold is
+//! there — the listing of a complete download is recorded in `rh-complete/<commit>.json`,
+//! and a dataset's own `build.json` names its files and their SHA-256.
 
-use hf_hub::{split_id, HFClient, HFError};
+pub mod cache;
+mod remote;
+
+use cache::RepoCache;
+use remote::{Remote, RemoteError};
+use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -20,6 +33,9 @@ pub const RELEASED_DATASET: &str = "Alan123/reacthuman-benchmark-scaled";
 /// The Hub's public address, used when `HF_ENDPOINT` is not set.
 pub const DEFAULT_ENDPOINT: &str = "https://huggingface.co";
 
+/// The embedded `configs/hub.toml`.
+pub const EMBEDDED_CONFIG: &str = include_str!("../../configs/hub.toml");
+
 /// Why a dataset could not be had.
 #[derive(Debug, thiserror::Error)]
 pub enum HubError {
@@ -29,6 +45,9 @@ pub enum HubError {
     /// The server wants a token, or refused the one given (exit 2).
     #[error("{0}")]
     Unauthorized(String),
+    /// Only part of the dataset is in the cache and the Hub cannot supply the rest (exit 2).
+    #[error("{0}")]
+    Incomplete(String),
     /// Anything else: the network, the server, the cache (exit 1).
     #[error("{0}")]
     Failed(String),
@@ -38,9 +57,69 @@ impl HubError {
     /// The process exit status for this error (SPEC §14: 2 bad input, 1 internal failure).
     pub fn exit_code(&self) -> u8 {
         match self {
-            HubError::NotFound(_) | HubError::Unauthorized(_) => 2,
+            HubError::NotFound(_) | HubError::Unauthorized(_) | HubError::Incomplete(_) => 2,
             HubError::Failed(_) => 1,
         }
+    }
+}
+
+/// Network policy: `configs/hub.toml`, each value overridable from the environment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    /// Connect and read timeout of metadata requests (`HF_HUB_ETAG_TIMEOUT`).
+    pub metadata_timeout: Duration,
+    /// Connect timeout and longest pause between two reads of a download
+    /// (`HF_HUB_DOWNLOAD_TIMEOUT`).
+    pub download_timeout: Duration,
+    /// Files downloaded at the same time.
+    pub concurrent_downloads: usize,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SettingsFile {
+    metadata_timeout_s: f64,
+    download_timeout_s: f64,
+    concurrent_downloads: usize,
+}
+
+fn seconds(what: &str, v: f64) -> Result<Duration, String> {
+    if v.is_finite() && v > 0.0 && v <= 86_400.0 {
+        Ok(Duration::from_secs_f64(v))
+    } else {
+        Err(format!("{what} must be a number of seconds in (0, 86400], not {v}"))
+    }
+}
+
+impl Settings {
+    /// Parses a `hub.toml` text (`origin` names it in errors).
+    pub fn parse(text: &str, origin: &str) -> Result<Settings, String> {
+        let f: SettingsFile = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
+        Ok(Settings {
+            metadata_timeout: seconds(&format!("{origin}: metadata_timeout_s"), f.metadata_timeout_s)?,
+            download_timeout: seconds(&format!("{origin}: download_timeout_s"), f.download_timeout_s)?,
+            concurrent_downloads: f.concurrent_downloads.clamp(1, 64),
+        })
+    }
+
+    /// The embedded configuration with the environment's overrides applied.
+    pub fn from_env() -> Result<Settings, String> {
+        let mut s = Settings::parse(EMBEDDED_CONFIG, "configs/hub.toml")?;
+        for (var, slot) in [
+            ("HF_HUB_ETAG_TIMEOUT", &mut s.metadata_timeout),
+            ("HF_HUB_DOWNLOAD_TIMEOUT", &mut s.download_timeout),
+        ] {
+            if let Ok(v) = std::env::var(var) {
+                if !v.trim().is_empty() {
+                    let n: f64 = v
+                        .trim()
+                        .parse()
+                        .map_err(|_| format!("{var}={v} is not a number of seconds"))?;
+                    *slot = seconds(var, n)?;
+                }
+            }
+        }
+        Ok(s)
     }
 }
 
@@ -52,6 +131,12 @@ pub struct Snapshot {
     /// True when the Hub was not asked (offline mode) or could not be reached and the
     /// snapshot came from the cache.
     pub from_cache_only: bool,
+    /// Why the cache was used (offline mode, or the Hub's failure).
+    pub cache_reason: Option<String>,
+    /// Files the snapshot holds (all checked).
+    pub files: usize,
+    /// Files this call downloaded.
+    pub downloaded: usize,
 }
 
 /// Whether `text` has the form of a Hub repository id, `owner/name`.
@@ -91,11 +176,34 @@ fn offline_mode() -> bool {
         .unwrap_or(false)
 }
 
+/// The token: `HF_TOKEN` (or the older `HUGGING_FACE_HUB_TOKEN`), else the file
+/// `HF_TOKEN_PATH`, else `$HF_HOME/token`.
+pub fn token() -> Option<String> {
+    let env = |k: &str| std::env::var(k).ok().map(|s| s.trim().to_string()).filter(|s| !s.is_empty());
+    if let Some(t) = env("HF_TOKEN").or_else(|| env("HUGGING_FACE_HUB_TOKEN")) {
+        return Some(t);
+    }
+    let path = env("HF_TOKEN_PATH")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| cache::hf_home().join("token"));
+    std::fs::read_to_string(path)
+        .ok()
+        .map(|s| s.trim().to_string())
+        .filter(|s| !s.is_empty())
+}
+
 /// Downloads every file of dataset `repo_id` at `revision` (default `main`) into the HF
-/// cache and returns the snapshot directory. Files already in the cache are not fetched
-/// again. When the Hub cannot be reached (or `HF_HUB_OFFLINE` is set), the snapshot
-/// that the cache's `refs/<revision>` names is used instead.
+/// cache and returns the snapshot directory. Files already in the cache (and matching
+/// their hash) are not fetched again. When the Hub cannot be reached, hangs past the
+/// timeouts, fails, or serves a corrupt file (or `HF_HUB_OFFLINE` is set), the snapshot
+/// that the cache's `refs/<revision>` names is used instead, if it is complete.
 pub fn fetch(repo_id: &str, revision: Option<&str>) -> Result<Snapshot, HubError> {
+    let settings = Settings::from_env().map_err(HubError::Failed)?;
+    fetch_with(repo_id, revision, &settings)
+}
+
+/// `fetch` with explicit network settings.
+pub fn fetch_with(repo_id: &str, revision: Option<&str>, settings: &Settings) -> Result<Snapshot, HubError> {
     let endpoint = endpoint();
     let revision = revision.unwrap_or("main");
     let what = format!("dataset {repo_id} (revision {revision}) on {endpoint}");
@@ -104,83 +212,95 @@ pub fn fetch(repo_id: &str, revision: Option<&str>) -> Result<Snapshot, HubError
             "'{repo_id}' is not a Hub dataset id (expected owner/name)"
         )));
     }
-    let client = HFClient::builder()
-        .endpoint(endpoint.clone())
-        // Few, short retries: an unreachable Hub should fall back to the cache quickly.
-        .retry_max_attempts(2)
-        .retry_base_delay(Duration::from_millis(50))
-        .build_sync()
-        .map_err(|e| HubError::Failed(format!("cannot set up the Hub client for {what}: {e}")))?;
-    let cache = hf_hub::resolve_cache_dir();
-    let (owner, name) = split_id(repo_id);
-    let repo = client.dataset(owner, name);
+    let cache_root = cache::cache_dir();
+    let repo_cache = RepoCache::new(&cache_root, repo_id);
 
-    let network_error = if offline_mode() {
+    let reason = if offline_mode() {
         "HF_HUB_OFFLINE is set".to_string()
     } else {
-        match repo
-            .snapshot_download()
-            .revision(revision.to_string())
-            .send()
-        {
-            Ok(path) => {
-                return Ok(Snapshot {
-                    path,
-                    from_cache_only: false,
-                })
+        match download(&endpoint, repo_id, revision, settings, &repo_cache) {
+            Ok(snapshot) => return Ok(snapshot),
+            Err(RemoteError::NotFound(e)) => {
+                return Err(HubError::NotFound(format!("{what} was not found: {e}")))
             }
-            Err(e) => match classify(&e) {
-                Class::NotFound => {
-                    return Err(HubError::NotFound(format!("{what} was not found: {e}")))
-                }
-                Class::Unauthorized => {
-                    return Err(HubError::Unauthorized(format!(
-                        "{what} needs a token with access (set HF_TOKEN or run `huggingface-cli login`): {e}"
-                    )))
-                }
-                Class::Unreachable => e.to_string(),
-                Class::Other => return Err(HubError::Failed(format!("cannot download {what}: {e}"))),
-            },
+            Err(RemoteError::Unauthorized(e)) => {
+                return Err(HubError::Unauthorized(format!(
+                    "{what} needs a token with access (set HF_TOKEN or run `huggingface-cli login`): {e}"
+                )))
+            }
+            Err(RemoteError::Unreachable(e)) => format!("cannot reach {what}: {e}"),
+            Err(RemoteError::Bad(e)) => format!("the Hub failed for {what}: {e}"),
         }
     };
-    match repo
-        .snapshot_download()
-        .revision(revision.to_string())
-        .local_files_only(true)
-        .send()
-    {
-        Ok(path) => Ok(Snapshot {
-            path,
-            from_cache_only: true,
-        }),
-        Err(_) if offline_mode() => Err(HubError::Failed(format!(
-            "HF_HUB_OFFLINE is set and the Hugging Face cache {} holds no copy of {what}",
-            cache.display()
-        ))),
-        Err(_) => Err(HubError::Failed(format!(
-            "cannot reach {what} ({network_error}), and the Hugging Face cache {} holds no copy of it",
-            cache.display()
-        ))),
-    }
+    from_cache(&repo_cache, revision, &what, &reason)
 }
 
-enum Class {
-    NotFound,
-    Unauthorized,
-    Unreachable,
-    Other,
+fn download(
+    endpoint: &str,
+    repo_id: &str,
+    revision: &str,
+    settings: &Settings,
+    repo_cache: &RepoCache,
+) -> Result<Snapshot, RemoteError> {
+    let remote = Remote::new(endpoint, repo_id, settings).map_err(RemoteError::Bad)?;
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .map_err(|e| RemoteError::Bad(format!("cannot start the async runtime: {e}")))?;
+    runtime.block_on(async {
+        let commit = remote.commit(revision).await?;
+        let entries = remote.files(&commit).await?;
+        let downloaded = remote.download_all(repo_cache, &commit, &entries).await?;
+        let io = |e: std::io::Error| RemoteError::Bad(format!("cannot write to the cache {}: {e}", repo_cache.root.display()));
+        repo_cache.write_record(&commit, &entries).map_err(io)?;
+        repo_cache.write_ref(revision, &commit).map_err(io)?;
+        Ok(Snapshot {
+            path: repo_cache.snapshot_dir(&commit),
+            from_cache_only: false,
+            cache_reason: None,
+            files: entries.len(),
+            downloaded,
+        })
+    })
 }
 
-fn classify(e: &HFError) -> Class {
-    match e {
-        HFError::RepoNotFound { .. }
-        | HFError::RevisionNotFound { .. }
-        | HFError::EntryNotFound { .. } => Class::NotFound,
-        HFError::AuthRequired { .. } | HFError::Forbidden { .. } => Class::Unauthorized,
-        HFError::Request { .. } => Class::Unreachable,
-        HFError::Http { context } if context.status.is_server_error() => Class::Unreachable,
-        _ => Class::Other,
+/// The cached snapshot of `revision`, if the cache holds all of it, every file checked.
+fn from_cache(repo_cache: &RepoCache, revision: &str, what: &str, reason: &str) -> Result<Snapshot, HubError> {
+    let cache_root = repo_cache.root.parent().unwrap_or(Path::new("."));
+    let Some(commit) = repo_cache.read_ref(revision) else {
+        return Err(HubError::Failed(format!(
+            "{reason}, and the Hugging Face cache {} holds no copy of {what}",
+            cache_root.display()
+        )));
+    };
+    let dir = repo_cache.snapshot_dir(&commit);
+    if !dir.is_dir() {
+        return Err(HubError::Failed(format!(
+            "{reason}, and the Hugging Face cache {} holds no copy of {what}",
+            cache_root.display()
+        )));
     }
+    let Some(entries) = repo_cache.expected_files(&commit) else {
+        return Err(HubError::Incomplete(format!(
+            "{reason}; the cached snapshot {} of {what} has no record of a complete download and no build.json listing its files, so it may be partial; download it once with the Hub reachable",
+            dir.display()
+        )));
+    };
+    let check = cache::check_snapshot(&dir, &entries);
+    if !check.ok() {
+        return Err(HubError::Incomplete(format!(
+            "{reason}; the cached snapshot {} of {what} is not a whole dataset: {}",
+            dir.display(),
+            check.describe()
+        )));
+    }
+    Ok(Snapshot {
+        path: dir,
+        from_cache_only: true,
+        cache_reason: Some(reason.to_string()),
+        files: entries.len(),
+        downloaded: 0,
+    })
 }
 
 /// Copies a snapshot (whose files may be links into the cache's blobs) into `out` as a
@@ -235,9 +355,21 @@ mod tests {
     }
 
     #[test]
+    fn settings_from_config_and_environment() {
+        let s = Settings::parse(EMBEDDED_CONFIG, "hub.toml").unwrap();
+        assert_eq!(s.metadata_timeout, Duration::from_secs(10));
+        assert_eq!(s.download_timeout, Duration::from_secs(10));
+        assert!(Settings::parse("metadata_timeout_s = 0\ndownload_timeout_s = 1\nconcurrent_downloads = 1", "x.toml")
+            .unwrap_err()
+            .contains("x.toml: metadata_timeout_s"));
+        assert!(Settings::parse("metadata_timeout_s = 1\n", "x.toml").unwrap_err().contains("x.toml"));
+    }
+
+    #[test]
     fn exit_codes() {
         assert_eq!(HubError::NotFound(String::new()).exit_code(), 2);
         assert_eq!(HubError::Unauthorized(String::new()).exit_code(), 2);
+        assert_eq!(HubError::Incomplete(String::new()).exit_code(), 2);
         assert_eq!(HubError::Failed(String::new()).exit_code(), 1);
     }
 }

@@ -22,6 +22,9 @@ use crate::card;
 use crate::config::Config;
 use crate::dataset;
 use crate::families;
+use crate::integrity::{self, FileSums};
+pub use crate::records::{record_path, WORK_DIR};
+use crate::records::{group_files, load_record, reopen_if_damaged};
 use crate::manifest::{Manifest, MANIFEST_FILE};
 use crate::scene::{run_group, GroupError, RenderStage};
 use arrow::array::RecordBatch;
@@ -32,9 +35,6 @@ use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
-
-/// Work-in-progress folder of an unfinished build (removed when the build completes).
-pub const WORK_DIR: &str = ".rh-build";
 
 #[derive(Debug, Clone)]
 pub struct BuildOptions {
@@ -117,7 +117,8 @@ pub fn check_options(
         }
         if config.speed_bands(f).is_none() {
             return Err(BuildError::Input(format!(
-                "the configuration has no [speed_bands] entry for '{f}'"
+                "{}: [speed_bands] has no entry for family '{f}' (add `{f} = [slow, normal, fast, very_fast]`)",
+                config.source
             )));
         }
         if catalog.objects_for_family(f).next().is_none() {
@@ -241,13 +242,6 @@ impl Syncer {
     }
 }
 
-/// Path of group `g`'s record.
-pub fn record_path(out: &Path, g: u64) -> PathBuf {
-    out.join(WORK_DIR)
-        .join("groups")
-        .join(format!("{g:08}.parquet"))
-}
-
 /// Holds an exclusive `flock` on a directory while alive (released by the kernel when
 /// the process dies, even by SIGKILL).
 pub struct DirLock(#[allow(dead_code)] std::fs::File);
@@ -325,13 +319,23 @@ pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError
             }
         }
         None => {
-            let occupied = ["data", "specs", "eval", WORK_DIR, "README.md"]
-                .iter()
-                .any(|p| out.join(p).exists());
-            if occupied {
+            // A build owns its directory: anything already there (a dataset of another
+            // version, or unrelated files) is refused rather than mixed with the dataset.
+            let mut present: Vec<String> = std::fs::read_dir(out)
+                .map_err(fail)?
+                .flatten()
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .collect();
+            present.sort();
+            if !present.is_empty() {
+                let shown: Vec<&str> = present.iter().take(5).map(|s| s.as_str()).collect();
                 return Err(BuildError::Input(format!(
-                    "{} holds files but no {MANIFEST_FILE} (not a build of this version); use a new --out or delete it",
-                    out.display()
+                    "--out {} is not empty and holds no {MANIFEST_FILE} ({} entr{}: {}{}); a build writes into a new or empty directory, or resumes its own — use a new --out",
+                    out.display(),
+                    present.len(),
+                    if present.len() == 1 { "y" } else { "ies" },
+                    shown.join(", "),
+                    if present.len() > 5 { ", …" } else { "" }
                 )));
             }
             dataset::write_atomic(&out.join(MANIFEST_FILE), manifest.to_json().as_bytes())
@@ -376,23 +380,46 @@ fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<Option<Str
     }
 }
 
-/// Reads group `g`'s record if it is there and whole (right rows, every file it names
-/// present: specs, videos, frames).
-fn load_record(out: &Path, manifest: &Manifest, g: u64) -> Option<RecordBatch> {
-    let path = record_path(out, g);
-    if !path.exists() {
-        return None;
+/// A build that `claim_out_dir` found complete (`complete`): its summary when every file
+/// is what its manifest records, else None after reopening it (the damaged groups'
+/// records removed, the intact ones kept) so that the build goes on and repairs it.
+fn finished_build(
+    out: &Path,
+    manifest: &Manifest,
+    complete: bool,
+    progress: bool,
+) -> Result<Option<BuildSummary>, BuildError> {
+    if !complete {
+        return Ok(None);
     }
-    let batch = dataset::read_batch(&path).ok()?;
-    let indices = dataset::u64_column(&batch, "scene_index");
-    let expected: Vec<u64> = (g * 4..g * 4 + manifest.group_size(g)).collect();
-    if indices != expected {
-        return None;
+    let on_disk = Manifest::read(out)
+        .map_err(BuildError::Input)?
+        .unwrap_or_else(|| manifest.clone());
+    let problems = reopen_if_damaged(out, &on_disk).map_err(BuildError::Internal)?;
+    if !problems.is_empty() {
+        eprintln!(
+            "{} holds this build, but {} file(s) are not what its {MANIFEST_FILE} records ({}); rebuilding the groups they belong to",
+            out.display(),
+            problems.len(),
+            integrity::describe(&problems, 5)
+        );
+        return Ok(None);
     }
-    let files_there = dataset::referenced_files(&batch)
-        .iter()
-        .all(|f| out.join(f).exists());
-    files_there.then_some(batch)
+    if progress {
+        eprintln!(
+            "{} already holds this build, complete; nothing to do",
+            out.display()
+        );
+    }
+    let data_file = dataset::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
+    let rows = dataset::read_columns(&out.join(&data_file), &dataset::SUMMARY_COLUMNS)
+        .map_err(BuildError::Internal)?;
+    let eval = out
+        .join(card::EVAL_FILE)
+        .exists()
+        .then(|| card::eval_selection(&rows).0.len());
+    let groups = manifest.groups().len();
+    Ok(Some(summarize(out, &rows, data_file, groups, 0, eval)))
 }
 
 /// Builds the dataset described by `opts`.
@@ -421,25 +448,13 @@ pub fn build(
     let _lock = lock_dir(out)?;
     let complete = claim_out_dir(out, &manifest)?;
     remove_stale_temporaries(out);
+    interrupt::say_resume_on_interrupt(out);
     let data_file = dataset::data_file_name(opts.shard.0 as usize, opts.shard.1 as usize);
     let groups = manifest.groups();
 
-    if complete {
-        if opts.progress {
-            eprintln!(
-                "{} already holds this build, complete; nothing to do",
-                out.display()
-            );
-        }
-        let rows = dataset::read_columns(&out.join(&data_file), &dataset::SUMMARY_COLUMNS)
-            .map_err(BuildError::Internal)?;
-        let eval = out
-            .join(card::EVAL_FILE)
-            .exists()
-            .then(|| card::eval_selection(&rows).0.len());
-        return Ok(summarize(out, &rows, data_file, groups.len(), 0, eval));
+    if let Some(summary) = finished_build(out, &manifest, complete, opts.progress)? {
+        return Ok(summary);
     }
-
     for sub in ["specs", "data", ".rh-build/groups"] {
         std::fs::create_dir_all(out.join(sub)).map_err(|e| internal(&out.join(sub), e))?;
     }
@@ -482,34 +497,15 @@ pub fn build(
         todo.par_iter()
             .try_for_each(|&g| -> Result<(), BuildError> {
                 let count = manifest.group_size(g);
-                let results = run_group(
-                    catalog,
-                    &opts.families,
-                    opts.selections.as_deref(),
-                    opts.seed,
-                    g,
-                    count,
-                    config,
-                    render,
-                )
-                .map_err(|e| match e {
-                    GroupError::Input(m) => BuildError::Input(m),
-                    GroupError::Render(m) => BuildError::Internal(m),
-                })?;
-                let mut files = Vec::with_capacity(results.len() + 1);
-                for r in &results {
-                    let path = out.join(dataset::spec_path(&r.spec.scene_id));
-                    files.push(
-                        crate::fsio::write_unsynced(&path, r.spec.to_json().as_bytes())
-                            .map_err(|e| internal(&path, e))?,
-                    );
-                }
-                // The record last: its presence says the group (specs included) is done.
-                let path = record_path(out, g);
-                let bytes = dataset::parquet_bytes(&dataset::record_batch(&results, catalog));
-                files.push(
-                    crate::fsio::write_unsynced(&path, &bytes).map_err(|e| internal(&path, e))?,
-                );
+                let results =
+                    run_group(catalog, &opts.families, opts.selections.as_deref(), opts.seed, g, count, config, render)
+                        .map_err(|e| match e {
+                            GroupError::Input(m) => BuildError::Input(m),
+                            GroupError::Render(m) => BuildError::Internal(m),
+                        })?;
+                // Specs, then the checksums of every file the rows name, and the record
+                // last: its presence says the group (specs, media, sums) is done.
+                let files = group_files(out, g, &results, catalog).map_err(BuildError::Internal)?;
                 syncer.submit(files)?;
                 progress.advance(count, opts.progress);
                 Ok(())
@@ -529,7 +525,8 @@ pub fn build(
         }
         Ok(())
     };
-    let (rows, eval) = finalize(out, &manifest, &records)?;
+    let sums = crate::records::gather_sums(out, &groups).map_err(BuildError::Internal)?;
+    let (rows, eval) = finalize(out, &manifest, &records, sums)?;
     // Retire the records in one atomic step (a rename), then delete them: a crash in
     // between leaves a finished build whose next run only removes the leftover.
     let work = out.join(WORK_DIR);
@@ -557,15 +554,17 @@ pub type RowSource<'a> = dyn Fn(&mut RowSink) -> Result<(), BuildError> + 'a;
 /// `rows`): the data Parquet (row group by row group), the eval subset (whole builds; a
 /// second pass over the rows picks it), and the card. Memory stays flat in the number of
 /// rows but for `dataset::SUMMARY_COLUMNS`, which it returns (every row, those columns)
-/// with the eval subset's size.
+/// with the eval subset's size. Then it writes `build.json` again, now with the SHA-256
+/// of every file (`sums`: the groups' specs and media, plus the files written here).
 pub fn finalize(
     out: &Path,
     manifest: &Manifest,
     rows: &RowSource,
+    mut sums: FileSums,
 ) -> Result<(RecordBatch, Option<usize>), BuildError> {
     let data_file = dataset::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
-    let mut data =
-        dataset::ParquetStream::create(&out.join(&data_file)).map_err(BuildError::Internal)?;
+    let data_path = out.join(&data_file);
+    let mut data = dataset::ParquetStream::create(&data_path).map_err(BuildError::Internal)?;
     let summary_schema = dataset::project(
         &RecordBatch::new_empty(std::sync::Arc::new(dataset::schema())),
         &dataset::SUMMARY_COLUMNS,
@@ -585,13 +584,16 @@ pub fn finalize(
         Ok(())
     })?;
     data.finish().map_err(BuildError::Internal)?;
+    let data_sum = integrity::sha256_file(&data_path).map_err(|e| internal(&data_path, e))?;
+    sums.insert(data_file.clone(), data_sum);
     let summary = compact(&summary)?;
     let eval = if manifest.is_whole() {
         let (indices, counts) = card::eval_selection(&summary);
         let subset = take_streamed(rows, &indices)?;
         let path = out.join(card::EVAL_FILE);
-        dataset::write_atomic(&path, &dataset::parquet_bytes(&subset))
-            .map_err(|e| internal(&path, e))?;
+        let bytes = dataset::parquet_bytes(&subset);
+        dataset::write_atomic(&path, &bytes).map_err(|e| internal(&path, e))?;
+        sums.insert(card::EVAL_FILE.to_string(), integrity::sha256_bytes(&bytes));
         Some(counts)
     } else {
         None
@@ -604,6 +606,13 @@ pub fn finalize(
     });
     let path = out.join("README.md");
     dataset::write_atomic(&path, readme.as_bytes()).map_err(|e| internal(&path, e))?;
+    sums.insert("README.md".to_string(), integrity::sha256_bytes(readme.as_bytes()));
+    let finished = Manifest {
+        files: Some(sums),
+        ..manifest.clone()
+    };
+    let path = out.join(MANIFEST_FILE);
+    dataset::write_atomic(&path, finished.to_json().as_bytes()).map_err(|e| internal(&path, e))?;
     Ok((summary, eval.map(|c| c.values().sum())))
 }
 
@@ -662,4 +671,38 @@ fn summarize(
         *summary.per_action.entry(action[i].clone()).or_default() += 1;
     }
     summary
+}
+
+/// Ctrl-C (SIGINT) or SIGTERM during a build: say that the finished groups are kept and
+/// that running the same command again resumes, then exit 130. The message is prepared
+/// before the handler is installed; the handler only writes it (async-signal-safe).
+mod interrupt {
+    use std::path::Path;
+    use std::sync::OnceLock;
+
+    static MESSAGE: OnceLock<Vec<u8>> = OnceLock::new();
+
+    extern "C" fn on_signal(_: libc::c_int) {
+        if let Some(m) = MESSAGE.get() {
+            // SAFETY: write(2) and _exit(2) are async-signal-safe; the buffer is immutable.
+            unsafe {
+                libc::write(2, m.as_ptr().cast(), m.len());
+            }
+        }
+        unsafe { libc::_exit(130) }
+    }
+
+    pub fn say_resume_on_interrupt(out: &Path) {
+        let text = format!(
+            "\nrh-pipeline: interrupted. Finished scene groups are kept in {}; run the same command again to resume (they are not recomputed, and the result is byte-identical to an uninterrupted build).\n",
+            out.display()
+        );
+        if MESSAGE.set(text.into_bytes()).is_ok() {
+            // SAFETY: installs a handler that only calls async-signal-safe functions.
+            unsafe {
+                libc::signal(libc::SIGINT, on_signal as *const () as libc::sighandler_t);
+                libc::signal(libc::SIGTERM, on_signal as *const () as libc::sighandler_t);
+            }
+        }
+    }
 }

@@ -4,7 +4,7 @@
 use crate::build::{build, BuildError, BuildOptions};
 use crate::config::Config;
 use crate::selection::{LexiconPlanner, Planner};
-use crate::verify::verify;
+use crate::verify::{verify, verify_fast};
 use clap::{Parser, Subcommand};
 use rh_catalog::Catalog;
 use std::path::{Path, PathBuf};
@@ -107,10 +107,17 @@ pub enum Command {
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
     },
-    /// Replay every spec of a dataset and compare per-step state hashes (exit 2 on any mismatch).
+    /// Check a dataset end to end (exit 2 on any problem): every file against the SHA-256
+    /// its build.json records, every spec against the one derived again from (selection,
+    /// seed, configuration), every Parquet column against the value derived from the
+    /// replay. `--fast` only replays the specs and compares per-step state hashes.
     Verify {
         /// Dataset directory built by `rh-pipeline build`.
         dir: PathBuf,
+        /// Only replay each stored spec and compare its state hash (no file checksums, no
+        /// re-derivation of specs and labels).
+        #[arg(long)]
+        fast: bool,
         /// Print the report as JSON on stdout.
         #[arg(long)]
         json: bool,
@@ -180,16 +187,14 @@ fn llm_planner<'a>(
         .ok_or_else(|| input("the LLM planner needs --model ID"))?;
     let cfg = crate::llm_plan::PlannerConfig::embedded();
     let mut client = cfg.client.clone();
-    if let Some(u) = args.base_url.clone().or_else(|| {
-        std::env::var("OPENAI_BASE_URL")
-            .ok()
-            .filter(|s| !s.is_empty())
-    }) {
+    if let Some(u) = args
+        .base_url
+        .clone()
+        .or_else(|| std::env::var("OPENAI_BASE_URL").ok().filter(|s| !s.is_empty()))
+    {
         client.base_url = u;
     }
-    client.api_key = std::env::var(&args.api_key_env)
-        .ok()
-        .filter(|k| !k.is_empty());
+    client.api_key = std::env::var(&args.api_key_env).ok().filter(|k| !k.is_empty());
     let cache = (!args.no_cache).then(|| rh_llm::cache::Cache::new(rh_llm::cache::default_dir()));
     crate::llm_plan::LlmPlanner::new(catalog, client, cache, model, cfg).map_err(|m| Failure {
         code: 1,
@@ -199,12 +204,8 @@ fn llm_planner<'a>(
 
 /// Reads a descriptions file: one a line; blank lines and `#` comments skipped.
 fn read_descriptions(path: &std::path::Path) -> Result<Vec<String>, Failure> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        input(format!(
-            "cannot read --descriptions {}: {e}",
-            path.display()
-        ))
-    })?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| input(format!("cannot read --descriptions {}: {e}", path.display())))?;
     let lines: Vec<String> = text
         .lines()
         .map(str::trim)
@@ -386,26 +387,52 @@ fn run_build(
 }
 
 /// `rh-pipeline verify`: replays every spec against its stored state hash.
-fn run_verify(dir: &Path, json: bool) -> Result<(), Failure> {
-    let report = verify(dir).map_err(input)?;
+fn run_verify(dir: &Path, catalog: &Catalog, fast: bool, json: bool) -> Result<(), Failure> {
+    let report = if fast {
+        verify_fast(dir)
+    } else {
+        verify(dir, catalog)
+    }
+    .map_err(input)?;
     if json {
         println!(
             "{}",
             serde_json::to_string_pretty(&report).expect("report serializes")
         );
     } else {
+        for p in &report.file_problems {
+            println!("FILE {}: {}", p.file, p.problem);
+        }
         for m in &report.mismatches {
             println!("MISMATCH {}: {}", m.scene_id, m.problem);
         }
-        println!(
-            "verified {} scenes: {} match, {} mismatch",
-            report.scenes,
-            report.matched,
-            report.mismatches.len()
-        );
+        if report.mode == "full" {
+            println!(
+                "verified {} files against build.json: {} problem(s); {} scenes derived again: {} match, {} differ",
+                report.files_checked,
+                report.file_problems.len(),
+                report.scenes,
+                report.matched,
+                report.scenes - report.matched
+            );
+        } else {
+            println!(
+                "verified {} scenes: {} match, {} mismatch",
+                report.scenes,
+                report.matched,
+                report.mismatches.len()
+            );
+        }
     }
     if report.ok() {
         Ok(())
+    } else if report.mode == "full" {
+        Err(input(format!(
+            "{}: {} file problem(s), {} scene(s) differ from what their build derives",
+            dir.display(),
+            report.file_problems.len(),
+            report.scenes - report.matched
+        )))
     } else {
         Err(input(format!(
             "{} scene(s) did not replay to their stored state hash",
@@ -414,7 +441,8 @@ fn run_verify(dir: &Path, json: bool) -> Result<(), Failure> {
     }
 }
 
-/// `rh-pipeline download`: fetch a dataset from the Hub (or its cache), optionally copy it.
+/// `download`: the dataset from the Hub (or a complete cached copy), checked; prints
+/// its path.
 fn download(repo: &str, revision: Option<&str>, out: Option<&Path>) -> Result<(), Failure> {
     let snapshot = rh_hub::fetch(repo, revision).map_err(|e| Failure {
         code: e.exit_code(),
@@ -422,16 +450,19 @@ fn download(repo: &str, revision: Option<&str>, out: Option<&Path>) -> Result<()
     })?;
     if snapshot.from_cache_only {
         eprintln!(
-            "the Hub at {} was not used; {repo} comes from the Hugging Face cache",
-            rh_hub::endpoint()
+            "the Hub at {} was not used ({}); {repo} comes from the Hugging Face cache, all {} files checked",
+            rh_hub::endpoint(),
+            snapshot.cache_reason.as_deref().unwrap_or("offline"),
+            snapshot.files
         );
     }
     let path = match out {
         Some(dir) => {
-            let files = rh_hub::copy_snapshot(&snapshot.path, dir).map_err(|e| Failure {
-                code: 1,
-                message: format!("cannot copy {repo} into {}: {e}", dir.display()),
-            })?;
+            let files =
+                rh_hub::copy_snapshot(&snapshot.path, dir).map_err(|e| Failure {
+                    code: 1,
+                    message: format!("cannot copy {repo} into {}: {e}", dir.display()),
+                })?;
             eprintln!("copied {files} files into {}", dir.display());
             dir.to_path_buf()
         }
@@ -441,7 +472,7 @@ fn download(repo: &str, revision: Option<&str>, out: Option<&Path>) -> Result<()
     Ok(())
 }
 
-/// `rh-pipeline balance`: label counts and rejection shares per family.
+/// `balance`: label counts per family over `per_family` scenes each, built in memory.
 fn balance(
     catalog: &Catalog,
     config: &Config,
@@ -463,8 +494,8 @@ fn balance(
         }
     }
     let rows = crate::balance::label_balance(
-        &catalog,
-        &config,
+        catalog,
+        config,
         seed.unwrap_or(config.build.seed),
         &families,
         per_family,
@@ -529,9 +560,12 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                 Some(path) => {
                     let texts = read_descriptions(path)?;
                     let sel = match planner {
-                        PlannerKind::Lexicon => {
-                            plan_descriptions(&LexiconPlanner::new(&catalog), &texts, path, seed)?
-                        }
+                        PlannerKind::Lexicon => plan_descriptions(
+                            &LexiconPlanner::new(&catalog),
+                            &texts,
+                            path,
+                            seed,
+                        )?,
                         PlannerKind::Llm => {
                             plan_descriptions(&llm_planner(&catalog, &llm)?, &texts, path, seed)?
                         }
@@ -600,7 +634,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             );
             Ok(())
         }
-        Command::Verify { dir, json } => run_verify(&dir, json),
+        Command::Verify { dir, fast, json } => run_verify(&dir, &catalog, fast, json),
     }
 }
 

@@ -187,8 +187,9 @@ struct RawConfig {
     speed_bands: BTreeMap<String, [f64; 4]>,
 }
 
-/// The whole, validated build configuration.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// The whole, validated build configuration (`Deserialize` reads back the copy a build
+/// manifest stores).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Config {
     pub build: BuildSection,
     pub physics: PhysicsConfig,
@@ -198,6 +199,9 @@ pub struct Config {
     pub render: RenderConfig,
     pub speed_bands: BTreeMap<String, [f64; 4]>,
     pub labels: LabelConfig,
+    /// Where the configuration came from (for messages; not part of its content).
+    #[serde(skip)]
+    pub source: String,
 }
 
 impl Config {
@@ -229,6 +233,7 @@ impl Config {
             render: raw.render,
             speed_bands: raw.speed_bands,
             labels,
+            source: name.to_string(),
         };
         config.validate(name)?;
         Ok(config)
@@ -348,7 +353,12 @@ fn parse<T: serde::de::DeserializeOwned>(name: &str, text: &str) -> Result<T, Co
     toml::from_str(text).map_err(|e| {
         let location = match e.span() {
             Some(span) => {
-                let line = text[..span.start.min(text.len())].lines().count().max(1);
+                // 1-based: the newlines before the span's start, plus one.
+                let line = text.as_bytes()[..span.start.min(text.len())]
+                    .iter()
+                    .filter(|&&b| b == b'\n')
+                    .count()
+                    + 1;
                 format!("{name}:{line}")
             }
             None => name.to_string(),
@@ -386,6 +396,15 @@ mod tests {
         let err = Config::load(&path).unwrap_err().to_string();
         assert!(err.contains("bad.toml:"), "{err}");
         assert!(err.contains("\"zero\""), "{err}");
+        // The exact line: a value at the start of a line and one after a blank line.
+        for (text, line) in [
+            ("labels = \"l.toml\"\n[build]\nseed = \"zero\"\n", 3),
+            ("labels = \"l.toml\"\n\n[build]\nseed = 0\nfamilies = 7\n", 5),
+            ("labels = 3\n", 1),
+        ] {
+            let err = parse::<RawConfig>("x.toml", text).unwrap_err().to_string();
+            assert!(err.starts_with(&format!("x.toml:{line}:")), "{text:?}: {err}");
+        }
     }
 
     #[test]

@@ -21,6 +21,7 @@ pub mod dataset;
 pub mod dataset_stream;
 pub mod families;
 pub mod fsio;
+pub mod integrity;
 pub mod label;
 pub mod llm_plan;
 pub mod manifest;
@@ -29,6 +30,7 @@ pub mod selection;
 /// The old name of [`selection`], kept so that code written against `plan` still builds.
 pub use selection as plan;
 pub mod randomize;
+pub mod records;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod scene;

@@ -36,6 +36,10 @@ pub struct Manifest {
     pub catalog_sha256: String,
     /// The whole build configuration (label thresholds included).
     pub config: serde_json::Value,
+    /// SHA-256 of every file the build wrote (this one aside), by path: written when the
+    /// build is finished (`build::finalize`); absent while it runs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub files: Option<crate::integrity::FileSums>,
     /// The planned selections of a build from descriptions (`--descriptions`), one per
     /// description with its planner record; group g takes selection g mod len.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -84,6 +88,7 @@ impl Manifest {
             config_sha256: config_sha256(config),
             catalog_sha256: catalog_sha256(catalog),
             config: serde_json::to_value(config).expect("config serializes"),
+            files: None,
             selections: None,
         }
     }
@@ -113,6 +118,7 @@ impl Manifest {
     pub fn whole(&self) -> Manifest {
         Manifest {
             shard: [0, 1],
+            files: None,
             ..self.clone()
         }
     }
@@ -122,7 +128,14 @@ impl Manifest {
         serde_json::from_value(self.config.get("labels")?.clone()).ok()
     }
 
-    /// Names the fields in which `other` differs from `self` (empty when equal).
+    /// The configuration the build ran with.
+    pub fn build_config(&self) -> Result<Config, String> {
+        serde_json::from_value(self.config.clone())
+            .map_err(|e| format!("{MANIFEST_FILE}: its configuration cannot be read: {e}"))
+    }
+
+    /// Names the fields in which `other` differs from `self` (empty when equal; the
+    /// file checksums are not part of a build's identity).
     pub fn differences(&self, other: &Manifest) -> Vec<String> {
         let mut d = Vec::new();
         let mut cmp = |name: &str, a: String, b: String| {

@@ -10,6 +10,7 @@
 
 use crate::build::{finalize, BuildError, RowSink, WORK_DIR};
 use crate::dataset;
+use crate::integrity::{self, FileSums};
 use crate::manifest::{Manifest, MANIFEST_FILE};
 use arrow::array::RecordBatch;
 use serde::Serialize;
@@ -81,9 +82,28 @@ fn read_shard(dir: &Path) -> Result<(Manifest, arrow::array::RecordBatch), Build
             expected.len()
         )));
     }
-    for spec in dataset::string_column(&rows, "spec_file") {
-        if !dir.join(&spec).is_file() {
-            return Err(input(format!("{}: {spec} is missing", dir.display())));
+    // Checksums first: every file the shard wrote must be what its manifest records.
+    let Some(sums) = &manifest.files else {
+        return Err(input(format!(
+            "{}: its {MANIFEST_FILE} records no file checksums (unfinished, or built by an older rh-pipeline); run its build command again",
+            dir.display()
+        )));
+    };
+    let problems = integrity::check(dir, sums);
+    if !problems.is_empty() {
+        return Err(input(format!(
+            "{}: {} file(s) are not what its {MANIFEST_FILE} records: {}; run its build command again to repair the shard",
+            dir.display(),
+            problems.len(),
+            integrity::describe(&problems, 5)
+        )));
+    }
+    for file in dataset::referenced_files(&rows) {
+        if !sums.contains_key(&file) {
+            return Err(input(format!(
+                "{}: {file} is named by a row but has no recorded checksum",
+                dir.display()
+            )));
         }
     }
     Ok((manifest, rows))
@@ -168,6 +188,7 @@ pub fn merge(out: &Path, shards: &[PathBuf]) -> Result<MergeSummary, BuildError>
     };
     std::fs::create_dir_all(&parent)
         .map_err(|e| input(format!("cannot create {}: {e}", parent.display())))?;
+    remove_stale_staging(&parent, out_name);
     let staging = parent.join(format!(".{out_name}.rh-merge.{}", std::process::id()));
     let result = write_merged(&staging, &whole, &read);
     if let Err(e) = result {
@@ -214,9 +235,12 @@ fn write_merged(staging: &Path, whole: &Manifest, shards: &[Shard]) -> Result<()
     std::fs::create_dir_all(staging.join("specs")).map_err(|e| internal(staging, e))?;
     dataset::write_atomic(&staging.join(MANIFEST_FILE), whole.to_json().as_bytes())
         .map_err(|e| internal(staging, e))?;
-    for (dir, (_, rows)) in shards {
-        // Specs, videos and frames: every file a row names.
+    let mut sums = FileSums::new();
+    for (dir, (manifest, rows)) in shards {
+        // Specs, videos and frames: every file a row names, with its checked checksum.
+        let shard_sums = manifest.files.as_ref().expect("checked by read_shard");
         for file in dataset::referenced_files(rows) {
+            sums.insert(file.clone(), shard_sums[&file].clone());
             let (from, to) = (dir.join(&file), staging.join(&file));
             if let Some(parent) = to.parent() {
                 std::fs::create_dir_all(parent).map_err(|e| internal(parent, e))?;
@@ -244,7 +268,7 @@ fn write_merged(staging: &Path, whole: &Manifest, shards: &[Shard]) -> Result<()
         }
         Ok(())
     };
-    finalize(staging, whole, &rows)?;
+    finalize(staging, whole, &rows, sums)?;
     Ok(())
 }
 
@@ -296,5 +320,25 @@ impl ShardCursor {
             need -= used;
         }
         dataset::concat(&parts).map_err(|e| input(format!("{}: {e}", self.path.display())))
+    }
+}
+
+/// Removes staging folders (`.OUT.rh-merge.PID`) that a killed merge into the same OUT
+/// left behind; a folder whose process still runs is left alone.
+fn remove_stale_staging(parent: &Path, out_name: &str) {
+    let prefix = format!(".{out_name}.rh-merge.");
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some(pid) = name.strip_prefix(&prefix).and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
+        let alive = pid != std::process::id() && Path::new(&format!("/proc/{pid}")).exists();
+        if !alive {
+            eprintln!("removing {} (left by a merge that was stopped)", e.path().display());
+            let _ = std::fs::remove_dir_all(e.path());
+        }
     }
 }

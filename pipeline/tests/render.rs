@@ -397,12 +397,17 @@ fn cached_static_frames_equal_whole_scene_frames_in_every_family() {
     let _ = std::fs::remove_dir_all(&dir);
     let mut compared = 0;
     for (fi, family) in families.iter().enumerate() {
-        let selection = plan_group(&catalog, std::slice::from_ref(family), 23, fi as u64).unwrap();
-        let results = produce_group(&selection, 23, fi as u64 * 4, 1, &catalog, &config).unwrap();
-        let spec = &results[0].spec;
-        if spec.cameras.is_empty() {
-            continue;
-        }
+        // The family's first group whose scene has cameras (a valid draw): no family is
+        // skipped — one without any in five groups fails the test.
+        let spec = (0..5u64)
+            .map(|k| {
+                let g = fi as u64 + 17 * k;
+                let selection = plan_group(&catalog, std::slice::from_ref(family), 23, g).unwrap();
+                produce_group(&selection, 23, g * 4, 1, &catalog, &config).unwrap().remove(0).spec
+            })
+            .find(|spec| !spec.cameras.is_empty())
+            .unwrap_or_else(|| panic!("{family}: no framed scene in five groups"));
+        let spec = &spec;
         let sim = simulate(spec, SimOptions::default());
         let rendered = r.render_scene(spec, &sim, &catalog, &dir).unwrap();
         for (ti, &t) in FRAME_TIMES.iter().enumerate() {
@@ -429,5 +434,36 @@ fn cached_static_frames_equal_whole_scene_frames_in_every_family() {
             }
         }
     }
-    assert!(compared >= 15 * 15, "only {compared} frames compared");
+    assert_eq!(compared, 17 * 15, "every family, every observation frame");
+}
+
+/// The default video size (1280×720 at 60 fps, what a build writes unless configured
+/// otherwise) probed on one scene: ffprobe agrees on codec, pixel format, size, rate and
+/// frame count.
+#[test]
+fn default_720p_video_probes_as_stated() {
+    let config = Config::embedded().unwrap();
+    assert_eq!((config.render.width, config.render.height, config.render.fps), (1280, 720, 60));
+    let catalog = Catalog::embedded().unwrap();
+    let families = vec!["object_drop".to_string()];
+    let selection = plan_group(&catalog, &families, 5, 0).unwrap();
+    let spec = produce_group(&selection, 5, 0, 1, &catalog, &config).unwrap().remove(0).spec;
+    assert!(!spec.cameras.is_empty());
+    let sim = simulate(&spec, SimOptions::default());
+    let mut r = Renderer::new(RenderOptions::from_config(&config.render)).unwrap();
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-720p-test");
+    let _ = std::fs::remove_dir_all(&dir);
+    let rendered = r.render_scene(&spec, &sim, &catalog, &dir).unwrap();
+    for cam in CAMERAS {
+        let v = ffprobe(&dir.join(rendered.video(cam).unwrap()));
+        assert_eq!(v["codec_name"], "h264", "{cam}");
+        assert_eq!(v["pix_fmt"], "yuv420p", "{cam}");
+        assert_eq!((v["width"].as_u64(), v["height"].as_u64()), (Some(1280), Some(720)), "{cam}");
+        assert_eq!(v["r_frame_rate"], "60/1", "{cam}");
+        assert_eq!(v["nb_read_frames"].as_str(), Some("37"), "{cam}");
+    }
+    let full = ffprobe(&dir.join(&rendered.full_event));
+    assert_eq!((full["width"].as_u64(), full["height"].as_u64()), (Some(640), Some(360)));
+    let png = image::open(dir.join(&rendered.frames[0])).unwrap();
+    assert_eq!((png.width(), png.height()), (1280, 720));
 }

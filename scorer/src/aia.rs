@@ -182,6 +182,9 @@ pub struct AiaMatcher {
     lexicon: PhraseSet,
     window: usize,
     material: PhraseSet,
+    /// Words that coordinate two keywords ("or", "nor") and the words allowed between them.
+    coordinators: Vec<String>,
+    fillers: Vec<String>,
 }
 
 /// Which vocabularies an intent mentions (after negation).
@@ -206,6 +209,8 @@ impl AiaMatcher {
             ]),
             window: cfg.negation_window,
             material: PhraseSet::new(&cfg.material_doubt),
+            coordinators: cfg.coordinators.iter().map(|w| normalize(w)).collect(),
+            fillers: cfg.coordination_fillers.iter().map(|w| normalize(w)).collect(),
         }
     }
 
@@ -286,6 +291,25 @@ impl AiaMatcher {
                 if negates(cue, k) && k.2 == vocab {
                     negated[j] = true;
                 }
+            }
+            // The negation covers keywords coordinated with the negated one: "don't
+            // catch or dodge", "never grab it or step back".
+            let mut last = first;
+            for j in first + 1..kept.len() {
+                let (prev, k) = (kept[last], kept[j]);
+                let between = &tokens[prev.0 + prev.1..k.0];
+                let coordinated = clause[prev.0] == clause[k.0]
+                    && between
+                        .iter()
+                        .any(|t| self.coordinators.iter().any(|c| c.as_str() == *t))
+                    && between
+                        .iter()
+                        .all(|t| self.fillers.iter().any(|f| f.as_str() == *t));
+                if !coordinated {
+                    break;
+                }
+                negated[j] = true;
+                last = j;
             }
         }
         let mut m = Mentions::default();
@@ -379,6 +403,14 @@ mod tests {
             mentions("it is not at all heavy or sharp in any way and I catch it"),
             [true, false, false]
         );
+        // A negation covers the whole coordinated phrase.
+        assert_eq!(mentions("don't catch or dodge"), [false, false, false]);
+        assert_eq!(mentions("neither catch nor dodge"), [false, false, false]);
+        assert_eq!(mentions("do not grab it or step back"), [false, false, false]);
+        assert_eq!(mentions("never catch, dodge or sidestep"), [false, true, false]);
+        assert_eq!(mentions("don't catch or dodge, just stay put"), [false, false, true]);
+        // Not coordinated: other words between, or "and then" (a new action).
+        assert_eq!(mentions("don't catch it and then dodge"), [false, true, false]);
         // Phrases containing a cue word keep their meaning.
         assert_eq!(mentions("do not move"), [false, false, true]);
         assert_eq!(
@@ -395,6 +427,8 @@ mod tests {
         assert_eq!(m.score("dodge", Action::Catch), 0.0);
         assert_eq!(m.score("do not catch, dodge", Action::Dodge), 1.0);
         assert_eq!(m.score("do not catch, dodge", Action::Catch), 0.0);
+        assert_eq!(m.score("don't catch or dodge", Action::Dodge), 0.0);
+        assert_eq!(m.score("neither catch nor dodge; stay put", Action::NoAction), 1.0);
         assert_eq!(m.score("", Action::NoAction), 0.0);
     }
 

@@ -45,6 +45,8 @@ pub struct SanityConfig {
     pub max_yaw_rate: f64,
     pub max_duration: f64,
     pub max_line_bytes: usize,
+    pub max_keyframes: usize,
+    pub max_nesting: usize,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -59,6 +61,8 @@ pub struct AnalysesConfig {
 pub struct AiaConfig {
     pub negation_window: usize,
     pub negation: Vec<String>,
+    pub coordinators: Vec<String>,
+    pub coordination_fillers: Vec<String>,
     pub clause_breaks: Vec<String>,
     pub catch: Vec<String>,
     pub dodge: Vec<String>,
@@ -108,6 +112,9 @@ impl Config {
         }
         if self.sanity.max_line_bytes < 1024 {
             bail!("config field sanity.max_line_bytes must be at least 1024");
+        }
+        if self.sanity.max_keyframes == 0 || self.sanity.max_nesting < 4 {
+            bail!("config fields sanity.max_keyframes must be >= 1 and sanity.max_nesting >= 4");
         }
         for (name, list) in [
             ("aia.catch", &self.aia.catch),

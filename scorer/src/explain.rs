@@ -34,7 +34,9 @@ PREDICTIONS (preds.jsonl, SPEC §9)
     frame, m). A missing hand stays at rest; `hands`/`position` sets both.
     Bare form (the paper's): [x, y, z] = both hands at that point.
     Keyframes without `t` get t_i = walking_duration * (i+1)/n (the last one at the end
-    of the walk), or (i+1) * {dt} s when walking_duration is 0. Keyframes are sorted by t
+    of the walk), or (i+1) * {dt} s when walking_duration is 0 — spread evenly over
+    (0, {md}] s instead when n * {dt} s would pass {md} s, so automatic times are never
+    absurd. Keyframes are sorted by t
     (stable); the first is keyframe 1, the last is the final one. A plan without
     keyframes has one implicit keyframe: hands at rest at the end of the walk.
     knee_bend is read but does not enter v1 metrics.
@@ -43,6 +45,9 @@ PREDICTIONS (preds.jsonl, SPEC §9)
     walking_duration or keyframe t outside [0, {md}] s, |hand coordinate| > {mc} m — is
     treated as NO PARSEABLE PLAN (R1) and counted as warning `absurd_number`. Nothing is
     clamped: a broken number is a broken plan. confidence outside [0, 1] is only a warning.
+  * Size caps: a plan with more than {mk} keyframes, or JSON nested deeper than {mn}
+    levels, is R1 (warning `r1_plan_too_large`). The caps are checked on the raw text
+    before any JSON tree is built, so memory stays flat whatever a line holds.
   * `error` (non-null, non-false, non-empty): the decision is LOST — counted per model,
     never scored (not R1). A later scored line for the same (scene, model) replaces a lost
     one (a retry; warning `retry_after_error`).
@@ -50,6 +55,8 @@ PREDICTIONS (preds.jsonl, SPEC §9)
     distances missing).
   * Skipped lines, each counted as a warning with its first line numbers: malformed_json,
     not_an_object, missing_scene_id, missing_model, unknown_scene_id, invalid_utf8,
+    plan_too_large (a line the fast reader cannot take apart, e.g. with duplicate keys,
+    that is over the size caps below),
     line_too_long (> {ml} bytes; never held in memory), invalid_scene (the dataset marks
     the scene valid = false: never scored, and baselines skip it), duplicate_decision
     (first line for a (scene, model) pair wins). Blank lines are ignored. A broken line never stops
@@ -92,7 +99,9 @@ AIA VOCABULARIES AND NEGATION
   Clauses end at , . ; : ! ? ( ) [ ] newlines and the words: {breaks}.
   Negation: a cue that ends at most {win} words before a keyword, in the same clause,
   negates the nearest such keyword and any further ones of the same vocabulary in reach;
-  negated keywords do not count. A cue strictly inside a longer keyword phrase ("no
+  negated keywords do not count. The negation carries over keywords coordinated with a
+  negated one ("don't catch or dodge", "neither catch nor dodge"): the words between
+  them are only {fill} and include one of {coord}. A cue strictly inside a longer keyword phrase ("no
   action", "do not move") is part of that phrase; a word that is both a cue and a
   keyword ("avoid") is a cue when it negates something ("avoid catching"), else a
   keyword ("avoid the lamp").
@@ -110,6 +119,10 @@ AIA VOCABULARIES AND NEGATION
         md = s.max_duration,
         mc = s.max_abs_coordinate,
         ml = s.max_line_bytes,
+        mk = s.max_keyframes,
+        mn = s.max_nesting,
+        fill = list(&aia.coordination_fillers),
+        coord = list(&aia.coordinators),
         ph = b.pelvis_height,
         rl = b.rest_left,
         rr = b.rest_right,
@@ -165,7 +178,8 @@ WARNINGS
   Every skipped line or non-fatal oddity is counted by kind with its first 5 line
   numbers (and examples where useful), shown in the report and in --json under
   input.warnings. Kinds starting with r1_ explain why a decision scored R1:
-  r1_no_json_in_response, r1_not_a_plan, r1_malformed_plan, r1_no_plan_or_response;
+  r1_no_json_in_response, r1_not_a_plan, r1_malformed_plan, r1_no_plan_or_response,
+  r1_plan_too_large;
   absurd_number also means R1. Other kinds: missing_intent (AIA 0),
   missing_walking_duration, confidence_out_of_range, retry_after_error, and the skipped
   lines listed above.

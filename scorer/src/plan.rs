@@ -59,6 +59,8 @@ pub enum PlanError {
     Malformed(String),
     /// A number is NaN/inf or outside the sanity bounds.
     Absurd(String),
+    /// More keyframes or deeper nesting than the configured caps.
+    TooLarge(String),
 }
 
 impl PlanError {
@@ -69,6 +71,7 @@ impl PlanError {
             PlanError::NotAPlan => "r1_not_a_plan",
             PlanError::Malformed(_) => "r1_malformed_plan",
             PlanError::Absurd(_) => "absurd_number",
+            PlanError::TooLarge(_) => "r1_plan_too_large",
         }
     }
 }
@@ -196,8 +199,64 @@ pub fn plan_from_value(v: &Value, cfg: &Config) -> Result<Plan, PlanError> {
     )
 }
 
+/// Containers (`{`, `[`) and the deepest nesting of a JSON text, strings skipped: a
+/// bound on the tree a parse would build, had without building it.
+pub fn json_shape(text: &str) -> (usize, usize) {
+    let (mut containers, mut depth, mut max_depth) = (0usize, 0usize, 0usize);
+    let (mut in_str, mut esc) = (false, false);
+    for &b in text.as_bytes() {
+        if in_str {
+            if esc {
+                esc = false;
+            } else if b == b'\\' {
+                esc = true;
+            } else if b == b'"' {
+                in_str = false;
+            }
+            continue;
+        }
+        match b {
+            b'"' => in_str = true,
+            b'{' | b'[' => {
+                containers += 1;
+                depth += 1;
+                max_depth = max_depth.max(depth);
+            }
+            b'}' | b']' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    (containers, max_depth)
+}
+
+/// The size caps (`sanity.max_keyframes`, `sanity.max_nesting`) on raw JSON text. A
+/// keyframe is at most 3 containers (itself and two hands), so a text with more than
+/// `4 * max_keyframes + 64` containers cannot be a plan within the cap.
+pub fn check_size(text: &str, cfg: &Config) -> Result<(), PlanError> {
+    let s = &cfg.sanity;
+    let (containers, depth) = json_shape(text);
+    if depth > s.max_nesting {
+        return Err(PlanError::TooLarge(format!(
+            "JSON nested {depth} levels deep, more than sanity.max_nesting = {}",
+            s.max_nesting
+        )));
+    }
+    if containers > 4 * s.max_keyframes + 64 {
+        return Err(PlanError::TooLarge(format!(
+            "{containers} JSON objects/lists, more than a plan of sanity.max_keyframes = {} keyframes can hold",
+            s.max_keyframes
+        )));
+    }
+    Ok(())
+}
+
 /// Parses a plan from JSON text. `None` when the text is not JSON at all.
 pub fn plan_from_json_str(text: &str, cfg: &Config) -> Option<Result<Plan, PlanError>> {
+    if let Err(e) = check_size(text, cfg) {
+        // Only JSON-looking text is reported (a plan's caller treats `None` as "no JSON").
+        let t = text.trim_start();
+        return (t.starts_with('{') || t.starts_with('[')).then_some(Err(e));
+    }
     if let Some(parts) = fast::parts(text) {
         return Some(finish(parts, cfg));
     }
@@ -239,6 +298,12 @@ fn finish(p: Parts, cfg: &Config) -> Result<Plan, PlanError> {
         }
     }
     let n = p.keyframes.len();
+    if n > s.max_keyframes {
+        return Err(PlanError::TooLarge(format!(
+            "{n} keyframes, more than sanity.max_keyframes = {}",
+            s.max_keyframes
+        )));
+    }
     let (mut objects, mut bare) = (false, false);
     let mut keyframes: Vec<Keyframe> = Vec::with_capacity(n);
     for (i, k) in p.keyframes.iter().enumerate() {
@@ -293,12 +358,20 @@ fn finish(p: Parts, cfg: &Config) -> Result<Plan, PlanError> {
 }
 
 /// Keyframe times for position `i` of `n` when the plan gives none: evenly spread over the
-/// walking duration (the last keyframe at its end), else `(i + 1) * default_keyframe_dt`.
+/// walking duration (the last keyframe at its end), else `(i + 1) * default_keyframe_dt`,
+/// compressed evenly into `(0, max_duration]` when that would run past it — an automatic
+/// time is never outside the sanity bound.
 pub fn default_time(i: usize, n: usize, duration: f64, cfg: &Config) -> f64 {
     if duration > 0.0 {
         duration * (i + 1) as f64 / n as f64
     } else {
-        cfg.body.default_keyframe_dt * (i + 1) as f64
+        let dt = cfg.body.default_keyframe_dt;
+        let span = (dt * n as f64).min(cfg.sanity.max_duration);
+        if span < dt * n as f64 {
+            span * (i + 1) as f64 / n as f64
+        } else {
+            dt * (i + 1) as f64
+        }
     }
 }
 
@@ -794,9 +867,54 @@ mod tests {
 
     #[test]
     fn pathological_text_terminates() {
+        // Unbalanced braces: no candidate closes, so no JSON is found — quickly.
+        let start = std::time::Instant::now();
         let text = "{".repeat(200_000) + &"}".repeat(10);
-        let _ = plan_from_text(&text, &cfg());
+        let r = plan_from_text(&text, &cfg());
+        assert!(matches!(r, Err(PlanError::NoJson) | Err(PlanError::TooLarge(_))), "{r:?}");
         let text = "```".repeat(10_000);
-        let _ = plan_from_text(&text, &cfg());
+        assert_eq!(plan_from_text(&text, &cfg()), Err(PlanError::NoJson));
+        // Deep but balanced nesting: R1 for its depth, never a stack overflow.
+        let text = "[".repeat(100_000) + &"]".repeat(100_000);
+        let text = format!("{{\"walking_cmd\": [0,0,0], \"keyframes\": {text}}}");
+        assert!(matches!(plan_from_text(&text, &cfg()), Err(PlanError::TooLarge(_))));
+        assert!(start.elapsed().as_secs() < 20, "took {:?}", start.elapsed());
+    }
+
+    #[test]
+    fn keyframe_and_nesting_caps_make_r1_with_a_reason() {
+        let cfg = cfg();
+        let many: Vec<String> = (0..cfg.sanity.max_keyframes + 1)
+            .map(|i| format!("{{\"t\": {}, \"pos\": [0.3, 0, 0.1]}}", i as f64 * 0.01))
+            .collect();
+        let text = format!("{{\"walking_cmd\": [0,0,0], \"keyframes\": [{}]}}", many.join(","));
+        match plan_from_json_str(&text, &cfg) {
+            Some(Err(PlanError::TooLarge(why))) => assert!(why.contains("max_keyframes"), "{why}"),
+            other => panic!("{other:?}"),
+        }
+        // Exactly at the cap: parsed.
+        let ok: Vec<String> = (0..cfg.sanity.max_keyframes).map(|_| "[0.3, 0, 0.1]".to_string()).collect();
+        let text = format!("{{\"walking_cmd\": [0,0,0], \"keyframes\": [{}]}}", ok.join(","));
+        assert_eq!(plan_from_json_str(&text, &cfg).unwrap().unwrap().keyframes.len(), cfg.sanity.max_keyframes);
+        let deep = format!("{{\"walking_cmd\": [0,0,0], \"x\": {}1{}}}", "[".repeat(40), "]".repeat(40));
+        match plan_from_json_str(&deep, &cfg) {
+            Some(Err(PlanError::TooLarge(why))) => assert!(why.contains("max_nesting"), "{why}"),
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(json_shape(r#"{"a": "[[[{{", "b": [1, {"c": []}]}"#), (4, 4));
+    }
+
+    #[test]
+    fn automatic_times_are_never_absurd() {
+        let cfg = cfg();
+        // 200 bare keyframes without walking: (i+1) * 0.25 s would reach 50 s.
+        let pts: Vec<String> = (0..200).map(|_| "[0.3, 0, 0.1]".to_string()).collect();
+        let text = format!("{{\"walking_cmd\": [0,0,0], \"walking_duration\": 0, \"keyframes\": [{}]}}", pts.join(","));
+        let p = plan_from_json_str(&text, &cfg).unwrap().unwrap();
+        let last = p.keyframes.last().unwrap().t;
+        assert!(last <= cfg.sanity.max_duration && last > 29.0, "{last}");
+        assert!(p.keyframes.windows(2).all(|w| w[0].t < w[1].t));
+        // Few keyframes keep the documented (i + 1) * dt.
+        assert_eq!(default_time(1, 3, 0.0, &cfg), 0.5);
     }
 }

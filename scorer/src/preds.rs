@@ -223,6 +223,10 @@ pub fn process_line(raw: &RawLine, ds: &Dataset, cfg: &Config, aia: &AiaMatcher)
             (plan_of_raw(plan, response, cfg), none)
         });
     }
+    // The lenient path builds a tree: only within the size caps (memory stays flat).
+    if text.starts_with('{') && crate::plan::check_size(text, cfg).is_err() {
+        return skip("plan_too_large");
+    }
     let v: Value = match serde_json::from_str(text) {
         Ok(v) => v,
         Err(_) => return skip("malformed_json"),

@@ -31,6 +31,31 @@ fn sha256_hex(bytes: &[u8]) -> String {
         .collect()
 }
 
+/// The git blob hash the Hub uses for files not stored in LFS.
+fn git_sha1(bytes: &[u8]) -> String {
+    use sha1::Digest as _;
+    let mut h = sha1::Sha1::new();
+    h.update(format!("blob {}\0", bytes.len()).as_bytes());
+    h.update(bytes);
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Files the stand-in stores in LFS (as the real dataset's `.gitattributes` does).
+fn is_lfs(path: &str) -> bool {
+    [".parquet", ".mp4", ".png"].iter().any(|e| path.ends_with(e))
+}
+
+/// What the stand-in Hub does with a connection.
+#[derive(Clone)]
+enum Mode {
+    /// Answers like the Hub.
+    Serve,
+    /// Accepts the connection, then never answers (a hung server).
+    Hang,
+    /// Answers like the Hub, but serves this file with one byte changed.
+    Corrupt(String),
+}
+
 /// The stand-in Hub.
 struct Hub {
     endpoint: String,
@@ -41,6 +66,10 @@ struct Hub {
 
 impl Hub {
     fn serve(files: BTreeMap<String, Vec<u8>>) -> Hub {
+        Hub::serve_mode(files, Mode::Serve)
+    }
+
+    fn serve_mode(files: BTreeMap<String, Vec<u8>>, mode: Mode) -> Hub {
         let listener = TcpListener::bind("127.0.0.1:0").unwrap();
         listener.set_nonblocking(true).unwrap();
         let endpoint = format!("http://{}", listener.local_addr().unwrap());
@@ -49,11 +78,21 @@ impl Hub {
         let (stop2, requests2) = (stop.clone(), requests.clone());
         let thread = std::thread::spawn(move || {
             let deadline = Instant::now() + Duration::from_secs(120);
+            // Connections a hung server holds open (closed when it stops).
+            let mut held = Vec::new();
             while !stop2.load(Ordering::SeqCst) && Instant::now() < deadline {
                 match listener.accept() {
                     Ok((stream, _)) => {
                         requests2.fetch_add(1, Ordering::SeqCst);
-                        let _ = handle(stream, &files);
+                        match &mode {
+                            Mode::Hang => held.push(stream),
+                            Mode::Serve => {
+                                let _ = handle(stream, &files, None);
+                            }
+                            Mode::Corrupt(f) => {
+                                let _ = handle(stream, &files, Some(f));
+                            }
+                        }
                     }
                     Err(_) => std::thread::sleep(Duration::from_millis(2)),
                 }
@@ -122,7 +161,11 @@ fn not_found(stream: &mut TcpStream, code: &str, head: bool) -> std::io::Result<
 }
 
 /// One request per connection (the response closes it).
-fn handle(mut stream: TcpStream, files: &BTreeMap<String, Vec<u8>>) -> std::io::Result<()> {
+fn handle(
+    mut stream: TcpStream,
+    files: &BTreeMap<String, Vec<u8>>,
+    corrupt: Option<&String>,
+) -> std::io::Result<()> {
     stream.set_nonblocking(false)?;
     stream.set_read_timeout(Some(Duration::from_secs(5)))?;
     let mut buf = Vec::new();
@@ -183,10 +226,16 @@ fn handle(mut stream: TcpStream, files: &BTreeMap<String, Vec<u8>>) -> std::io::
             let entries: Vec<_> = files
                 .iter()
                 .map(|(f, bytes)| {
-                    serde_json::json!({
+                    let mut e = serde_json::json!({
                         "type": "file", "path": f, "size": bytes.len(),
-                        "oid": sha256_hex(bytes),
-                    })
+                        "oid": git_sha1(bytes),
+                    });
+                    if is_lfs(f) {
+                        e["lfs"] = serde_json::json!({
+                            "oid": sha256_hex(bytes), "size": bytes.len(), "pointerSize": 134
+                        });
+                    }
+                    e
                 })
                 .collect();
             json(&mut stream, serde_json::Value::Array(entries))
@@ -194,19 +243,34 @@ fn handle(mut stream: TcpStream, files: &BTreeMap<String, Vec<u8>>) -> std::io::
         ["datasets", owner, name, "resolve", rev, file @ ..]
             if format!("{owner}/{name}") == REPO && known_rev(rev) =>
         {
-            match files.get(&file.join("/")) {
-                Some(bytes) => respond(
-                    &mut stream,
-                    "200 OK",
-                    &[
-                        ("Content-Type", "application/octet-stream".into()),
-                        ("Content-Length", bytes.len().to_string()),
-                        ("X-Repo-Commit", COMMIT.into()),
-                        ("ETag", format!("\"{}\"", sha256_hex(bytes))),
-                    ],
-                    bytes,
-                    head,
-                ),
+            let name = file.join("/");
+            match files.get(&name) {
+                Some(bytes) => {
+                    // The ETag names the true content; a corrupting server still sends
+                    // it (as a proxy that damages bodies would).
+                    let etag = if is_lfs(&name) {
+                        sha256_hex(bytes)
+                    } else {
+                        git_sha1(bytes)
+                    };
+                    let mut body = bytes.clone();
+                    if corrupt == Some(&name) {
+                        let mid = body.len() / 2;
+                        body[mid] ^= 0x20;
+                    }
+                    respond(
+                        &mut stream,
+                        "200 OK",
+                        &[
+                            ("Content-Type", "application/octet-stream".into()),
+                            ("Content-Length", body.len().to_string()),
+                            ("X-Repo-Commit", COMMIT.into()),
+                            ("ETag", format!("\"{etag}\"")),
+                        ],
+                        &body,
+                        head,
+                    )
+                }
                 None => not_found(&mut stream, "EntryNotFound", head),
             }
         }
@@ -225,6 +289,10 @@ fn hub_run_token(
     hf_home: &Path,
     token: Option<&str>,
 ) -> Output {
+    hub_cmd(name, args, endpoint, hf_home, token).output().unwrap()
+}
+
+fn hub_cmd(name: &str, args: &[&str], endpoint: &str, hf_home: &Path, token: Option<&str>) -> Command {
     let mut cmd = Command::new(bin(name));
     if let Some(t) = token {
         cmd.env("HF_TOKEN", t);
@@ -239,9 +307,10 @@ fn hub_run_token(
         .env_remove("HUGGINGFACE_HUB_CACHE")
         .env_remove("HF_HUB_OFFLINE")
         .env_remove("HF_TOKEN_PATH")
-        .env_remove("RH_DATASET")
-        .output()
-        .unwrap()
+        .env_remove("HF_HUB_ETAG_TIMEOUT")
+        .env_remove("HF_HUB_DOWNLOAD_TIMEOUT")
+        .env_remove("RH_DATASET");
+    cmd
 }
 
 fn ok(out: &Output, what: &str) -> String {
@@ -392,4 +461,136 @@ fn dataset_hub_download_then_offline_from_cache() {
         err.contains("rh-test/other") && err.contains(&endpoint) && err.contains("cache"),
         "{err}"
     );
+}
+
+/// A small dataset to serve (4 scenes, no videos), as a file map.
+fn small_dataset(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    run_ok(
+        "rh-pipeline",
+        &[
+            "build", "--n", "4", "--seed", "5", "--no-render", "--quiet",
+            "--families", "object_drop", "--out", dir.to_str().unwrap(),
+        ],
+    );
+    files_under(dir)
+}
+
+/// Runs with 1-second timeouts and returns (exit code, stderr, stdout, seconds taken).
+fn timed(mut cmd: Command) -> (Option<i32>, String, String, f64) {
+    let start = Instant::now();
+    let out = cmd
+        .env("HF_HUB_ETAG_TIMEOUT", "1")
+        .env("HF_HUB_DOWNLOAD_TIMEOUT", "1")
+        .output()
+        .unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+        String::from_utf8_lossy(&out.stdout).to_string(),
+        start.elapsed().as_secs_f64(),
+    )
+}
+
+#[test]
+fn hung_hub_times_out_to_the_cache_or_a_clear_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    let files = small_dataset(&tmp.path().join("built"));
+    let hung = Hub::serve_mode(files.clone(), Mode::Hang);
+
+    // Nothing cached: a clear error within the timeout, naming the timeout's variables.
+    let empty_home = tmp.path().join("empty-home");
+    let (code, err, _, secs) = timed(hub_cmd(
+        "rh-pipeline", &["download", REPO], &hung.endpoint, &empty_home, Some(TOKEN),
+    ));
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("no answer within 1 s") && err.contains("HF_HUB_ETAG_TIMEOUT"), "{err}");
+    assert!(err.contains("holds no copy"), "{err}");
+    assert!(secs < 20.0, "took {secs} s");
+
+    // A complete cached copy: used, exit 0, for both programs.
+    let home = tmp.path().join("home");
+    let mut good = Hub::serve(files.clone());
+    let snapshot = ok(&hub_run("rh-pipeline", &["download", REPO], &good.endpoint, &home), "download");
+    good.shutdown();
+    let (code, err, out, secs) = timed(hub_cmd(
+        "rh-pipeline", &["download", REPO], &hung.endpoint, &home, Some(TOKEN),
+    ));
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(out.trim(), snapshot.trim());
+    assert!(err.contains("comes from the Hugging Face cache") && err.contains("no answer"), "{err}");
+    assert!(secs < 20.0, "took {secs} s");
+    let (code, err, _, _) = timed(hub_cmd(
+        "rh-score",
+        &["baseline", "majority", "--dataset", REPO],
+        &hung.endpoint,
+        &home,
+        Some(TOKEN),
+    ));
+    assert_eq!(code, Some(0), "{err}");
+
+    // A partial cache (one file gone), offline: exit 2 naming the missing file.
+    let snap = PathBuf::from(snapshot.trim());
+    let victim = files.keys().find(|k| k.starts_with("specs/")).unwrap().clone();
+    std::fs::remove_file(snap.join(&victim)).unwrap();
+    let (code, err, _, _) = timed(hub_cmd(
+        "rh-pipeline", &["download", REPO], &hung.endpoint, &home, Some(TOKEN),
+    ));
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains(&victim) && err.contains("missing"), "{err}");
+    let mut offline = hub_cmd("rh-pipeline", &["download", REPO], &hung.endpoint, &home, Some(TOKEN));
+    offline.env("HF_HUB_OFFLINE", "1");
+    let (code, err, _, _) = timed(offline);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains(&victim), "{err}");
+}
+
+#[test]
+fn corrupt_bodies_never_enter_the_cache_and_bad_blobs_are_refetched() {
+    let tmp = tempfile::tempdir().unwrap();
+    let files = small_dataset(&tmp.path().join("built"));
+    let data = files.keys().find(|k| k.ends_with(".parquet") && k.starts_with("data/")).unwrap().clone();
+    let spec = files.keys().find(|k| k.starts_with("specs/")).unwrap().clone();
+    let home = tmp.path().join("home");
+
+    // An LFS file (hash: SHA-256) and a plain one (git blob SHA-1) served altered.
+    // (Each into a fresh cache: the other files are stored meanwhile.)
+    for (i, victim) in [&data, &spec].into_iter().enumerate() {
+        let bad = Hub::serve_mode(files.clone(), Mode::Corrupt(victim.clone()));
+        let fresh = tmp.path().join(format!("fresh-{i}"));
+        let blobs = fresh.join("hub/datasets--rh-test--tiny/blobs");
+        let (code, err, _, _) = timed(hub_cmd(
+            "rh-pipeline", &["download", REPO], &bad.endpoint, &fresh, Some(TOKEN),
+        ));
+        assert_eq!(code, Some(1), "{victim}: {err}");
+        assert!(err.contains(victim.as_str()) && err.contains("corrupt"), "{err}");
+        // Every blob in the store matches its name; no temporary is left.
+        for entry in std::fs::read_dir(&blobs).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().to_string();
+            let bytes = std::fs::read(&path).unwrap();
+            let real = if name.len() == 64 { sha256_hex(&bytes) } else { git_sha1(&bytes) };
+            assert_eq!(real, name, "blob {name} does not match its content");
+        }
+    }
+
+    // Download whole, then damage one blob in the store.
+    let mut good = Hub::serve(files.clone());
+    let snapshot = PathBuf::from(ok(&hub_run("rh-pipeline", &["download", REPO], &good.endpoint, &home), "download").trim());
+    let blob = std::fs::canonicalize(snapshot.join(&data)).unwrap();
+    let mut bytes = std::fs::read(&blob).unwrap();
+    let mid = bytes.len() / 2;
+    bytes[mid] ^= 1;
+    std::fs::write(&blob, &bytes).unwrap();
+    // Offline: reported (exit 2, naming it), not returned.
+    let mut offline = hub_cmd("rh-pipeline", &["download", REPO], &good.endpoint, &home, Some(TOKEN));
+    offline.env("HF_HUB_OFFLINE", "1");
+    let (code, err, _, _) = timed(offline);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains(&data) && err.contains("does not match"), "{err}");
+    // Online: fetched again, and the snapshot equals the served dataset.
+    let (code, err, _, _) = timed(hub_cmd("rh-pipeline", &["download", REPO], &good.endpoint, &home, Some(TOKEN)));
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("does not match its hash; fetching it again"), "{err}");
+    assert!(files_under(&snapshot) == files, "snapshot differs after the re-fetch");
+    good.shutdown();
 }

@@ -198,12 +198,20 @@ fn verify_replays_and_catches_a_tampered_spec() {
     let x = spec["bodies"][hazard]["linvel"][0].as_f64().unwrap();
     spec["bodies"][hazard]["linvel"][0] = serde_json::json!(x + 0.05);
     fs::write(&victim, serde_json::to_string_pretty(&spec).unwrap()).unwrap();
+    let id = victim.file_stem().unwrap().to_str().unwrap();
+    // The replay-only check sees the physics change.
+    let out = run("rh-pipeline", &["verify", "--fast", dir.path().to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains(&format!("MISMATCH {id}: state hash")), "{stdout}");
+    assert!(stdout.contains("59 match, 1 mismatch"), "{stdout}");
+    // The full check sees the altered file and the spec that no longer derives.
     let out = run("rh-pipeline", &["verify", dir.path().to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     let stdout = String::from_utf8_lossy(&out.stdout);
-    let id = victim.file_stem().unwrap().to_str().unwrap();
+    assert!(stdout.contains(&format!("FILE specs/{id}.json: altered")), "{stdout}");
     assert!(stdout.contains(&format!("MISMATCH {id}")), "{stdout}");
-    assert!(stdout.contains("59 match, 1 mismatch"), "{stdout}");
+    assert!(stdout.contains("59 match, 1 differ"), "{stdout}");
 }
 
 fn assert_bad_input(args: &[&str], expect_in_message: &str) {
@@ -399,5 +407,40 @@ fn balance_reports_counts_per_action_per_family() {
             .status
             .code(),
         Some(2)
+    );
+}
+
+/// The README's label balance sentence is the output of `rh-pipeline balance` (the one
+/// source): a change to the samplers or labels that moves a count fails here, and the
+/// message gives the sentence to paste.
+#[test]
+fn readme_label_balance_matches_the_balance_command() {
+    let readme = fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"))
+        .unwrap()
+        .replace('\n', " ");
+    let start = readme
+        .find("Label balance of the 17 × 18 subset")
+        .expect("README states the label balance");
+    let sentence = &readme[start..start + readme[start..].find('.').unwrap()];
+    let count = |label: &str| -> u64 {
+        let at = sentence.find(&format!("{label} ")).unwrap_or_else(|| panic!("{label} in: {sentence}"));
+        sentence[at + label.len() + 1..]
+            .split(|c: char| !c.is_ascii_digit())
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let stated = (count("CATCH"), count("DODGE"), count("NO_ACTION"));
+    let rows: serde_json::Value =
+        serde_json::from_str(&run_ok("rh-pipeline", &["balance", "--json", "--seed", "0"])).unwrap();
+    let rows = rows.as_array().unwrap();
+    assert_eq!(rows.len(), 17);
+    let sum = |k: &str| rows.iter().map(|r| r[k].as_u64().unwrap_or(0)).sum::<u64>();
+    let actual = (sum("catch"), sum("dodge"), sum("no_action"));
+    assert_eq!(
+        stated, actual,
+        "README says CATCH {}, DODGE {}, NO_ACTION {}; `rh-pipeline balance --seed 0` gives CATCH {}, DODGE {}, NO_ACTION {} — update the README",
+        stated.0, stated.1, stated.2, actual.0, actual.1, actual.2
     );
 }

@@ -344,8 +344,10 @@ fn dataset_dir(arg: Option<String>) -> Result<PathBuf> {
         Ok(snapshot) => {
             if snapshot.from_cache_only {
                 eprintln!(
-                    "rh-score: the Hub at {} was not used; {repo} comes from the Hugging Face cache",
-                    rh_hub::endpoint()
+                    "rh-score: the Hub at {} was not used ({}); {repo} comes from the Hugging Face cache, all {} files checked",
+                    rh_hub::endpoint(),
+                    snapshot.cache_reason.as_deref().unwrap_or("offline"),
+                    snapshot.files
                 );
             }
             Ok(snapshot.path)
@@ -459,6 +461,16 @@ fn score(cli: Cli) -> Result<()> {
             "rh-score: {warned} input warning(s) in {}; see the report's warnings section",
             preds.display()
         );
+        // One line per kind, naming its first line, so a user can go and look.
+        for w in &report.input.warnings {
+            match w.first_lines.first() {
+                Some(first) => eprintln!(
+                    "rh-score:   {} ×{} (first at line {first})",
+                    w.kind, w.count
+                ),
+                None => eprintln!("rh-score:   {} ×{}", w.kind, w.count),
+            }
+        }
     }
     Ok(())
 }

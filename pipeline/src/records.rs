@@ -1,0 +1,151 @@
+//! A build's per-group records (`.rh-build/groups/<g>.parquet`, with the SHA-256 of every
+//! file the group wrote beside it in `<g>.sha256.json`): writing them, loading them on
+//! resume (only when every file still has its recorded checksum), gathering their sums
+//! for `build.json`, and turning a damaged finished build back into records so that only
+//! the damaged groups are computed again.
+
+use crate::dataset;
+use crate::fsio::{write_unsynced, Unsynced};
+use crate::integrity::{self, FileSums};
+use crate::manifest::Manifest;
+use crate::scene::SceneResult;
+use arrow::array::RecordBatch;
+use rh_catalog::Catalog;
+use std::path::{Path, PathBuf};
+
+/// Work-in-progress folder of an unfinished build (removed when the build completes).
+pub const WORK_DIR: &str = ".rh-build";
+
+/// Path of group `g`'s record.
+pub fn record_path(out: &Path, g: u64) -> PathBuf {
+    out.join(WORK_DIR)
+        .join("groups")
+        .join(format!("{g:08}.parquet"))
+}
+
+fn internal(path: &Path, e: impl std::fmt::Display) -> String {
+    format!("{}: {e}", path.display())
+}
+
+/// Group `g`'s files, written under temporary names for the syncer to make durable in
+/// this order: its specs, then the checksums of every file its rows name (specs from
+/// memory; videos and frames, already in place, read back), and its record last: the
+/// record's presence says the group (specs, media, sums) is done.
+pub fn group_files(
+    out: &Path,
+    g: u64,
+    results: &[SceneResult],
+    catalog: &Catalog,
+) -> Result<Vec<Unsynced>, String> {
+    let mut files = Vec::with_capacity(results.len() + 2);
+    let mut spec_sums = FileSums::new();
+    for r in results {
+        let rel = dataset::spec_path(&r.spec.scene_id);
+        let path = out.join(&rel);
+        let json = r.spec.to_json();
+        spec_sums.insert(rel, integrity::sha256_bytes(json.as_bytes()));
+        files.push(write_unsynced(&path, json.as_bytes()).map_err(|e| internal(&path, e))?);
+    }
+    let path = record_path(out, g);
+    let batch = dataset::record_batch(results, catalog);
+    let sums = integrity::group_sums_known(out, &batch, spec_sums).map_err(|e| internal(out, e))?;
+    let sums_path = integrity::group_sums_path(&path);
+    let text = integrity::sums_json(&sums);
+    files.push(write_unsynced(&sums_path, text.as_bytes()).map_err(|e| internal(&sums_path, e))?);
+    let bytes = dataset::parquet_bytes(&batch);
+    files.push(write_unsynced(&path, &bytes).map_err(|e| internal(&path, e))?);
+    Ok(files)
+}
+
+/// The checksums of every finished group's files, together.
+pub fn gather_sums(out: &Path, groups: &[u64]) -> Result<FileSums, String> {
+    let mut sums = FileSums::new();
+    for &g in groups {
+        let path = record_path(out, g);
+        let group = integrity::read_group_sums(&path).ok_or_else(|| {
+            format!(
+                "{}: checksums missing",
+                integrity::group_sums_path(&path).display()
+            )
+        })?;
+        sums.extend(group);
+    }
+    Ok(sums)
+}
+
+/// Reads group `g`'s record if it is there and whole (right rows, every file it names
+/// present: specs, videos, frames).
+pub fn load_record(out: &Path, manifest: &Manifest, g: u64) -> Option<RecordBatch> {
+    let path = record_path(out, g);
+    if !path.exists() {
+        return None;
+    }
+    let batch = dataset::read_batch(&path).ok()?;
+    let indices = dataset::u64_column(&batch, "scene_index");
+    let expected: Vec<u64> = (g * 4..g * 4 + manifest.group_size(g)).collect();
+    if indices != expected {
+        return None;
+    }
+    // Every file the rows name, with the checksum recorded when the group finished.
+    let sums = integrity::read_group_sums(&path)?;
+    let named: Vec<String> = dataset::referenced_files(&batch);
+    if named.len() != sums.len() || !named.iter().all(|f| sums.contains_key(f)) {
+        return None;
+    }
+    let problems = integrity::check(out, &sums);
+    if !problems.is_empty() {
+        eprintln!(
+            "group {g}: {}; computing it again",
+            integrity::describe(&problems, 3)
+        );
+        return None;
+    }
+    Some(batch)
+}
+
+/// A finished build whose files are not all what its manifest records: turns it back
+/// into an unfinished one, keeping (as records) the groups whose files are intact, so
+/// the run recomputes only the damaged groups. Returns the problems found (empty: the
+/// build is intact and nothing was changed).
+pub fn reopen_if_damaged(
+    out: &Path,
+    manifest: &Manifest,
+) -> Result<Vec<integrity::FileProblem>, String> {
+    let Some(sums) = &manifest.files else {
+        // A finished build of a version that recorded no checksums: nothing to compare.
+        return Ok(vec![]);
+    };
+    let problems = integrity::check(out, sums);
+    if problems.is_empty() {
+        return Ok(problems);
+    }
+    let groups_dir = out.join(WORK_DIR).join("groups");
+    std::fs::create_dir_all(&groups_dir).map_err(|e| internal(&groups_dir, e))?;
+    let data_file = dataset::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
+    let data_ok = !problems.iter().any(|p| p.file == data_file);
+    let rows = if data_ok {
+        dataset::read_batch(&out.join(&data_file)).ok()
+    } else {
+        None
+    };
+    if let Some(rows) = rows {
+        let bad: std::collections::BTreeSet<&str> = problems.iter().map(|p| p.file.as_str()).collect();
+        let index = dataset::u64_column(&rows, "scene_index");
+        for g in manifest.groups() {
+            let picks: Vec<u32> = (0..rows.num_rows() as u32)
+                .filter(|&i| index[i as usize] / 4 == g)
+                .collect();
+            let batch = dataset::take_rows(&rows, &picks);
+            let files = dataset::referenced_files(&batch);
+            if picks.is_empty() || files.iter().any(|f| bad.contains(f.as_str()) || !sums.contains_key(f)) {
+                continue;
+            }
+            let group_sums: FileSums = files.iter().map(|f| (f.clone(), sums[f].clone())).collect();
+            let record = record_path(out, g);
+            integrity::write_group_sums(&record, &group_sums).map_err(|e| internal(&record, e))?;
+            dataset::write_atomic(&record, &dataset::parquet_bytes(&batch)).map_err(|e| internal(&record, e))?;
+        }
+    }
+    Ok(problems)
+}
+
