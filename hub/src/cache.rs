@@ -106,7 +106,11 @@ impl RepoCache {
         if std::fs::read_link(&link).ok().as_deref() == Some(target.as_path()) {
             return Ok(());
         }
-        let tmp = parent.join(format!(".{}.{}.link.tmp", file_name(&link), std::process::id()));
+        let tmp = parent.join(format!(
+            ".{}.{}.link.tmp",
+            file_name(&link),
+            std::process::id()
+        ));
         let _ = std::fs::remove_file(&tmp);
         symlink(&target, &tmp)?;
         std::fs::rename(&tmp, &link)
@@ -126,7 +130,8 @@ impl RepoCache {
                 return Some(entries);
             }
         }
-        let manifest = std::fs::read_to_string(self.snapshot_dir(commit).join("build.json")).ok()?;
+        let manifest =
+            std::fs::read_to_string(self.snapshot_dir(commit).join("build.json")).ok()?;
         let value: serde_json::Value = serde_json::from_str(&manifest).ok()?;
         let files = value.get("files")?.as_object()?;
         let mut entries = vec![Entry {
@@ -168,7 +173,11 @@ impl SnapshotCheck {
         };
         let mut parts = vec![];
         if !self.missing.is_empty() {
-            parts.push(format!("{} file(s) missing: {}", self.missing.len(), list(&self.missing)));
+            parts.push(format!(
+                "{} file(s) missing: {}",
+                self.missing.len(),
+                list(&self.missing)
+            ));
         }
         if !self.corrupt.is_empty() {
             parts.push(format!(
@@ -336,7 +345,10 @@ mod tests {
         h.update(b"lo\n");
         let (s256, s1) = h.finish();
         assert_eq!(s1, "ce013625030ba8dba906f756967f9e9ca394464a");
-        assert_eq!(s256, "5891b5b522d5df086d0ff0b110fbd9d21bb4fc7163af34d08286a2e846f6be03");
+        assert_eq!(
+            s256,
+            "5891b5b522d5df086d0ff0b110fbd9d21bb4fc7163af34d08286a2e846f6be03"
+        );
     }
 
     #[test]
@@ -347,11 +359,19 @@ mod tests {
         std::fs::create_dir_all(repo.root.join("blobs")).unwrap();
         let blob = "ce013625030ba8dba906f756967f9e9ca394464a";
         std::fs::write(repo.blob_path(blob), b"hello\n").unwrap();
-        let e = Entry { path: "a/b.txt".into(), size: 6, blob: blob.into() };
+        let e = Entry {
+            path: "a/b.txt".into(),
+            size: 6,
+            blob: blob.into(),
+        };
         repo.link(commit, &e).unwrap();
         let snap = repo.snapshot_dir(commit);
         assert_eq!(std::fs::read(snap.join("a/b.txt")).unwrap(), b"hello\n");
-        let missing = Entry { path: "c.txt".into(), size: 1, blob: blob.into() };
+        let missing = Entry {
+            path: "c.txt".into(),
+            size: 1,
+            blob: blob.into(),
+        };
         let check = check_snapshot(&snap, &[e.clone(), missing]);
         assert_eq!(check.missing, vec!["c.txt".to_string()]);
         std::fs::write(repo.blob_path(blob), b"hellO\n").unwrap();

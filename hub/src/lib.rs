@@ -87,7 +87,9 @@ fn seconds(what: &str, v: f64) -> Result<Duration, String> {
     if v.is_finite() && v > 0.0 && v <= 86_400.0 {
         Ok(Duration::from_secs_f64(v))
     } else {
-        Err(format!("{what} must be a number of seconds in (0, 86400], not {v}"))
+        Err(format!(
+            "{what} must be a number of seconds in (0, 86400], not {v}"
+        ))
     }
 }
 
@@ -96,8 +98,14 @@ impl Settings {
     pub fn parse(text: &str, origin: &str) -> Result<Settings, String> {
         let f: SettingsFile = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
         Ok(Settings {
-            metadata_timeout: seconds(&format!("{origin}: metadata_timeout_s"), f.metadata_timeout_s)?,
-            download_timeout: seconds(&format!("{origin}: download_timeout_s"), f.download_timeout_s)?,
+            metadata_timeout: seconds(
+                &format!("{origin}: metadata_timeout_s"),
+                f.metadata_timeout_s,
+            )?,
+            download_timeout: seconds(
+                &format!("{origin}: download_timeout_s"),
+                f.download_timeout_s,
+            )?,
             concurrent_downloads: f.concurrent_downloads.clamp(1, 64),
         })
     }
@@ -179,7 +187,12 @@ fn offline_mode() -> bool {
 /// The token: `HF_TOKEN` (or the older `HUGGING_FACE_HUB_TOKEN`), else the file
 /// `HF_TOKEN_PATH`, else `$HF_HOME/token`.
 pub fn token() -> Option<String> {
-    let env = |k: &str| std::env::var(k).ok().map(|s| s.trim().to_string()).filter(|s| !s.is_empty());
+    let env = |k: &str| {
+        std::env::var(k)
+            .ok()
+            .map(|s| s.trim().to_string())
+            .filter(|s| !s.is_empty())
+    };
     if let Some(t) = env("HF_TOKEN").or_else(|| env("HUGGING_FACE_HUB_TOKEN")) {
         return Some(t);
     }
@@ -203,7 +216,11 @@ pub fn fetch(repo_id: &str, revision: Option<&str>) -> Result<Snapshot, HubError
 }
 
 /// `fetch` with explicit network settings.
-pub fn fetch_with(repo_id: &str, revision: Option<&str>, settings: &Settings) -> Result<Snapshot, HubError> {
+pub fn fetch_with(
+    repo_id: &str,
+    revision: Option<&str>,
+    settings: &Settings,
+) -> Result<Snapshot, HubError> {
     let endpoint = endpoint();
     let revision = revision.unwrap_or("main");
     let what = format!("dataset {repo_id} (revision {revision}) on {endpoint}");
@@ -251,7 +268,12 @@ fn download(
         let commit = remote.commit(revision).await?;
         let entries = remote.files(&commit).await?;
         let downloaded = remote.download_all(repo_cache, &commit, &entries).await?;
-        let io = |e: std::io::Error| RemoteError::Bad(format!("cannot write to the cache {}: {e}", repo_cache.root.display()));
+        let io = |e: std::io::Error| {
+            RemoteError::Bad(format!(
+                "cannot write to the cache {}: {e}",
+                repo_cache.root.display()
+            ))
+        };
         repo_cache.write_record(&commit, &entries).map_err(io)?;
         repo_cache.write_ref(revision, &commit).map_err(io)?;
         Ok(Snapshot {
@@ -265,7 +287,12 @@ fn download(
 }
 
 /// The cached snapshot of `revision`, if the cache holds all of it, every file checked.
-fn from_cache(repo_cache: &RepoCache, revision: &str, what: &str, reason: &str) -> Result<Snapshot, HubError> {
+fn from_cache(
+    repo_cache: &RepoCache,
+    revision: &str,
+    what: &str,
+    reason: &str,
+) -> Result<Snapshot, HubError> {
     let cache_root = repo_cache.root.parent().unwrap_or(Path::new("."));
     let Some(commit) = repo_cache.read_ref(revision) else {
         return Err(HubError::Failed(format!(
@@ -359,10 +386,15 @@ mod tests {
         let s = Settings::parse(EMBEDDED_CONFIG, "hub.toml").unwrap();
         assert_eq!(s.metadata_timeout, Duration::from_secs(10));
         assert_eq!(s.download_timeout, Duration::from_secs(10));
-        assert!(Settings::parse("metadata_timeout_s = 0\ndownload_timeout_s = 1\nconcurrent_downloads = 1", "x.toml")
+        assert!(Settings::parse(
+            "metadata_timeout_s = 0\ndownload_timeout_s = 1\nconcurrent_downloads = 1",
+            "x.toml"
+        )
+        .unwrap_err()
+        .contains("x.toml: metadata_timeout_s"));
+        assert!(Settings::parse("metadata_timeout_s = 1\n", "x.toml")
             .unwrap_err()
-            .contains("x.toml: metadata_timeout_s"));
-        assert!(Settings::parse("metadata_timeout_s = 1\n", "x.toml").unwrap_err().contains("x.toml"));
+            .contains("x.toml"));
     }
 
     #[test]

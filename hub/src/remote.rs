@@ -115,7 +115,12 @@ impl Remote {
     }
 
     /// Sends a GET and classifies a failing status.
-    async fn get(&self, client: &Client, url: &str, timeout: Duration) -> Result<reqwest::Response, RemoteError> {
+    async fn get(
+        &self,
+        client: &Client,
+        url: &str,
+        timeout: Duration,
+    ) -> Result<reqwest::Response, RemoteError> {
         let response = client
             .get(url)
             .send()
@@ -142,8 +147,13 @@ impl Remote {
         })
     }
 
-    async fn get_json<T: for<'de> Deserialize<'de>>(&self, url: &str) -> Result<(T, Option<String>), RemoteError> {
-        let response = self.get(&self.metadata, url, self.settings.metadata_timeout).await?;
+    async fn get_json<T: for<'de> Deserialize<'de>>(
+        &self,
+        url: &str,
+    ) -> Result<(T, Option<String>), RemoteError> {
+        let response = self
+            .get(&self.metadata, url, self.settings.metadata_timeout)
+            .await?;
         let next = response
             .headers()
             .get(LINK)
@@ -186,7 +196,9 @@ impl Remote {
                     Some(lfs) => (lfs.oid, lfs.size),
                     None => (e.oid, e.size),
                 };
-                if !crate::cache::is_hash_name(&blob) || e.path.split('/').any(|p| p == ".." || p.is_empty()) {
+                if !crate::cache::is_hash_name(&blob)
+                    || e.path.split('/').any(|p| p == ".." || p.is_empty())
+                {
                     return Err(RemoteError::Bad(format!(
                         "{url}: file entry '{}' has no usable hash or path",
                         e.path
@@ -211,19 +223,33 @@ impl Remote {
 
     /// Downloads one file into `blobs/<hash>`, checking size, hash and ETag on the way;
     /// nothing that fails a check is left in `blobs/`.
-    pub async fn download(&self, cache: &RepoCache, commit: &str, entry: &Entry) -> Result<(), RemoteError> {
+    pub async fn download(
+        &self,
+        cache: &RepoCache,
+        commit: &str,
+        entry: &Entry,
+    ) -> Result<(), RemoteError> {
         let url = format!(
             "{}/datasets/{}/resolve/{commit}/{}",
             self.endpoint,
             self.repo_id,
-            entry.path.split('/').map(encode).collect::<Vec<_>>().join("/")
+            entry
+                .path
+                .split('/')
+                .map(encode)
+                .collect::<Vec<_>>()
+                .join("/")
         );
         let timeout = self.settings.download_timeout;
         let mut response = self.get(&self.download, &url, timeout).await?;
         // The server's own statement of the content's hash, when it gives one.
         let etag = ["x-linked-etag", "etag"].iter().find_map(|h| {
             let v = response.headers().get(*h)?.to_str().ok()?;
-            let v = v.trim().trim_start_matches("W/").trim_matches('"').to_ascii_lowercase();
+            let v = v
+                .trim()
+                .trim_start_matches("W/")
+                .trim_matches('"')
+                .to_ascii_lowercase();
             crate::cache::is_hash_name(&v).then_some(v)
         });
         if let Some(etag) = &etag {
@@ -236,7 +262,8 @@ impl Remote {
         }
         let blob = cache.blob_path(&entry.blob);
         let dir = blob.parent().expect("blobs/ folder");
-        std::fs::create_dir_all(dir).map_err(|e| RemoteError::Bad(format!("{}: {e}", dir.display())))?;
+        std::fs::create_dir_all(dir)
+            .map_err(|e| RemoteError::Bad(format!("{}: {e}", dir.display())))?;
         let tmp = dir.join(format!("{}.{}.incomplete", entry.blob, std::process::id()));
         let result = async {
             let mut file = std::fs::File::create(&tmp)
@@ -279,7 +306,12 @@ impl Remote {
 
     /// Downloads every entry whose blob is absent or does not match its name; links them
     /// all into the snapshot. Prints progress to stderr when there is much to fetch.
-    pub async fn download_all(&self, cache: &RepoCache, commit: &str, entries: &[Entry]) -> Result<usize, RemoteError> {
+    pub async fn download_all(
+        &self,
+        cache: &RepoCache,
+        commit: &str,
+        entries: &[Entry],
+    ) -> Result<usize, RemoteError> {
         let mut todo = Vec::new();
         let mut seen = std::collections::BTreeSet::new();
         for e in entries {
@@ -288,7 +320,8 @@ impl Remote {
                 continue;
             }
             let blob = cache.blob_path(&e.blob);
-            let good = blob.exists() && crate::cache::content_matches(&blob, &e.blob).unwrap_or(false);
+            let good =
+                blob.exists() && crate::cache::content_matches(&blob, &e.blob).unwrap_or(false);
             if !good {
                 if blob.exists() {
                     eprintln!(
@@ -302,8 +335,9 @@ impl Remote {
         }
         let total = todo.len();
         let mut done = 0usize;
-        let mut stream = futures_util::stream::iter(todo.iter().map(|e| self.download(cache, commit, e)))
-            .buffer_unordered(self.settings.concurrent_downloads.max(1));
+        let mut stream =
+            futures_util::stream::iter(todo.iter().map(|e| self.download(cache, commit, e)))
+                .buffer_unordered(self.settings.concurrent_downloads.max(1));
         // Every started download runs to its end (a failure removes its own temporary);
         // the first failure is reported.
         let mut first_error = None;
@@ -322,9 +356,9 @@ impl Remote {
             return Err(e);
         }
         for e in entries {
-            cache
-                .link(commit, e)
-                .map_err(|err| RemoteError::Bad(format!("cannot link {} in the cache: {err}", e.path)))?;
+            cache.link(commit, e).map_err(|err| {
+                RemoteError::Bad(format!("cannot link {} in the cache: {err}", e.path))
+            })?;
         }
         Ok(total)
     }
@@ -334,9 +368,12 @@ impl Remote {
 fn next_link(header: &str) -> Option<String> {
     header.split(',').find_map(|part| {
         let (url, params) = part.split_once(';')?;
-        params
-            .contains("rel=\"next\"")
-            .then(|| url.trim().trim_start_matches('<').trim_end_matches('>').to_string())
+        params.contains("rel=\"next\"").then(|| {
+            url.trim()
+                .trim_start_matches('<')
+                .trim_end_matches('>')
+                .to_string()
+        })
     })
 }
 
@@ -344,7 +381,9 @@ fn next_link(header: &str) -> Option<String> {
 fn encode(s: &str) -> String {
     s.bytes()
         .map(|b| match b {
-            b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'_' | b'.' | b'~' => (b as char).to_string(),
+            b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'_' | b'.' | b'~' => {
+                (b as char).to_string()
+            }
             _ => format!("%{b:02X}"),
         })
         .collect()

@@ -262,7 +262,8 @@ impl Client {
     /// from a hash of (request, attempt) so concurrent retries spread out. Timing only:
     /// nothing it decides reaches an output.
     fn backoff(&self, seed: &str, k: u32) -> Duration {
-        let cap = (self.cfg.backoff_base_s * 2f64.powi(k.min(30) as i32)).min(self.cfg.backoff_max_s);
+        let cap =
+            (self.cfg.backoff_base_s * 2f64.powi(k.min(30) as i32)).min(self.cfg.backoff_max_s);
         let h = Sha256::digest(format!("{seed}/{k}").as_bytes());
         let u = u64::from_le_bytes(h[..8].try_into().expect("8 bytes")) as f64 / u64::MAX as f64;
         Duration::from_secs_f64((cap * (0.5 + 0.5 * u)).max(0.0))
@@ -462,13 +463,22 @@ mod tests {
     fn parses_answers_refusals_and_failures() {
         let ok = br#"{"choices":[{"message":{"content":"hi"},"finish_reason":"stop"}],"usage":{"prompt_tokens":5,"completion_tokens":2}}"#;
         let r = parse_reply(ok).unwrap();
-        assert_eq!((r.text.as_str(), r.refusal, r.usage.prompt_tokens), ("hi", false, 5));
+        assert_eq!(
+            (r.text.as_str(), r.refusal, r.usage.prompt_tokens),
+            ("hi", false, 5)
+        );
         let refusal = br#"{"choices":[{"message":{"content":null,"refusal":"I can't help"}}]}"#;
         let r = parse_reply(refusal).unwrap();
         assert!(r.refusal);
         assert_eq!(r.text, "I can't help");
-        assert!(matches!(parse_reply(br#"{"choices":[]}"#), Err(LlmError::EmptyChoices)));
-        assert!(matches!(parse_reply(b"{not json"), Err(LlmError::Malformed(_))));
+        assert!(matches!(
+            parse_reply(br#"{"choices":[]}"#),
+            Err(LlmError::EmptyChoices)
+        ));
+        assert!(matches!(
+            parse_reply(b"{not json"),
+            Err(LlmError::Malformed(_))
+        ));
         let parts = br#"{"choices":[{"message":{"content":[{"type":"text","text":"a"},{"type":"text","text":"b"}]}}]}"#;
         assert_eq!(parse_reply(parts).unwrap().text, "ab");
     }
@@ -482,7 +492,13 @@ mod tests {
             cache::key("http://b/v1", "m", "h", &p, 0),
             cache::key("http://a/v1", "n", "h", &p, 0),
             cache::key("http://a/v1", "m", "g", &p, 0),
-            cache::key("http://a/v1", "m", "h", &serde_json::json!({"temperature": 1.0}), 0),
+            cache::key(
+                "http://a/v1",
+                "m",
+                "h",
+                &serde_json::json!({"temperature": 1.0}),
+                0,
+            ),
             cache::key("http://a/v1", "m", "h", &p, 1),
         ] {
             assert_ne!(base, other);

@@ -168,6 +168,10 @@ mod tests {
         drop(p);
         let t = Instant::now();
         let _q = l.acquire().await;
-        assert!(t.elapsed() >= Duration::from_millis(140), "{:?}", t.elapsed());
+        assert!(
+            t.elapsed() >= Duration::from_millis(140),
+            "{:?}",
+            t.elapsed()
+        );
     }
 }

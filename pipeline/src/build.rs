@@ -23,9 +23,9 @@ use crate::config::Config;
 use crate::dataset;
 use crate::families;
 use crate::integrity::{self, FileSums};
-pub use crate::records::{record_path, WORK_DIR};
-use crate::records::{group_files, load_record, reopen_if_damaged};
 use crate::manifest::{Manifest, MANIFEST_FILE};
+use crate::records::{group_files, load_record, reopen_if_damaged};
+pub use crate::records::{record_path, WORK_DIR};
 use crate::scene::{run_group, GroupError, RenderStage};
 use arrow::array::RecordBatch;
 use rayon::prelude::*;
@@ -497,12 +497,20 @@ pub fn build(
         todo.par_iter()
             .try_for_each(|&g| -> Result<(), BuildError> {
                 let count = manifest.group_size(g);
-                let results =
-                    run_group(catalog, &opts.families, opts.selections.as_deref(), opts.seed, g, count, config, render)
-                        .map_err(|e| match e {
-                            GroupError::Input(m) => BuildError::Input(m),
-                            GroupError::Render(m) => BuildError::Internal(m),
-                        })?;
+                let results = run_group(
+                    catalog,
+                    &opts.families,
+                    opts.selections.as_deref(),
+                    opts.seed,
+                    g,
+                    count,
+                    config,
+                    render,
+                )
+                .map_err(|e| match e {
+                    GroupError::Input(m) => BuildError::Input(m),
+                    GroupError::Render(m) => BuildError::Internal(m),
+                })?;
                 // Specs, then the checksums of every file the rows name, and the record
                 // last: its presence says the group (specs, media, sums) is done.
                 let files = group_files(out, g, &results, catalog).map_err(BuildError::Internal)?;
@@ -606,7 +614,10 @@ pub fn finalize(
     });
     let path = out.join("README.md");
     dataset::write_atomic(&path, readme.as_bytes()).map_err(|e| internal(&path, e))?;
-    sums.insert("README.md".to_string(), integrity::sha256_bytes(readme.as_bytes()));
+    sums.insert(
+        "README.md".to_string(),
+        integrity::sha256_bytes(readme.as_bytes()),
+    );
     let finished = Manifest {
         files: Some(sums),
         ..manifest.clone()

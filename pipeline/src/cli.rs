@@ -187,14 +187,16 @@ fn llm_planner<'a>(
         .ok_or_else(|| input("the LLM planner needs --model ID"))?;
     let cfg = crate::llm_plan::PlannerConfig::embedded();
     let mut client = cfg.client.clone();
-    if let Some(u) = args
-        .base_url
-        .clone()
-        .or_else(|| std::env::var("OPENAI_BASE_URL").ok().filter(|s| !s.is_empty()))
-    {
+    if let Some(u) = args.base_url.clone().or_else(|| {
+        std::env::var("OPENAI_BASE_URL")
+            .ok()
+            .filter(|s| !s.is_empty())
+    }) {
         client.base_url = u;
     }
-    client.api_key = std::env::var(&args.api_key_env).ok().filter(|k| !k.is_empty());
+    client.api_key = std::env::var(&args.api_key_env)
+        .ok()
+        .filter(|k| !k.is_empty());
     let cache = (!args.no_cache).then(|| rh_llm::cache::Cache::new(rh_llm::cache::default_dir()));
     crate::llm_plan::LlmPlanner::new(catalog, client, cache, model, cfg).map_err(|m| Failure {
         code: 1,
@@ -204,8 +206,12 @@ fn llm_planner<'a>(
 
 /// Reads a descriptions file: one a line; blank lines and `#` comments skipped.
 fn read_descriptions(path: &std::path::Path) -> Result<Vec<String>, Failure> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| input(format!("cannot read --descriptions {}: {e}", path.display())))?;
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        input(format!(
+            "cannot read --descriptions {}: {e}",
+            path.display()
+        ))
+    })?;
     let lines: Vec<String> = text
         .lines()
         .map(str::trim)
@@ -458,11 +464,10 @@ fn download(repo: &str, revision: Option<&str>, out: Option<&Path>) -> Result<()
     }
     let path = match out {
         Some(dir) => {
-            let files =
-                rh_hub::copy_snapshot(&snapshot.path, dir).map_err(|e| Failure {
-                    code: 1,
-                    message: format!("cannot copy {repo} into {}: {e}", dir.display()),
-                })?;
+            let files = rh_hub::copy_snapshot(&snapshot.path, dir).map_err(|e| Failure {
+                code: 1,
+                message: format!("cannot copy {repo} into {}: {e}", dir.display()),
+            })?;
             eprintln!("copied {files} files into {}", dir.display());
             dir.to_path_buf()
         }
@@ -560,12 +565,9 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                 Some(path) => {
                     let texts = read_descriptions(path)?;
                     let sel = match planner {
-                        PlannerKind::Lexicon => plan_descriptions(
-                            &LexiconPlanner::new(&catalog),
-                            &texts,
-                            path,
-                            seed,
-                        )?,
+                        PlannerKind::Lexicon => {
+                            plan_descriptions(&LexiconPlanner::new(&catalog), &texts, path, seed)?
+                        }
                         PlannerKind::Llm => {
                             plan_descriptions(&llm_planner(&catalog, &llm)?, &texts, path, seed)?
                         }

@@ -399,11 +399,17 @@ mod tests {
         // The exact line: a value at the start of a line and one after a blank line.
         for (text, line) in [
             ("labels = \"l.toml\"\n[build]\nseed = \"zero\"\n", 3),
-            ("labels = \"l.toml\"\n\n[build]\nseed = 0\nfamilies = 7\n", 5),
+            (
+                "labels = \"l.toml\"\n\n[build]\nseed = 0\nfamilies = 7\n",
+                5,
+            ),
             ("labels = 3\n", 1),
         ] {
             let err = parse::<RawConfig>("x.toml", text).unwrap_err().to_string();
-            assert!(err.starts_with(&format!("x.toml:{line}:")), "{text:?}: {err}");
+            assert!(
+                err.starts_with(&format!("x.toml:{line}:")),
+                "{text:?}: {err}"
+            );
         }
     }
 

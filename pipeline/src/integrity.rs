@@ -180,6 +180,9 @@ mod tests {
         assert_eq!(problems.len(), 2);
         assert!(problems[0].problem.starts_with("altered"));
         assert_eq!(problems[1].problem, "missing");
-        assert_eq!(unlisted(dir.path(), &sums), vec!["specs/c.json".to_string()]);
+        assert_eq!(
+            unlisted(dir.path(), &sums),
+            vec!["specs/c.json".to_string()]
+        );
     }
 }

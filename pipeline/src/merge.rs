@@ -332,12 +332,18 @@ fn remove_stale_staging(parent: &Path, out_name: &str) {
     };
     for e in entries.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
-        let Some(pid) = name.strip_prefix(&prefix).and_then(|p| p.parse::<u32>().ok()) else {
+        let Some(pid) = name
+            .strip_prefix(&prefix)
+            .and_then(|p| p.parse::<u32>().ok())
+        else {
             continue;
         };
         let alive = pid != std::process::id() && Path::new(&format!("/proc/{pid}")).exists();
         if !alive {
-            eprintln!("removing {} (left by a merge that was stopped)", e.path().display());
+            eprintln!(
+                "removing {} (left by a merge that was stopped)",
+                e.path().display()
+            );
             let _ = std::fs::remove_dir_all(e.path());
         }
     }

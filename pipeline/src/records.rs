@@ -129,7 +129,8 @@ pub fn reopen_if_damaged(
         None
     };
     if let Some(rows) = rows {
-        let bad: std::collections::BTreeSet<&str> = problems.iter().map(|p| p.file.as_str()).collect();
+        let bad: std::collections::BTreeSet<&str> =
+            problems.iter().map(|p| p.file.as_str()).collect();
         let index = dataset::u64_column(&rows, "scene_index");
         for g in manifest.groups() {
             let picks: Vec<u32> = (0..rows.num_rows() as u32)
@@ -137,15 +138,19 @@ pub fn reopen_if_damaged(
                 .collect();
             let batch = dataset::take_rows(&rows, &picks);
             let files = dataset::referenced_files(&batch);
-            if picks.is_empty() || files.iter().any(|f| bad.contains(f.as_str()) || !sums.contains_key(f)) {
+            if picks.is_empty()
+                || files
+                    .iter()
+                    .any(|f| bad.contains(f.as_str()) || !sums.contains_key(f))
+            {
                 continue;
             }
             let group_sums: FileSums = files.iter().map(|f| (f.clone(), sums[f].clone())).collect();
             let record = record_path(out, g);
             integrity::write_group_sums(&record, &group_sums).map_err(|e| internal(&record, e))?;
-            dataset::write_atomic(&record, &dataset::parquet_bytes(&batch)).map_err(|e| internal(&record, e))?;
+            dataset::write_atomic(&record, &dataset::parquet_bytes(&batch))
+                .map_err(|e| internal(&record, e))?;
         }
     }
     Ok(problems)
 }
-

@@ -170,7 +170,10 @@ pub fn verify(dir: &Path, catalog: &Catalog) -> Result<VerifyReport, String> {
                 }
                 _ => None,
             };
-            Ok((results.len(), check_group(dir, &mut results, stored.as_ref(), catalog)))
+            Ok((
+                results.len(),
+                check_group(dir, &mut results, stored.as_ref(), catalog),
+            ))
         })
         .collect();
     let mut scenes = 0;
@@ -228,10 +231,16 @@ fn check_group(
     };
     let ids = dataset::string_column(stored, "scene_id");
     if ids.len() != results.len()
-        || ids.iter().zip(results.iter()).any(|(a, r)| *a != r.spec.scene_id)
+        || ids
+            .iter()
+            .zip(results.iter())
+            .any(|(a, r)| *a != r.spec.scene_id)
     {
         out.push(Mismatch {
-            scene_id: results.first().map(|r| r.spec.scene_id.clone()).unwrap_or_default(),
+            scene_id: results
+                .first()
+                .map(|r| r.spec.scene_id.clone())
+                .unwrap_or_default(),
             problem: format!(
                 "the data rows of this group name scenes {ids:?}, not the ones the build derives"
             ),
@@ -303,7 +312,11 @@ fn json_difference(stored: &str, derived: &str) -> String {
         match (a, b) {
             (Object(x), Object(y)) => {
                 for (k, v) in y {
-                    let p = if path.is_empty() { k.clone() } else { format!("{path}.{k}") };
+                    let p = if path.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{path}.{k}")
+                    };
                     match x.get(k) {
                         Some(w) => {
                             if let Some(d) = walk(w, v, p) {
@@ -326,9 +339,17 @@ fn json_difference(stored: &str, derived: &str) -> String {
             _ => {
                 let short = |v: &serde_json::Value| {
                     let s = v.to_string();
-                    if s.len() > 60 { format!("{}…", &s[..60]) } else { s }
+                    if s.len() > 60 {
+                        format!("{}…", &s[..60])
+                    } else {
+                        s
+                    }
                 };
-                Some(format!("`{path}`: stored {}, derived {}", short(a), short(b)))
+                Some(format!(
+                    "`{path}`: stored {}, derived {}",
+                    short(a),
+                    short(b)
+                ))
             }
         }
     }
@@ -344,7 +365,8 @@ mod tests {
 
     #[test]
     fn json_differences_name_the_field() {
-        let a = r#"{"selection": {"object_id": "mug", "room": "k"}, "labels": {"reach_radius": 1.2}}"#;
+        let a =
+            r#"{"selection": {"object_id": "mug", "room": "k"}, "labels": {"reach_radius": 1.2}}"#;
         let b = r#"{"selection": {"object_id": "knife", "room": "k"}, "labels": {"reach_radius": 1.2}}"#;
         assert_eq!(
             json_difference(a, b),

@@ -35,8 +35,8 @@ fn pinned_specs_replay_to_their_pinned_state_hashes() {
     let mut actual: BTreeMap<String, Pin> = BTreeMap::new();
     for family in rh_catalog::FAMILIES {
         let path = dir.join("specs").join(format!("{family}.json"));
-        let text = std::fs::read_to_string(&path)
-            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let text =
+            std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let spec = SceneSpec::from_json(&text)
             .unwrap_or_else(|e| panic!("{}: not a spec of this schema: {e}", path.display()));
         assert_eq!(spec.family, *family, "{}", path.display());
@@ -51,7 +51,11 @@ fn pinned_specs_replay_to_their_pinned_state_hashes() {
     }
     let hashes = dir.join("hashes.json");
     if std::env::var_os("RH_UPDATE_PINNED").is_some() {
-        std::fs::write(&hashes, serde_json::to_string_pretty(&actual).unwrap() + "\n").unwrap();
+        std::fs::write(
+            &hashes,
+            serde_json::to_string_pretty(&actual).unwrap() + "\n",
+        )
+        .unwrap();
         return;
     }
     let expected: BTreeMap<String, Pin> =
@@ -83,6 +87,10 @@ fn regenerate_pinned_specs() {
         let selection = plan_group(&catalog, &families, 2026, g as u64).unwrap();
         let results = produce_group(&selection, 2026, g as u64 * 4, 1, &catalog, &config).unwrap();
         assert_eq!(&results[0].spec.family, family);
-        std::fs::write(dir.join(format!("{family}.json")), results[0].spec.to_json()).unwrap();
+        std::fs::write(
+            dir.join(format!("{family}.json")),
+            results[0].spec.to_json(),
+        )
+        .unwrap();
     }
 }

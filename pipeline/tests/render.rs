@@ -403,7 +403,10 @@ fn cached_static_frames_equal_whole_scene_frames_in_every_family() {
             .map(|k| {
                 let g = fi as u64 + 17 * k;
                 let selection = plan_group(&catalog, std::slice::from_ref(family), 23, g).unwrap();
-                produce_group(&selection, 23, g * 4, 1, &catalog, &config).unwrap().remove(0).spec
+                produce_group(&selection, 23, g * 4, 1, &catalog, &config)
+                    .unwrap()
+                    .remove(0)
+                    .spec
             })
             .find(|spec| !spec.cameras.is_empty())
             .unwrap_or_else(|| panic!("{family}: no framed scene in five groups"));
@@ -443,11 +446,17 @@ fn cached_static_frames_equal_whole_scene_frames_in_every_family() {
 #[test]
 fn default_720p_video_probes_as_stated() {
     let config = Config::embedded().unwrap();
-    assert_eq!((config.render.width, config.render.height, config.render.fps), (1280, 720, 60));
+    assert_eq!(
+        (config.render.width, config.render.height, config.render.fps),
+        (1280, 720, 60)
+    );
     let catalog = Catalog::embedded().unwrap();
     let families = vec!["object_drop".to_string()];
     let selection = plan_group(&catalog, &families, 5, 0).unwrap();
-    let spec = produce_group(&selection, 5, 0, 1, &catalog, &config).unwrap().remove(0).spec;
+    let spec = produce_group(&selection, 5, 0, 1, &catalog, &config)
+        .unwrap()
+        .remove(0)
+        .spec;
     assert!(!spec.cameras.is_empty());
     let sim = simulate(&spec, SimOptions::default());
     let mut r = Renderer::new(RenderOptions::from_config(&config.render)).unwrap();
@@ -458,12 +467,19 @@ fn default_720p_video_probes_as_stated() {
         let v = ffprobe(&dir.join(rendered.video(cam).unwrap()));
         assert_eq!(v["codec_name"], "h264", "{cam}");
         assert_eq!(v["pix_fmt"], "yuv420p", "{cam}");
-        assert_eq!((v["width"].as_u64(), v["height"].as_u64()), (Some(1280), Some(720)), "{cam}");
+        assert_eq!(
+            (v["width"].as_u64(), v["height"].as_u64()),
+            (Some(1280), Some(720)),
+            "{cam}"
+        );
         assert_eq!(v["r_frame_rate"], "60/1", "{cam}");
         assert_eq!(v["nb_read_frames"].as_str(), Some("37"), "{cam}");
     }
     let full = ffprobe(&dir.join(&rendered.full_event));
-    assert_eq!((full["width"].as_u64(), full["height"].as_u64()), (Some(640), Some(360)));
+    assert_eq!(
+        (full["width"].as_u64(), full["height"].as_u64()),
+        (Some(640), Some(360))
+    );
     let png = image::open(dir.join(&rendered.frames[0])).unwrap();
     assert_eq!((png.width(), png.height()), (1280, 720));
 }

@@ -47,7 +47,14 @@ fn start_server(delay: f64) -> Server {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/llm_server.py");
     let mut child = Command::new("python3")
         .arg(script)
-        .args(["--delay", &delay.to_string(), "--then", "bare", "--lifetime", "900"])
+        .args([
+            "--delay",
+            &delay.to_string(),
+            "--then",
+            "bare",
+            "--lifetime",
+            "900",
+        ])
         .stdout(Stdio::piped())
         .spawn()
         .expect("python3");

@@ -210,7 +210,11 @@ impl AiaMatcher {
             window: cfg.negation_window,
             material: PhraseSet::new(&cfg.material_doubt),
             coordinators: cfg.coordinators.iter().map(|w| normalize(w)).collect(),
-            fillers: cfg.coordination_fillers.iter().map(|w| normalize(w)).collect(),
+            fillers: cfg
+                .coordination_fillers
+                .iter()
+                .map(|w| normalize(w))
+                .collect(),
         }
     }
 
@@ -406,11 +410,23 @@ mod tests {
         // A negation covers the whole coordinated phrase.
         assert_eq!(mentions("don't catch or dodge"), [false, false, false]);
         assert_eq!(mentions("neither catch nor dodge"), [false, false, false]);
-        assert_eq!(mentions("do not grab it or step back"), [false, false, false]);
-        assert_eq!(mentions("never catch, dodge or sidestep"), [false, true, false]);
-        assert_eq!(mentions("don't catch or dodge, just stay put"), [false, false, true]);
+        assert_eq!(
+            mentions("do not grab it or step back"),
+            [false, false, false]
+        );
+        assert_eq!(
+            mentions("never catch, dodge or sidestep"),
+            [false, true, false]
+        );
+        assert_eq!(
+            mentions("don't catch or dodge, just stay put"),
+            [false, false, true]
+        );
         // Not coordinated: other words between, or "and then" (a new action).
-        assert_eq!(mentions("don't catch it and then dodge"), [false, true, false]);
+        assert_eq!(
+            mentions("don't catch it and then dodge"),
+            [false, true, false]
+        );
         // Phrases containing a cue word keep their meaning.
         assert_eq!(mentions("do not move"), [false, false, true]);
         assert_eq!(
@@ -428,7 +444,10 @@ mod tests {
         assert_eq!(m.score("do not catch, dodge", Action::Dodge), 1.0);
         assert_eq!(m.score("do not catch, dodge", Action::Catch), 0.0);
         assert_eq!(m.score("don't catch or dodge", Action::Dodge), 0.0);
-        assert_eq!(m.score("neither catch nor dodge; stay put", Action::NoAction), 1.0);
+        assert_eq!(
+            m.score("neither catch nor dodge; stay put", Action::NoAction),
+            1.0
+        );
         assert_eq!(m.score("", Action::NoAction), 0.0);
     }
 

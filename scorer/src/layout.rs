@@ -19,7 +19,10 @@ pub fn paper_scene_folders(dir: &Path) -> usize {
     let mut n = 0;
     for fam in families.flatten() {
         let fam_path = fam.path();
-        let Some(fam_name) = fam_path.file_name().and_then(|s| s.to_str()).map(str::to_string)
+        let Some(fam_name) = fam_path
+            .file_name()
+            .and_then(|s| s.to_str())
+            .map(str::to_string)
         else {
             continue;
         };
@@ -89,10 +92,16 @@ mod tests {
         std::fs::create_dir_all(&s).unwrap();
         std::fs::write(s.join("metadata.json"), "{}").unwrap();
         let m = missing_parquet_message(d.path());
-        assert!(m.contains("metadata-only") && m.contains("1 scene folders"), "{m}");
+        assert!(
+            m.contains("metadata-only") && m.contains("1 scene folders"),
+            "{m}"
+        );
         let e = tempfile::tempdir().unwrap();
         std::fs::write(e.path().join("notes.txt"), "x").unwrap();
         let m = missing_parquet_message(e.path());
-        assert!(m.contains("found: notes.txt") && m.contains("data/*.parquet"), "{m}");
+        assert!(
+            m.contains("found: notes.txt") && m.contains("data/*.parquet"),
+            "{m}"
+        );
     }
 }

@@ -871,13 +871,19 @@ mod tests {
         let start = std::time::Instant::now();
         let text = "{".repeat(200_000) + &"}".repeat(10);
         let r = plan_from_text(&text, &cfg());
-        assert!(matches!(r, Err(PlanError::NoJson) | Err(PlanError::TooLarge(_))), "{r:?}");
+        assert!(
+            matches!(r, Err(PlanError::NoJson) | Err(PlanError::TooLarge(_))),
+            "{r:?}"
+        );
         let text = "```".repeat(10_000);
         assert_eq!(plan_from_text(&text, &cfg()), Err(PlanError::NoJson));
         // Deep but balanced nesting: R1 for its depth, never a stack overflow.
         let text = "[".repeat(100_000) + &"]".repeat(100_000);
         let text = format!("{{\"walking_cmd\": [0,0,0], \"keyframes\": {text}}}");
-        assert!(matches!(plan_from_text(&text, &cfg()), Err(PlanError::TooLarge(_))));
+        assert!(matches!(
+            plan_from_text(&text, &cfg()),
+            Err(PlanError::TooLarge(_))
+        ));
         assert!(start.elapsed().as_secs() < 20, "took {:?}", start.elapsed());
     }
 
@@ -887,16 +893,35 @@ mod tests {
         let many: Vec<String> = (0..cfg.sanity.max_keyframes + 1)
             .map(|i| format!("{{\"t\": {}, \"pos\": [0.3, 0, 0.1]}}", i as f64 * 0.01))
             .collect();
-        let text = format!("{{\"walking_cmd\": [0,0,0], \"keyframes\": [{}]}}", many.join(","));
+        let text = format!(
+            "{{\"walking_cmd\": [0,0,0], \"keyframes\": [{}]}}",
+            many.join(",")
+        );
         match plan_from_json_str(&text, &cfg) {
             Some(Err(PlanError::TooLarge(why))) => assert!(why.contains("max_keyframes"), "{why}"),
             other => panic!("{other:?}"),
         }
         // Exactly at the cap: parsed.
-        let ok: Vec<String> = (0..cfg.sanity.max_keyframes).map(|_| "[0.3, 0, 0.1]".to_string()).collect();
-        let text = format!("{{\"walking_cmd\": [0,0,0], \"keyframes\": [{}]}}", ok.join(","));
-        assert_eq!(plan_from_json_str(&text, &cfg).unwrap().unwrap().keyframes.len(), cfg.sanity.max_keyframes);
-        let deep = format!("{{\"walking_cmd\": [0,0,0], \"x\": {}1{}}}", "[".repeat(40), "]".repeat(40));
+        let ok: Vec<String> = (0..cfg.sanity.max_keyframes)
+            .map(|_| "[0.3, 0, 0.1]".to_string())
+            .collect();
+        let text = format!(
+            "{{\"walking_cmd\": [0,0,0], \"keyframes\": [{}]}}",
+            ok.join(",")
+        );
+        assert_eq!(
+            plan_from_json_str(&text, &cfg)
+                .unwrap()
+                .unwrap()
+                .keyframes
+                .len(),
+            cfg.sanity.max_keyframes
+        );
+        let deep = format!(
+            "{{\"walking_cmd\": [0,0,0], \"x\": {}1{}}}",
+            "[".repeat(40),
+            "]".repeat(40)
+        );
         match plan_from_json_str(&deep, &cfg) {
             Some(Err(PlanError::TooLarge(why))) => assert!(why.contains("max_nesting"), "{why}"),
             other => panic!("{other:?}"),
@@ -909,7 +934,10 @@ mod tests {
         let cfg = cfg();
         // 200 bare keyframes without walking: (i+1) * 0.25 s would reach 50 s.
         let pts: Vec<String> = (0..200).map(|_| "[0.3, 0, 0.1]".to_string()).collect();
-        let text = format!("{{\"walking_cmd\": [0,0,0], \"walking_duration\": 0, \"keyframes\": [{}]}}", pts.join(","));
+        let text = format!(
+            "{{\"walking_cmd\": [0,0,0], \"walking_duration\": 0, \"keyframes\": [{}]}}",
+            pts.join(",")
+        );
         let p = plan_from_json_str(&text, &cfg).unwrap().unwrap();
         let last = p.keyframes.last().unwrap().t;
         assert!(last <= cfg.sanity.max_duration && last > 29.0, "{last}");

@@ -283,7 +283,11 @@ fn model_report(m: &ModelAgg, ds: &Dataset) -> ModelReport {
         prompt_version: if m.prompt_versions.is_empty() {
             "-".to_string()
         } else {
-            m.prompt_versions.iter().cloned().collect::<Vec<_>>().join("+")
+            m.prompt_versions
+                .iter()
+                .cloned()
+                .collect::<Vec<_>>()
+                .join("+")
         },
         lost: m.lost,
         duplicates: m.duplicates,

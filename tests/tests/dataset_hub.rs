@@ -42,7 +42,9 @@ fn git_sha1(bytes: &[u8]) -> String {
 
 /// Files the stand-in stores in LFS (as the real dataset's `.gitattributes` does).
 fn is_lfs(path: &str) -> bool {
-    [".parquet", ".mp4", ".png"].iter().any(|e| path.ends_with(e))
+    [".parquet", ".mp4", ".png"]
+        .iter()
+        .any(|e| path.ends_with(e))
 }
 
 /// What the stand-in Hub does with a connection.
@@ -289,10 +291,18 @@ fn hub_run_token(
     hf_home: &Path,
     token: Option<&str>,
 ) -> Output {
-    hub_cmd(name, args, endpoint, hf_home, token).output().unwrap()
+    hub_cmd(name, args, endpoint, hf_home, token)
+        .output()
+        .unwrap()
 }
 
-fn hub_cmd(name: &str, args: &[&str], endpoint: &str, hf_home: &Path, token: Option<&str>) -> Command {
+fn hub_cmd(
+    name: &str,
+    args: &[&str],
+    endpoint: &str,
+    hf_home: &Path,
+    token: Option<&str>,
+) -> Command {
     let mut cmd = Command::new(bin(name));
     if let Some(t) = token {
         cmd.env("HF_TOKEN", t);
@@ -468,8 +478,17 @@ fn small_dataset(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     run_ok(
         "rh-pipeline",
         &[
-            "build", "--n", "4", "--seed", "5", "--no-render", "--quiet",
-            "--families", "object_drop", "--out", dir.to_str().unwrap(),
+            "build",
+            "--n",
+            "4",
+            "--seed",
+            "5",
+            "--no-render",
+            "--quiet",
+            "--families",
+            "object_drop",
+            "--out",
+            dir.to_str().unwrap(),
         ],
     );
     files_under(dir)
@@ -500,24 +519,41 @@ fn hung_hub_times_out_to_the_cache_or_a_clear_error() {
     // Nothing cached: a clear error within the timeout, naming the timeout's variables.
     let empty_home = tmp.path().join("empty-home");
     let (code, err, _, secs) = timed(hub_cmd(
-        "rh-pipeline", &["download", REPO], &hung.endpoint, &empty_home, Some(TOKEN),
+        "rh-pipeline",
+        &["download", REPO],
+        &hung.endpoint,
+        &empty_home,
+        Some(TOKEN),
     ));
     assert_eq!(code, Some(1), "{err}");
-    assert!(err.contains("no answer within 1 s") && err.contains("HF_HUB_ETAG_TIMEOUT"), "{err}");
+    assert!(
+        err.contains("no answer within 1 s") && err.contains("HF_HUB_ETAG_TIMEOUT"),
+        "{err}"
+    );
     assert!(err.contains("holds no copy"), "{err}");
     assert!(secs < 20.0, "took {secs} s");
 
     // A complete cached copy: used, exit 0, for both programs.
     let home = tmp.path().join("home");
     let mut good = Hub::serve(files.clone());
-    let snapshot = ok(&hub_run("rh-pipeline", &["download", REPO], &good.endpoint, &home), "download");
+    let snapshot = ok(
+        &hub_run("rh-pipeline", &["download", REPO], &good.endpoint, &home),
+        "download",
+    );
     good.shutdown();
     let (code, err, out, secs) = timed(hub_cmd(
-        "rh-pipeline", &["download", REPO], &hung.endpoint, &home, Some(TOKEN),
+        "rh-pipeline",
+        &["download", REPO],
+        &hung.endpoint,
+        &home,
+        Some(TOKEN),
     ));
     assert_eq!(code, Some(0), "{err}");
     assert_eq!(out.trim(), snapshot.trim());
-    assert!(err.contains("comes from the Hugging Face cache") && err.contains("no answer"), "{err}");
+    assert!(
+        err.contains("comes from the Hugging Face cache") && err.contains("no answer"),
+        "{err}"
+    );
     assert!(secs < 20.0, "took {secs} s");
     let (code, err, _, _) = timed(hub_cmd(
         "rh-score",
@@ -530,14 +566,28 @@ fn hung_hub_times_out_to_the_cache_or_a_clear_error() {
 
     // A partial cache (one file gone), offline: exit 2 naming the missing file.
     let snap = PathBuf::from(snapshot.trim());
-    let victim = files.keys().find(|k| k.starts_with("specs/")).unwrap().clone();
+    let victim = files
+        .keys()
+        .find(|k| k.starts_with("specs/"))
+        .unwrap()
+        .clone();
     std::fs::remove_file(snap.join(&victim)).unwrap();
     let (code, err, _, _) = timed(hub_cmd(
-        "rh-pipeline", &["download", REPO], &hung.endpoint, &home, Some(TOKEN),
+        "rh-pipeline",
+        &["download", REPO],
+        &hung.endpoint,
+        &home,
+        Some(TOKEN),
     ));
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains(&victim) && err.contains("missing"), "{err}");
-    let mut offline = hub_cmd("rh-pipeline", &["download", REPO], &hung.endpoint, &home, Some(TOKEN));
+    let mut offline = hub_cmd(
+        "rh-pipeline",
+        &["download", REPO],
+        &hung.endpoint,
+        &home,
+        Some(TOKEN),
+    );
     offline.env("HF_HUB_OFFLINE", "1");
     let (code, err, _, _) = timed(offline);
     assert_eq!(code, Some(2), "{err}");
@@ -548,8 +598,16 @@ fn hung_hub_times_out_to_the_cache_or_a_clear_error() {
 fn corrupt_bodies_never_enter_the_cache_and_bad_blobs_are_refetched() {
     let tmp = tempfile::tempdir().unwrap();
     let files = small_dataset(&tmp.path().join("built"));
-    let data = files.keys().find(|k| k.ends_with(".parquet") && k.starts_with("data/")).unwrap().clone();
-    let spec = files.keys().find(|k| k.starts_with("specs/")).unwrap().clone();
+    let data = files
+        .keys()
+        .find(|k| k.ends_with(".parquet") && k.starts_with("data/"))
+        .unwrap()
+        .clone();
+    let spec = files
+        .keys()
+        .find(|k| k.starts_with("specs/"))
+        .unwrap()
+        .clone();
     let home = tmp.path().join("home");
 
     // An LFS file (hash: SHA-256) and a plain one (git blob SHA-1) served altered.
@@ -559,38 +617,76 @@ fn corrupt_bodies_never_enter_the_cache_and_bad_blobs_are_refetched() {
         let fresh = tmp.path().join(format!("fresh-{i}"));
         let blobs = fresh.join("hub/datasets--rh-test--tiny/blobs");
         let (code, err, _, _) = timed(hub_cmd(
-            "rh-pipeline", &["download", REPO], &bad.endpoint, &fresh, Some(TOKEN),
+            "rh-pipeline",
+            &["download", REPO],
+            &bad.endpoint,
+            &fresh,
+            Some(TOKEN),
         ));
         assert_eq!(code, Some(1), "{victim}: {err}");
-        assert!(err.contains(victim.as_str()) && err.contains("corrupt"), "{err}");
+        assert!(
+            err.contains(victim.as_str()) && err.contains("corrupt"),
+            "{err}"
+        );
         // Every blob in the store matches its name; no temporary is left.
         for entry in std::fs::read_dir(&blobs).unwrap() {
             let path = entry.unwrap().path();
             let name = path.file_name().unwrap().to_string_lossy().to_string();
             let bytes = std::fs::read(&path).unwrap();
-            let real = if name.len() == 64 { sha256_hex(&bytes) } else { git_sha1(&bytes) };
+            let real = if name.len() == 64 {
+                sha256_hex(&bytes)
+            } else {
+                git_sha1(&bytes)
+            };
             assert_eq!(real, name, "blob {name} does not match its content");
         }
     }
 
     // Download whole, then damage one blob in the store.
     let mut good = Hub::serve(files.clone());
-    let snapshot = PathBuf::from(ok(&hub_run("rh-pipeline", &["download", REPO], &good.endpoint, &home), "download").trim());
+    let snapshot = PathBuf::from(
+        ok(
+            &hub_run("rh-pipeline", &["download", REPO], &good.endpoint, &home),
+            "download",
+        )
+        .trim(),
+    );
     let blob = std::fs::canonicalize(snapshot.join(&data)).unwrap();
     let mut bytes = std::fs::read(&blob).unwrap();
     let mid = bytes.len() / 2;
     bytes[mid] ^= 1;
     std::fs::write(&blob, &bytes).unwrap();
     // Offline: reported (exit 2, naming it), not returned.
-    let mut offline = hub_cmd("rh-pipeline", &["download", REPO], &good.endpoint, &home, Some(TOKEN));
+    let mut offline = hub_cmd(
+        "rh-pipeline",
+        &["download", REPO],
+        &good.endpoint,
+        &home,
+        Some(TOKEN),
+    );
     offline.env("HF_HUB_OFFLINE", "1");
     let (code, err, _, _) = timed(offline);
     assert_eq!(code, Some(2), "{err}");
-    assert!(err.contains(&data) && err.contains("does not match"), "{err}");
+    assert!(
+        err.contains(&data) && err.contains("does not match"),
+        "{err}"
+    );
     // Online: fetched again, and the snapshot equals the served dataset.
-    let (code, err, _, _) = timed(hub_cmd("rh-pipeline", &["download", REPO], &good.endpoint, &home, Some(TOKEN)));
+    let (code, err, _, _) = timed(hub_cmd(
+        "rh-pipeline",
+        &["download", REPO],
+        &good.endpoint,
+        &home,
+        Some(TOKEN),
+    ));
     assert_eq!(code, Some(0), "{err}");
-    assert!(err.contains("does not match its hash; fetching it again"), "{err}");
-    assert!(files_under(&snapshot) == files, "snapshot differs after the re-fetch");
+    assert!(
+        err.contains("does not match its hash; fetching it again"),
+        "{err}"
+    );
+    assert!(
+        files_under(&snapshot) == files,
+        "snapshot differs after the re-fetch"
+    );
     good.shutdown();
 }

@@ -14,7 +14,17 @@ const FAMILIES: &str = "object_drop,rolling_ball";
 
 fn build_args<'a>(out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     let mut a = vec![
-        "build", "--n", "8", "--seed", "11", "--no-render", "--quiet", "--families", FAMILIES, "--out", out,
+        "build",
+        "--n",
+        "8",
+        "--seed",
+        "11",
+        "--no-render",
+        "--quiet",
+        "--families",
+        FAMILIES,
+        "--out",
+        out,
     ];
     a.extend_from_slice(extra);
     a
@@ -67,7 +77,8 @@ fn first_spec(dir: &Path) -> PathBuf {
 
 /// Rewrites a spec with one field changed, in the build's own formatting.
 fn edit_spec(path: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
-    let mut spec: serde_json::Value = serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap();
+    let mut spec: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap();
     edit(&mut spec);
     fs::write(path, serde_json::to_string_pretty(&spec).unwrap() + "\n").unwrap();
 }
@@ -86,12 +97,18 @@ fn a_clean_build_verifies_and_records_every_file() {
             continue;
         }
         use sha2::Digest;
-        let sha: String = sha2::Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect();
+        let sha: String = sha2::Sha256::digest(bytes)
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
         assert_eq!(files[name].as_str(), Some(sha.as_str()), "{name}");
     }
     let (code, stdout, stderr) = verify(reference, false);
     assert_eq!(code, Some(0), "{stdout}{stderr}");
-    assert!(stdout.contains("0 problem(s); 8 scenes derived again: 8 match, 0 differ"), "{stdout}");
+    assert!(
+        stdout.contains("0 problem(s); 8 scenes derived again: 8 match, 0 differ"),
+        "{stdout}"
+    );
 }
 
 #[test]
@@ -105,7 +122,10 @@ fn verify_catches_a_flipped_byte_in_the_data_parquet() {
     fs::write(&data, bytes).unwrap();
     let (code, stdout, stderr) = verify(&dir, false);
     assert_eq!(code, Some(2), "{stdout}{stderr}");
-    assert!(stdout.contains("FILE data/test-00000-of-00001.parquet: altered"), "{stdout}");
+    assert!(
+        stdout.contains("FILE data/test-00000-of-00001.parquet: altered"),
+        "{stdout}"
+    );
     assert!(stderr.contains("file problem"), "{stderr}");
 }
 
@@ -126,13 +146,18 @@ fn verify_catches_spec_edits_that_leave_the_physics_alone() {
     assert_eq!(code, Some(2), "{stdout}");
     assert!(stdout.contains(&format!("MISMATCH {id}")), "{stdout}");
     assert!(stdout.contains("`labels.reach_radius`"), "{stdout}");
-    assert!(stdout.contains(&format!("FILE specs/{id}.json: altered")), "{stdout}");
+    assert!(
+        stdout.contains(&format!("FILE specs/{id}.json: altered")),
+        "{stdout}"
+    );
 
     // The same for the selection's object (what the scene claims to show).
     let tmp2 = tempfile::tempdir().unwrap();
     let dir = copy_of_reference(tmp2.path());
     let spec = first_spec(&dir);
-    edit_spec(&spec, |s| s["selection"]["object_id"] = serde_json::json!("not_the_object"));
+    edit_spec(&spec, |s| {
+        s["selection"]["object_id"] = serde_json::json!("not_the_object")
+    });
     let (code, stdout, _) = verify(&dir, false);
     assert_eq!(code, Some(2), "{stdout}");
     assert!(stdout.contains("`selection.object_id`"), "{stdout}");
@@ -178,13 +203,19 @@ fn a_deleted_spec_is_caught_and_a_rerun_rebuilds_only_its_group() {
 
     // The finished build, run again, is no longer "nothing to do": it recomputes the
     // one group and ends byte-identical to the reference.
-    let out = run("rh-pipeline", &build_args(dir.to_str().unwrap(), &["--json"]));
+    let out = run(
+        "rh-pipeline",
+        &build_args(dir.to_str().unwrap(), &["--json"]),
+    );
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{stderr}");
     let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(summary["computed_groups"], 1, "{summary}");
     assert_eq!(summary["resumed_groups"], 1, "{summary}");
-    assert!(files_under(&dir) == files_under(&reference().1), "repaired build differs");
+    assert!(
+        files_under(&dir) == files_under(&reference().1),
+        "repaired build differs"
+    );
 
     // An altered data file: every group is rebuilt (its rows cannot be trusted), same bytes.
     let data = dir.join("data/test-00000-of-00001.parquet");
@@ -192,10 +223,16 @@ fn a_deleted_spec_is_caught_and_a_rerun_rebuilds_only_its_group() {
     let last = bytes.len() - 100;
     bytes[last] ^= 0xff;
     fs::write(&data, bytes).unwrap();
-    let out = run("rh-pipeline", &build_args(dir.to_str().unwrap(), &["--json"]));
+    let out = run(
+        "rh-pipeline",
+        &build_args(dir.to_str().unwrap(), &["--json"]),
+    );
     let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(summary["computed_groups"], 2, "{summary}");
-    assert!(files_under(&dir) == files_under(&reference().1), "repaired build differs");
+    assert!(
+        files_under(&dir) == files_under(&reference().1),
+        "repaired build differs"
+    );
 }
 
 #[test]
@@ -204,7 +241,10 @@ fn merge_checks_shard_checksums_and_equals_the_single_build() {
     let shards: Vec<PathBuf> = (0..2).map(|i| tmp.path().join(format!("s{i}"))).collect();
     for (i, s) in shards.iter().enumerate() {
         let shard = format!("{i}/2");
-        run_ok("rh-pipeline", &build_args(s.to_str().unwrap(), &["--shard", &shard]));
+        run_ok(
+            "rh-pipeline",
+            &build_args(s.to_str().unwrap(), &["--shard", &shard]),
+        );
     }
     let merged = tmp.path().join("merged");
     let args = |out: &Path| -> Vec<String> {
@@ -213,8 +253,14 @@ fn merge_checks_shard_checksums_and_equals_the_single_build() {
         a
     };
     let a = args(&merged);
-    run_ok("rh-pipeline", &a.iter().map(|s| s.as_str()).collect::<Vec<_>>());
-    assert!(files_under(&merged) == files_under(&reference().1), "merge differs from the single build");
+    run_ok(
+        "rh-pipeline",
+        &a.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+    );
+    assert!(
+        files_under(&merged) == files_under(&reference().1),
+        "merge differs from the single build"
+    );
 
     // A flipped byte in a shard's spec: refused before anything is written, naming it.
     let spec = first_spec(&shards[1]);
@@ -223,20 +269,33 @@ fn merge_checks_shard_checksums_and_equals_the_single_build() {
     fs::write(&spec, bytes).unwrap();
     let merged2 = tmp.path().join("merged2");
     let a = args(&merged2);
-    let out = run("rh-pipeline", &a.iter().map(|s| s.as_str()).collect::<Vec<_>>());
+    let out = run(
+        "rh-pipeline",
+        &a.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+    );
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains(spec.file_name().unwrap().to_str().unwrap()) && stderr.contains("altered"), "{stderr}");
+    assert!(
+        stderr.contains(spec.file_name().unwrap().to_str().unwrap()) && stderr.contains("altered"),
+        "{stderr}"
+    );
     assert!(!merged2.exists());
 
     // A killed merge's staging folder is removed by the next merge into the same OUT.
     let stale = tmp.path().join(".merged3.rh-merge.999999999");
     fs::create_dir_all(stale.join("specs")).unwrap();
     fs::write(stale.join("specs/x.json"), "{}").unwrap();
-    fs::write(&spec, fs::read(reference().1.join(spec.strip_prefix(&shards[1]).unwrap())).unwrap()).unwrap();
+    fs::write(
+        &spec,
+        fs::read(reference().1.join(spec.strip_prefix(&shards[1]).unwrap())).unwrap(),
+    )
+    .unwrap();
     let merged3 = tmp.path().join("merged3");
     let a = args(&merged3);
-    run_ok("rh-pipeline", &a.iter().map(|s| s.as_str()).collect::<Vec<_>>());
+    run_ok(
+        "rh-pipeline",
+        &a.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+    );
     assert!(!stale.exists(), "stale merge folder left behind");
 }
 
@@ -249,8 +308,15 @@ fn build_refuses_a_directory_holding_unrelated_files() {
     let res = run("rh-pipeline", &build_args(out.to_str().unwrap(), &[]));
     let stderr = String::from_utf8_lossy(&res.stderr);
     assert_eq!(res.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("not empty") && stderr.contains("notes.txt"), "{stderr}");
-    assert_eq!(fs::read_dir(&out).unwrap().count(), 1, "the build wrote into it");
+    assert!(
+        stderr.contains("not empty") && stderr.contains("notes.txt"),
+        "{stderr}"
+    );
+    assert_eq!(
+        fs::read_dir(&out).unwrap().count(),
+        1,
+        "the build wrote into it"
+    );
 }
 
 #[test]
@@ -270,9 +336,25 @@ fn a_missing_speed_bands_entry_names_the_config_file() {
     let out = tmp.path().join("out");
     let res = run(
         "rh-pipeline",
-        &["--config", config.to_str().unwrap(), "build", "--n", "4", "--families", "rolling_ball", "--no-render", "--out", out.to_str().unwrap()],
+        &[
+            "--config",
+            config.to_str().unwrap(),
+            "build",
+            "--n",
+            "4",
+            "--families",
+            "rolling_ball",
+            "--no-render",
+            "--out",
+            out.to_str().unwrap(),
+        ],
     );
     let stderr = String::from_utf8_lossy(&res.stderr);
     assert_eq!(res.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("mine.toml") && stderr.contains("[speed_bands]") && stderr.contains("rolling_ball"), "{stderr}");
+    assert!(
+        stderr.contains("mine.toml")
+            && stderr.contains("[speed_bands]")
+            && stderr.contains("rolling_ball"),
+        "{stderr}"
+    );
 }

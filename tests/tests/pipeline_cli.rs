@@ -200,16 +200,25 @@ fn verify_replays_and_catches_a_tampered_spec() {
     fs::write(&victim, serde_json::to_string_pretty(&spec).unwrap()).unwrap();
     let id = victim.file_stem().unwrap().to_str().unwrap();
     // The replay-only check sees the physics change.
-    let out = run("rh-pipeline", &["verify", "--fast", dir.path().to_str().unwrap()]);
+    let out = run(
+        "rh-pipeline",
+        &["verify", "--fast", dir.path().to_str().unwrap()],
+    );
     assert_eq!(out.status.code(), Some(2));
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains(&format!("MISMATCH {id}: state hash")), "{stdout}");
+    assert!(
+        stdout.contains(&format!("MISMATCH {id}: state hash")),
+        "{stdout}"
+    );
     assert!(stdout.contains("59 match, 1 mismatch"), "{stdout}");
     // The full check sees the altered file and the spec that no longer derives.
     let out = run("rh-pipeline", &["verify", dir.path().to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains(&format!("FILE specs/{id}.json: altered")), "{stdout}");
+    assert!(
+        stdout.contains(&format!("FILE specs/{id}.json: altered")),
+        "{stdout}"
+    );
     assert!(stdout.contains(&format!("MISMATCH {id}")), "{stdout}");
     assert!(stdout.contains("59 match, 1 differ"), "{stdout}");
 }
@@ -423,7 +432,9 @@ fn readme_label_balance_matches_the_balance_command() {
         .expect("README states the label balance");
     let sentence = &readme[start..start + readme[start..].find('.').unwrap()];
     let count = |label: &str| -> u64 {
-        let at = sentence.find(&format!("{label} ")).unwrap_or_else(|| panic!("{label} in: {sentence}"));
+        let at = sentence
+            .find(&format!("{label} "))
+            .unwrap_or_else(|| panic!("{label} in: {sentence}"));
         sentence[at + label.len() + 1..]
             .split(|c: char| !c.is_ascii_digit())
             .next()
@@ -432,8 +443,11 @@ fn readme_label_balance_matches_the_balance_command() {
             .unwrap()
     };
     let stated = (count("CATCH"), count("DODGE"), count("NO_ACTION"));
-    let rows: serde_json::Value =
-        serde_json::from_str(&run_ok("rh-pipeline", &["balance", "--json", "--seed", "0"])).unwrap();
+    let rows: serde_json::Value = serde_json::from_str(&run_ok(
+        "rh-pipeline",
+        &["balance", "--json", "--seed", "0"],
+    ))
+    .unwrap();
     let rows = rows.as_array().unwrap();
     assert_eq!(rows.len(), 17);
     let sum = |k: &str| rows.iter().map(|r| r[k].as_u64().unwrap_or(0)).sum::<u64>();

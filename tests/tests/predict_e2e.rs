@@ -78,7 +78,16 @@ impl Server {
         let log = dir.join(format!("server-{}.log", rand_suffix()));
         let mut child = Command::new("python3")
             .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("llm_server.py"))
-            .args(["--script", script, "--then", then, "--lifetime", "240", "--hang", "3"])
+            .args([
+                "--script",
+                script,
+                "--then",
+                then,
+                "--lifetime",
+                "240",
+                "--hang",
+                "3",
+            ])
             .arg("--log")
             .arg(&log)
             .args(extra)
@@ -89,7 +98,12 @@ impl Server {
         std::io::BufReader::new(child.stdout.take().unwrap())
             .read_line(&mut line)
             .unwrap();
-        let port = line.trim().strip_prefix("PORT ").expect("PORT line").parse().unwrap();
+        let port = line
+            .trim()
+            .strip_prefix("PORT ")
+            .expect("PORT line")
+            .parse()
+            .unwrap();
         Server { child, port, log }
     }
 
@@ -109,7 +123,11 @@ impl Server {
 fn rand_suffix() -> String {
     use std::sync::atomic::{AtomicU64, Ordering};
     static N: AtomicU64 = AtomicU64::new(0);
-    format!("{}-{}", std::process::id(), N.fetch_add(1, Ordering::SeqCst))
+    format!(
+        "{}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::SeqCst)
+    )
 }
 
 /// A runner config with quick backoff (the real one waits seconds).
@@ -131,10 +149,22 @@ fn fast_config(dir: &Path) -> PathBuf {
 fn predict(dir: &Path, server_url: &str, out: &Path, extra: &[&str]) -> Output {
     Command::new(bin("rh-score"))
         .arg("predict")
-        .args(["--dataset", dataset().to_str().unwrap(), "--model", "test-model"])
+        .args([
+            "--dataset",
+            dataset().to_str().unwrap(),
+            "--model",
+            "test-model",
+        ])
         .arg("--out")
         .arg(out)
-        .args(["--base-url", server_url, "--subset", "all", "--quiet", "--json"])
+        .args([
+            "--base-url",
+            server_url,
+            "--subset",
+            "all",
+            "--quiet",
+            "--json",
+        ])
         .arg("--config")
         .arg(fast_config(dir))
         .args(extra)
@@ -173,14 +203,19 @@ fn assert_no_key_under(dir: &Path) {
         if name.starts_with("server-") {
             continue;
         }
-        assert!(!String::from_utf8_lossy(&bytes).contains(KEY), "the API key leaked into {name}");
+        assert!(
+            !String::from_utf8_lossy(&bytes).contains(KEY),
+            "the API key leaked into {name}"
+        );
     }
 }
 
 fn lines(path: &Path) -> Vec<Value> {
     let text = std::fs::read_to_string(path).unwrap();
     assert!(text.is_empty() || text.ends_with('\n'), "torn last line");
-    text.lines().map(|l| serde_json::from_str(l).unwrap()).collect()
+    text.lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
 }
 
 /// Asserts every selected scene appears exactly once; returns the scene count.
@@ -205,14 +240,20 @@ fn answers_resume_cache_report_and_no_key_anywhere() {
     assert_eq!(srv.requests().len(), n);
     for r in srv.requests() {
         assert_eq!(r["images"], 5, "five ego frames per request");
-        assert_eq!(r["authorization"].as_str(), Some(format!("Bearer {KEY}").as_str()));
+        assert_eq!(
+            r["authorization"].as_str(),
+            Some(format!("Bearer {KEY}").as_str())
+        );
         assert_eq!(r["model"], "test-model");
     }
     let refusals: Vec<&Value> = ls.iter().filter(|l| l["refusal"] == true).collect();
     assert_eq!(refusals.len(), 1);
     assert!(refusals[0].get("plan").is_none() && refusals[0]["error"].is_null());
     for l in ls.iter().filter(|l| l["refusal"] != true) {
-        assert!(l["plan"]["keyframes"].is_array(), "fenced, prose and bare JSON all parse: {l}");
+        assert!(
+            l["plan"]["keyframes"].is_array(),
+            "fenced, prose and bare JSON all parse: {l}"
+        );
         assert!(l["error"].is_null());
         // 1000 prompt tokens at $10/M + 100 completion tokens at $100/M.
         assert!((l["usage"]["cost"].as_f64().unwrap() - 0.02).abs() < 1e-12);
@@ -237,13 +278,26 @@ fn answers_resume_cache_report_and_no_key_anywhere() {
     // The report carries the prompt version; the refusal is R1, nothing is lost.
     let rep = run_ok(
         "rh-score",
-        &[out.to_str().unwrap(), "--dataset", dataset().to_str().unwrap(), "--json", "-"],
+        &[
+            out.to_str().unwrap(),
+            "--dataset",
+            dataset().to_str().unwrap(),
+            "--json",
+            "-",
+        ],
     );
     let rep: Value = serde_json::from_str(&rep).unwrap();
     assert_eq!(rep["models"][0]["prompt_version"], "rh-prompt-v1");
     assert_eq!(rep["models"][0]["lost"], 0);
     assert_eq!(rep["models"][0]["overall"]["first_rule"]["R1"], 1);
-    let table = run_ok("rh-score", &[out.to_str().unwrap(), "--dataset", dataset().to_str().unwrap()]);
+    let table = run_ok(
+        "rh-score",
+        &[
+            out.to_str().unwrap(),
+            "--dataset",
+            dataset().to_str().unwrap(),
+        ],
+    );
     assert!(table.contains("rh-prompt-v1"), "{table}");
     assert_no_key_under(d);
 }
@@ -268,10 +322,17 @@ fn transient_failures_are_retried_and_retry_after_is_honoured() {
     let n = s["scenes"].as_u64().unwrap() as usize;
     let ls = lines(&out);
     once_each(&ls, n);
-    assert!(ls.iter().all(|l| l["error"].is_null() && l["plan"].is_object()), "{ls:?}");
+    assert!(
+        ls.iter()
+            .all(|l| l["error"].is_null() && l["plan"].is_object()),
+        "{ls:?}"
+    );
     assert_eq!(s["lost"], 0);
     assert_eq!(s["rate_limited"], 2);
-    assert_eq!(s["retries"], 7, "500, 502, 503, malformed, empty, drop and the hang: {s}");
+    assert_eq!(
+        s["retries"], 7,
+        "500, 502, 503, malformed, empty, drop and the hang: {s}"
+    );
     assert_eq!(srv.requests().len(), n + 9);
     let first = ls.iter().find(|l| l["attempts"] == 10);
     assert!(first.is_some(), "one decision took ten attempts: {ls:?}");
@@ -296,12 +357,22 @@ fn lost_decisions_retry_errors_and_fatal_errors() {
     once_each(&ls, n);
     let lost: Vec<&Value> = ls.iter().filter(|l| !l["error"].is_null()).collect();
     assert_eq!(lost.len(), 1);
-    assert!(lost[0]["error"].as_str().unwrap().contains("503"), "{}", lost[0]);
+    assert!(
+        lost[0]["error"].as_str().unwrap().contains("503"),
+        "{}",
+        lost[0]
+    );
     assert!(lost[0]["response"].is_null() && lost[0].get("plan").is_none());
     // The scorer counts it as lost, never as R1.
     let rep: Value = serde_json::from_str(&run_ok(
         "rh-score",
-        &[out.to_str().unwrap(), "--dataset", dataset().to_str().unwrap(), "--json", "-"],
+        &[
+            out.to_str().unwrap(),
+            "--dataset",
+            dataset().to_str().unwrap(),
+            "--json",
+            "-",
+        ],
     ))
     .unwrap();
     assert_eq!(rep["models"][0]["lost"], 1);
@@ -311,7 +382,12 @@ fn lost_decisions_retry_errors_and_fatal_errors() {
     let before = srv.requests().len();
     ok_json(&predict(d, &srv.url(), &out, &args));
     assert_eq!(srv.requests().len(), before);
-    let s = ok_json(&predict(d, &srv.url(), &out, &[&args[..], &["--retry-errors"]].concat()));
+    let s = ok_json(&predict(
+        d,
+        &srv.url(),
+        &out,
+        &[&args[..], &["--retry-errors"]].concat(),
+    ));
     assert_eq!(s["error_lines_retried"], 1);
     assert_eq!(srv.requests().len(), before + 1);
     let ls = lines(&out);
@@ -321,7 +397,12 @@ fn lost_decisions_retry_errors_and_fatal_errors() {
     // is never printed.
     let bad = Server::start(d, "", "401", &[]);
     let o = predict(d, &bad.url(), &d.join("bad.jsonl"), &["--no-cache"]);
-    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("401"), "{err}");
     assert_no_key(&o.stderr);
@@ -338,10 +419,23 @@ fn sigkill_resume_and_max_cost() {
     let cfg = fast_config(d);
     let mut child = Command::new(bin("rh-score"))
         .arg("predict")
-        .args(["--dataset", dataset().to_str().unwrap(), "--model", "test-model"])
+        .args([
+            "--dataset",
+            dataset().to_str().unwrap(),
+            "--model",
+            "test-model",
+        ])
         .arg("--out")
         .arg(&out)
-        .args(["--base-url", &srv.url(), "--subset", "all", "--quiet", "--concurrency", "1"])
+        .args([
+            "--base-url",
+            &srv.url(),
+            "--subset",
+            "all",
+            "--quiet",
+            "--concurrency",
+            "1",
+        ])
         .arg("--config")
         .arg(&cfg)
         .env("RH_LLM_CACHE", d.join("cache"))
@@ -374,15 +468,30 @@ fn sigkill_resume_and_max_cost() {
     // --max-cost: each answer costs $0.02; a $0.05 budget stops after two.
     let costly = d.join("costly.jsonl");
     let price = ["--price-in", "10", "--price-out", "100", "--no-cache"];
-    let s = ok_json(&predict(d, &srv.url(), &costly, &[&price[..], &["--max-cost", "0.05"]].concat()));
+    let s = ok_json(&predict(
+        d,
+        &srv.url(),
+        &costly,
+        &[&price[..], &["--max-cost", "0.05"]].concat(),
+    ));
     assert_eq!(s["stopped"], "max_cost");
     assert_eq!(lines(&costly).len(), 2);
     assert!(s["total_cost_usd"].as_f64().unwrap() <= 0.05);
     // The same budget again: nothing more to spend.
-    let s = ok_json(&predict(d, &srv.url(), &costly, &[&price[..], &["--max-cost", "0.05"]].concat()));
+    let s = ok_json(&predict(
+        d,
+        &srv.url(),
+        &costly,
+        &[&price[..], &["--max-cost", "0.05"]].concat(),
+    ));
     assert_eq!(s["written"], 0);
     // A higher one resumes and finishes.
-    let s = ok_json(&predict(d, &srv.url(), &costly, &[&price[..], &["--max-cost", "10"]].concat()));
+    let s = ok_json(&predict(
+        d,
+        &srv.url(),
+        &costly,
+        &[&price[..], &["--max-cost", "10"]].concat(),
+    ));
     assert_eq!(s["stopped"], "complete");
     once_each(&lines(&costly), n);
     assert_no_key_under(d);
@@ -393,8 +502,20 @@ fn dry_run_prints_the_request_and_paper_layout_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let o = Command::new(bin("rh-score"))
-        .args(["predict", "--dataset", dataset().to_str().unwrap(), "--model", "m"])
-        .args(["--dry-run", "--subset", "all", "--base-url", "http://127.0.0.1:9/v1"])
+        .args([
+            "predict",
+            "--dataset",
+            dataset().to_str().unwrap(),
+            "--model",
+            "m",
+        ])
+        .args([
+            "--dry-run",
+            "--subset",
+            "all",
+            "--base-url",
+            "http://127.0.0.1:9/v1",
+        ])
         .env("OPENAI_API_KEY", KEY)
         .output()
         .unwrap();
@@ -409,7 +530,9 @@ fn dry_run_prints_the_request_and_paper_layout_is_refused() {
         .filter_map(|p| p["image_url"]["url"].as_str())
         .collect();
     assert_eq!(images.len(), 5);
-    assert!(images.iter().all(|u| u.contains("base64 characters elided")));
+    assert!(images
+        .iter()
+        .all(|u| u.contains("base64 characters elided")));
     assert!(user.iter().any(|p| p["text"] == "t = 0.60 s (ego camera)"));
     assert_eq!(v["prompt_version"], "rh-prompt-v1");
     assert_eq!(v["body"]["temperature"], 0.0);
@@ -423,17 +546,39 @@ fn dry_run_prints_the_request_and_paper_layout_is_refused() {
     let preds = d.join("p.jsonl");
     std::fs::write(&preds, "").unwrap();
     for args in [
-        vec!["predict", "--dataset", paper.to_str().unwrap(), "--model", "m", "--out", preds.to_str().unwrap()],
-        vec![preds.to_str().unwrap(), "--dataset", paper.to_str().unwrap()],
+        vec![
+            "predict",
+            "--dataset",
+            paper.to_str().unwrap(),
+            "--model",
+            "m",
+            "--out",
+            preds.to_str().unwrap(),
+        ],
+        vec![
+            preds.to_str().unwrap(),
+            "--dataset",
+            paper.to_str().unwrap(),
+        ],
     ] {
         let o = run("rh-score", &args);
         assert_eq!(o.status.code(), Some(2));
         let err = String::from_utf8_lossy(&o.stderr);
-        assert!(err.contains("metadata-only") && err.contains("data/*.parquet"), "{err}");
+        assert!(
+            err.contains("metadata-only") && err.contains("data/*.parquet"),
+            "{err}"
+        );
     }
     let empty = d.join("empty");
     std::fs::create_dir_all(empty.join("specs")).unwrap();
-    let o = run("rh-score", &[preds.to_str().unwrap(), "--dataset", empty.to_str().unwrap()]);
+    let o = run(
+        "rh-score",
+        &[
+            preds.to_str().unwrap(),
+            "--dataset",
+            empty.to_str().unwrap(),
+        ],
+    );
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("no data/*.parquet (found: specs/)"), "{err}");
@@ -455,10 +600,22 @@ fn llm_planner_validates_reasks_falls_back_and_caches() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let bad = r#"select:{"family": "juggling", "object_id": "apple", "room_id": "kitchen"}"#;
-    let good = r#"select:{"family": "thrown_object", "object_id": "steel_apple", "room_id": "kitchen"}"#;
+    let good =
+        r#"select:{"family": "thrown_object", "object_id": "steel_apple", "room_id": "kitchen"}"#;
     let srv = Server::start(d, bad, &good, &[]);
     let text = "someone throws a heavy apple-shaped thing at the robot";
-    let o = pipeline(d, &["plan", text, "--llm", "--model", "planner-model", "--base-url", &srv.url()]);
+    let o = pipeline(
+        d,
+        &[
+            "plan",
+            text,
+            "--llm",
+            "--model",
+            "planner-model",
+            "--base-url",
+            &srv.url(),
+        ],
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: Value = serde_json::from_slice(&o.stdout).unwrap();
     let sel = &v["selection"];
@@ -468,7 +625,10 @@ fn llm_planner_validates_reasks_falls_back_and_caches() {
     assert_eq!(sel["description"], text);
     let r = srv.requests();
     assert_eq!(r.len(), 2);
-    assert_eq!(r[1]["messages"], 4, "the re-ask carries the answer and the error");
+    assert_eq!(
+        r[1]["messages"], 4,
+        "the re-ask carries the answer and the error"
+    );
 
     // Never a valid answer: the lexicon decides, and the spec says so.
     let never = Server::start(d, "", bad, &[]);
@@ -479,9 +639,21 @@ fn llm_planner_validates_reasks_falls_back_and_caches() {
         pipeline(
             d,
             &[
-                "build", "--descriptions", desc.to_str().unwrap(), "--planner", "llm",
-                "--model", "planner-model", "--base-url", url, "--no-render", "--quiet",
-                "--seed", "2", "--out", out.to_str().unwrap(),
+                "build",
+                "--descriptions",
+                desc.to_str().unwrap(),
+                "--planner",
+                "llm",
+                "--model",
+                "planner-model",
+                "--base-url",
+                url,
+                "--no-render",
+                "--quiet",
+                "--seed",
+                "2",
+                "--out",
+                out.to_str().unwrap(),
             ],
         )
     };
@@ -498,7 +670,10 @@ fn llm_planner_validates_reasks_falls_back_and_caches() {
     let sel = &spec["selection"];
     assert_eq!(sel["description"], "an apple rolls off the counter");
     assert_eq!(sel["planner"]["planner"], "lexicon");
-    assert!(sel["planner"]["fallback"].as_str().unwrap().contains("no valid selection"));
+    assert!(sel["planner"]["fallback"]
+        .as_str()
+        .unwrap()
+        .contains("no valid selection"));
     assert_eq!(sel["object_id"], "apple");
     // A rebuild from the same descriptions makes no request (the cache answers) and
     // gives the same specs.

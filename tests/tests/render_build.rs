@@ -285,10 +285,21 @@ fn rendered_build_killed_mid_video_resumes_to_the_same_bytes() {
     // says so: recomputing everything would also give the same bytes, so count.
     let finished = records(&killed);
     assert!(finished >= 1);
-    let summary: serde_json::Value =
-        serde_json::from_str(&run_ok("rh-pipeline", &build_args(&config, &killed, &["--jobs", "1", "--json"]))).unwrap();
-    assert_eq!(summary["resumed_groups"].as_u64(), Some(finished as u64), "{summary}");
-    assert_eq!(summary["computed_groups"].as_u64(), Some(2 - finished as u64), "{summary}");
+    let summary: serde_json::Value = serde_json::from_str(&run_ok(
+        "rh-pipeline",
+        &build_args(&config, &killed, &["--jobs", "1", "--json"]),
+    ))
+    .unwrap();
+    assert_eq!(
+        summary["resumed_groups"].as_u64(),
+        Some(finished as u64),
+        "{summary}"
+    );
+    assert_eq!(
+        summary["computed_groups"].as_u64(),
+        Some(2 - finished as u64),
+        "{summary}"
+    );
     let (a, b) = (files_under(&reference), files_under(&killed));
     assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
     for (name, bytes) in &a {

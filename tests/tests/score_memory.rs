@@ -24,12 +24,28 @@ fn hostile_predictions_score_as_r1_with_flat_memory() {
     let ds = tmp.path().join("ds");
     run_ok(
         "rh-score",
-        &["make-fixture", "--out", ds.to_str().unwrap(), "--n", "40", "--seed", "3"],
+        &[
+            "make-fixture",
+            "--out",
+            ds.to_str().unwrap(),
+            "--n",
+            "40",
+            "--seed",
+            "3",
+        ],
     );
-    let base = run_ok("rh-score", &["baseline", "oracle", "--dataset", ds.to_str().unwrap()]);
+    let base = run_ok(
+        "rh-score",
+        &["baseline", "oracle", "--dataset", ds.to_str().unwrap()],
+    );
     let ids: Vec<String> = base
         .lines()
-        .map(|l| serde_json::from_str::<Value>(l).unwrap()["scene_id"].as_str().unwrap().to_string())
+        .map(|l| {
+            serde_json::from_str::<Value>(l).unwrap()["scene_id"]
+                .as_str()
+                .unwrap()
+                .to_string()
+        })
         .collect();
     let before = children_peak_rss_mib();
 
@@ -46,14 +62,28 @@ fn hostile_predictions_score_as_r1_with_flat_memory() {
     let bare = &bare[..bare.len() - 1];
     writeln!(f, r#"{{"scene_id":"{}","model":"hostile","response":"```json\n{{\"walking_cmd\":[0,0,0],\"keyframes\":[{bare}]}}\n```"}}"#, ids[4]).unwrap();
     // Line 6: nested 100 levels deep.
-    writeln!(f, r#"{{"scene_id":"{}","model":"hostile","plan":{{"walking_cmd":[0,0,0],"x":{}1{}}}}}"#, ids[5], "[".repeat(100), "]".repeat(100)).unwrap();
+    writeln!(
+        f,
+        r#"{{"scene_id":"{}","model":"hostile","plan":{{"walking_cmd":[0,0,0],"x":{}1{}}}}}"#,
+        ids[5],
+        "[".repeat(100),
+        "]".repeat(100)
+    )
+    .unwrap();
     // Line 7: 200 bare keyframes without walking — automatic times, a valid plan.
     let pts = vec!["[0.3,0.0,0.1]"; 200].join(",");
     writeln!(f, r#"{{"scene_id":"{}","model":"hostile","plan":{{"intent":"catch","walking_cmd":[0,0,0],"walking_duration":0,"keyframes":[{pts}]}}}}"#, ids[6]).unwrap();
     drop(f);
 
     let out = Command::new(bin("rh-score"))
-        .args([preds.to_str().unwrap(), "--dataset", ds.to_str().unwrap(), "--json", "-", "--quiet"])
+        .args([
+            preds.to_str().unwrap(),
+            "--dataset",
+            ds.to_str().unwrap(),
+            "--json",
+            "-",
+            "--quiet",
+        ])
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -61,13 +91,22 @@ fn hostile_predictions_score_as_r1_with_flat_memory() {
     let peak = children_peak_rss_mib();
     let report: Value = serde_json::from_slice(&out.stdout).unwrap();
     let warnings = report["input"]["warnings"].as_array().unwrap();
-    let too_large = warnings.iter().find(|w| w["kind"] == "r1_plan_too_large").expect("r1_plan_too_large counted");
+    let too_large = warnings
+        .iter()
+        .find(|w| w["kind"] == "r1_plan_too_large")
+        .expect("r1_plan_too_large counted");
     assert_eq!(too_large["count"], 6, "{too_large}");
     assert_eq!(too_large["first_lines"][0], 1);
-    assert!(!warnings.iter().any(|w| w["kind"] == "absurd_number"), "{warnings:?}");
+    assert!(
+        !warnings.iter().any(|w| w["kind"] == "absurd_number"),
+        "{warnings:?}"
+    );
     assert_eq!(report["input"]["decisions_scored"], 7);
     // stderr names the first line of each kind.
-    assert!(stderr.contains("r1_plan_too_large ×6 (first at line 1)"), "{stderr}");
+    assert!(
+        stderr.contains("r1_plan_too_large ×6 (first at line 1)"),
+        "{stderr}"
+    );
     // 4 × 16 MB of keyframes: the lines are read one at a time and never turned into trees.
     assert!(
         peak < 200.0,

@@ -208,11 +208,11 @@ fn predict(a: PredictArgs) -> Result<()> {
     let cfg = PredictConfig::load(a.config.as_deref())?;
     let prompt = PromptConfig::load(a.prompt.as_deref())?;
     let mut client = cfg.client.clone();
-    if let Some(u) = a
-        .base_url
-        .clone()
-        .or_else(|| std::env::var("OPENAI_BASE_URL").ok().filter(|s| !s.is_empty()))
-    {
+    if let Some(u) = a.base_url.clone().or_else(|| {
+        std::env::var("OPENAI_BASE_URL")
+            .ok()
+            .filter(|s| !s.is_empty())
+    }) {
         client.base_url = u;
     }
     client.api_key = std::env::var(&a.api_key_env).ok().filter(|k| !k.is_empty());
@@ -259,8 +259,11 @@ fn predict(a: PredictArgs) -> Result<()> {
         price,
         max_cost: a.max_cost,
         retry_errors: a.retry_errors,
-        cache_dir: (!a.no_cache)
-            .then(|| a.cache_dir.clone().unwrap_or_else(rh_llm::cache::default_dir)),
+        cache_dir: (!a.no_cache).then(|| {
+            a.cache_dir
+                .clone()
+                .unwrap_or_else(rh_llm::cache::default_dir)
+        }),
         sample: a.sample_index,
         prompt,
         progress: !a.quiet && !a.json,

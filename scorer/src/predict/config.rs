@@ -89,7 +89,9 @@ impl PromptConfig {
             return Err(bad("[images] max_side must be at least 16".into()));
         }
         if !["low", "high", "auto"].contains(&cfg.images.detail.as_str()) {
-            return Err(bad("[images] detail must be \"low\", \"high\" or \"auto\"".into()));
+            return Err(bad(
+                "[images] detail must be \"low\", \"high\" or \"auto\"".into()
+            ));
         }
         if cfg.version.trim().is_empty() {
             return Err(bad("version must not be empty".into()));

@@ -91,11 +91,7 @@ fn eval_scene_ids(dir: &Path) -> Result<Option<BTreeSet<String>>> {
 }
 
 /// The scene ids to run, in dataset order: valid scenes of the subset, first `limit`.
-pub fn select_scenes(
-    ds: &Dataset,
-    subset: Subset,
-    limit: Option<usize>,
-) -> Result<Vec<String>> {
+pub fn select_scenes(ds: &Dataset, subset: Subset, limit: Option<usize>) -> Result<Vec<String>> {
     let eval = match subset {
         Subset::All => None,
         Subset::Eval => Some(eval_scene_ids(&ds.dir)?.ok_or_else(|| {
@@ -125,8 +121,7 @@ pub fn select_scenes(
 
 /// The request for one scene, as `--dry-run` prints it (images elided, no key).
 pub fn dry_run(opts: &PredictOptions, scene_id: &str) -> Result<serde_json::Value> {
-    let built = prompt::build(&opts.prompt, &opts.dataset, scene_id)
-        .map_err(|e| InputError(e))?;
+    let built = prompt::build(&opts.prompt, &opts.dataset, scene_id).map_err(|e| InputError(e))?;
     let req = runner::request(opts, built.messages);
     Ok(serde_json::json!({
         "url": format!("{}/chat/completions", opts.client.base_url.trim_end_matches('/')),

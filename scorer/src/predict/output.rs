@@ -49,9 +49,7 @@ pub fn prepare(path: &Path, model: &str, retry_errors: bool) -> Result<Existing>
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(ex),
-        Err(e) => {
-            return Err(InputError(format!("cannot read {}: {e}", path.display())).into())
-        }
+        Err(e) => return Err(InputError(format!("cannot read {}: {e}", path.display())).into()),
     };
     let complete = match bytes.iter().rposition(|&b| b == b'\n') {
         Some(i) => i + 1,
@@ -72,8 +70,13 @@ pub fn prepare(path: &Path, model: &str, retry_errors: bool) -> Result<Existing>
             continue;
         }
         let n = i + 1;
-        let v: Value = serde_json::from_slice(line)
-            .map_err(|e| bad(path, n, format!("not a JSON prediction line ({e}); is this file from rh-score predict?")))?;
+        let v: Value = serde_json::from_slice(line).map_err(|e| {
+            bad(
+                path,
+                n,
+                format!("not a JSON prediction line ({e}); is this file from rh-score predict?"),
+            )
+        })?;
         let scene = v
             .get("scene_id")
             .and_then(Value::as_str)
@@ -173,9 +176,12 @@ mod tests {
         std::fs::write(
             &p,
             concat!(
-                r#"{"scene_id":"a","model":"m","response":"x","usage":{"cost":0.5}}"#, "\n",
-                r#"{"scene_id":"b","model":"m","error":"timed out"}"#, "\n",
-                r#"{"scene_id":"c","model":"m","response":"y","cached":true,"usage":{"cost":9}}"#, "\n",
+                r#"{"scene_id":"a","model":"m","response":"x","usage":{"cost":0.5}}"#,
+                "\n",
+                r#"{"scene_id":"b","model":"m","error":"timed out"}"#,
+                "\n",
+                r#"{"scene_id":"c","model":"m","response":"y","cached":true,"usage":{"cost":9}}"#,
+                "\n",
                 r#"{"scene_id":"d","mod"#
             ),
         )

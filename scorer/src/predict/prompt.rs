@@ -25,10 +25,13 @@ pub fn frame_rel_path(scene_id: &str, camera: &str, t: f64) -> String {
 
 fn fill(text: &str, cfg: &PromptConfig) -> String {
     let window = cfg.images.times.iter().copied().fold(0.0f64, f64::max);
-    text.replace("{n_frames}", &(cfg.images.times.len() * cfg.images.cameras.len()).to_string())
-        .replace("{window_s}", &format!("{window:.2}"))
-        .trim()
-        .to_string()
+    text.replace(
+        "{n_frames}",
+        &(cfg.images.times.len() * cfg.images.cameras.len()).to_string(),
+    )
+    .replace("{window_s}", &format!("{window:.2}"))
+    .trim()
+    .to_string()
 }
 
 /// The system message's text.
@@ -109,10 +112,7 @@ pub fn elide_images(v: &Value) -> Value {
     match v {
         Value::String(s) if s.starts_with("data:image/") => {
             let (head, data) = s.split_once(',').unwrap_or((s, ""));
-            Value::String(format!(
-                "{head},<{} base64 characters elided>",
-                data.len()
-            ))
+            Value::String(format!("{head},<{} base64 characters elided>", data.len()))
         }
         Value::Array(a) => Value::Array(a.iter().map(elide_images).collect()),
         Value::Object(m) => Value::Object(
@@ -153,7 +153,10 @@ mod tests {
         let elided = elide_images(&p.messages).to_string();
         assert!(!elided.contains(&url[30..80]));
         assert!(elided.contains("base64 characters elided"));
-        assert!(p.messages[0]["content"].as_str().unwrap().contains("0.60 s"));
+        assert!(p.messages[0]["content"]
+            .as_str()
+            .unwrap()
+            .contains("0.60 s"));
         let err = build(&cfg, d.path(), "ffffffff").unwrap_err();
         assert!(err.contains("missing observation frame"), "{err}");
     }

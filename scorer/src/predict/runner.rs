@@ -289,7 +289,8 @@ pub fn run(opts: &PredictOptions, scenes: &[String]) -> Result<Summary> {
                 break;
             };
             let done = done?;
-            out.write(&done.line).map_err(|e| Stop::Fatal(format!("{e:#}")))?;
+            out.write(&done.line)
+                .map_err(|e| Stop::Fatal(format!("{e:#}")))?;
             s.written += 1;
             s.remaining -= 1;
             s.encode_s += done.encode_s;
