@@ -190,38 +190,10 @@ fn distance_table(r: &Report) -> Table {
 }
 
 /// d_end and AIA per group (family or speed band) and model: "d_end / AIA (n)".
-fn distance_aia_table(
-    r: &Report,
-    title: &str,
-    pick: fn(&ModelReport) -> &Vec<MetricsRow>,
-) -> Table {
-    let models: Vec<&ModelReport> = r
-        .models
-        .iter()
-        .chain((r.models.len() > 1).then_some(&r.pooled))
-        .collect();
-    let mut head = vec![title.to_string()];
-    for m in &models {
-        head.push(format!("{} d_end m / AIA", m.model));
-    }
-    let mut t = Table {
-        head,
-        rows: Vec::new(),
-    };
-    let groups: Vec<String> = pick(&r.pooled).iter().map(|g| g.group.clone()).collect();
-    for (gi, g) in groups.iter().enumerate() {
-        let mut row = vec![g.clone()];
-        for m in &models {
-            let x = &pick(m)[gi];
-            row.push(if x.decisions == 0 {
-                "—".into()
-            } else {
-                format!("{} / {} (n={})", num(x.d_end, 2), num(x.aia, 2), x.d_end_n)
-            });
-        }
-        t.row(row);
-    }
-    t
+fn distance_aia_table(r: &Report, title: &str, pick: Pick) -> Table {
+    group_table(r, title, pick, "d_end m / AIA", |x| {
+        format!("{} / {} (n={})", num(x.d_end, 2), num(x.aia, 2), x.d_end_n)
+    })
 }
 
 type Pick = fn(&ModelReport) -> &Vec<MetricsRow>;
@@ -240,15 +212,31 @@ fn distance_breakdowns() -> [(&'static str, &'static str, Pick); 2] {
     ]
 }
 
-fn breakdown_table(r: &Report, title: &str, pick: fn(&ModelReport) -> &Vec<MetricsRow>) -> Table {
-    let mut head = vec![title.to_string()];
+/// SAA and safety per group (family, speed band, …) and model: "SAA / Safety (n)".
+fn breakdown_table(r: &Report, title: &str, pick: Pick) -> Table {
+    group_table(r, title, pick, "SAA/Safety %", |x| {
+        format!("{} / {} (n={})", pct(x.saa), pct(x.safety), x.decisions)
+    })
+}
+
+/// One row per group of `pick` (in the pooled report's order), one column per model
+/// (and the pooled one when there are several) headed "<model> <suffix>", each cell
+/// `cell` of that model's group, or "—" when it has no decisions.
+fn group_table(
+    r: &Report,
+    title: &str,
+    pick: Pick,
+    suffix: &str,
+    cell: fn(&MetricsRow) -> String,
+) -> Table {
     let models: Vec<&ModelReport> = r
         .models
         .iter()
         .chain((r.models.len() > 1).then_some(&r.pooled))
         .collect();
+    let mut head = vec![title.to_string()];
     for m in &models {
-        head.push(format!("{} SAA/Safety %", m.model));
+        head.push(format!("{} {suffix}", m.model));
     }
     let mut t = Table {
         head,
@@ -262,7 +250,7 @@ fn breakdown_table(r: &Report, title: &str, pick: fn(&ModelReport) -> &Vec<Metri
             row.push(if x.decisions == 0 {
                 "—".into()
             } else {
-                format!("{} / {} (n={})", pct(x.saa), pct(x.safety), x.decisions)
+                cell(x)
             });
         }
         t.row(row);
