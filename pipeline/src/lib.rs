@@ -39,3 +39,4 @@ pub mod simulate;
 pub mod spec;
 pub mod validate;
 pub mod verify;
+pub mod visibility;

@@ -159,6 +159,7 @@ print(json.dumps({{"columns": t.column_names, "n": t.num_rows,
         "valid_energy",
         "valid_no_tunnelling",
         "valid_in_frame",
+        "valid_visible",
         "valid_intended_event",
     ] {
         assert!(columns.contains(&required), "missing column {required}");
