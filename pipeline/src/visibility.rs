@@ -286,3 +286,209 @@ pub fn tangent_size(origin: Vec3, basis: (Vec3, Vec3, Vec3), points: &[Vec3]) ->
     }
     (hi[0] - lo[0]).max(hi[1] - lo[1])
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Config;
+    use crate::randomize::{randomize, SceneKey};
+    use crate::spec::{BodyKind, BodyRole, BodySpec, PartSpec, Selection};
+    use rh_catalog::Catalog;
+
+    const MARGIN: f64 = 0.08;
+
+    fn body(kind: BodyKind, shape: ShapeSpec, position: Vec3) -> BodySpec {
+        BodySpec {
+            name: "b".into(),
+            role: if kind == BodyKind::Fixed {
+                BodyRole::Support
+            } else {
+                BodyRole::Hazard
+            },
+            kind,
+            catalog_id: None,
+            parts: vec![PartSpec {
+                shape,
+                offset: [0.0; 3],
+                rotation: [0.0, 0.0, 0.0, 1.0],
+            }],
+            position,
+            rotation: [0.0, 0.0, 0.0, 1.0],
+            mass: 1.0,
+            friction: 0.5,
+            restitution: 0.1,
+            linvel: [0.0; 3],
+            angvel: [0.0; 3],
+            ccd: false,
+        }
+    }
+
+    /// A constructed scene: the hazard (body 0) and the given fixed bodies, the observer
+    /// standing at `observer` (x, y); everything else from a sampled spec.
+    fn scene(hazard: BodySpec, fixed: Vec<BodySpec>, observer: [f64; 2]) -> SceneSpec {
+        let catalog = Catalog::embedded().unwrap();
+        let config = Config::embedded().unwrap();
+        let selection = Selection {
+            family: "object_drop".into(),
+            object_id: "apple".into(),
+            room_id: "kitchen".into(),
+            description: None,
+            planner: None,
+        };
+        let mut spec = randomize(&selection, &SceneKey::new(0, 0, 0), &catalog, &config).unwrap();
+        spec.bodies = std::iter::once(hazard).chain(fixed).collect();
+        spec.hazard = 0;
+        spec.source_support = None;
+        spec.joints.clear();
+        spec.observer.x = observer[0];
+        spec.observer.y = observer[1];
+        spec
+    }
+
+    /// A 1280 × 720 camera at `position` looking at `look_at`.
+    fn camera(position: Vec3, look_at: Vec3, fov_y: f64) -> CameraSpec {
+        CameraSpec {
+            name: "test".into(),
+            position,
+            look_at,
+            fov_y,
+            width: 1280,
+            height: 720,
+        }
+    }
+
+    fn sight_of(spec: &SceneSpec, cam: &CameraSpec) -> Sight {
+        let h = spec.hazard_body();
+        let points = hazard_points(spec, h.position, h.rotation);
+        sight(cam, &points, &Occluders::of(spec, MARGIN))
+    }
+
+    #[test]
+    fn the_observer_between_camera_and_hazard_hides_it() {
+        let ball = body(
+            BodyKind::Dynamic,
+            ShapeSpec::Sphere { radius: 0.1 },
+            [3.0, 0.0, 1.0],
+        );
+        let cam = camera([-3.0, 0.0, 1.0], [3.0, 0.0, 1.0], 0.8);
+        // The observer's capsule stands on the line of sight: nothing of the ball is seen.
+        let behind = scene(ball.clone(), vec![], [0.0, 0.0]);
+        assert_eq!(sight_of(&behind, &cam).fraction, 0.0);
+        // 0.2 m beside the line: the bare capsule (torso radius 0.18) would leave the
+        // centre in sight; the widened one (+ 0.08 m, the drawn arms) hides every ray.
+        let beside = scene(ball.clone(), vec![], [0.0, 0.2]);
+        assert_eq!(sight_of(&beside, &cam).fraction, 0.0);
+        // Two metres aside: all of it.
+        let clear = scene(ball.clone(), vec![], [0.0, 2.0]);
+        assert_eq!(sight_of(&clear, &cam).fraction, 1.0);
+        // The ego camera, inside the observer's head, is not blocked by its own body.
+        let o = &behind.observer;
+        let ego = camera([o.x, o.y, o.height - 0.08], [3.0, 0.0, 1.0], 0.8);
+        assert_eq!(sight_of(&behind, &ego).fraction, 1.0);
+    }
+
+    #[test]
+    fn a_tiny_far_hazard_is_too_small() {
+        let rules = Config::embedded().unwrap().validators.framing();
+        let (r, d, fov) = (0.02, 10.0, 1.0);
+        let pebble = body(
+            BodyKind::Dynamic,
+            ShapeSpec::Sphere { radius: r },
+            [d, 0.0, 1.0],
+        );
+        let spec = scene(pebble, vec![], [0.0, 5.0]);
+        let s = sight_of(&spec, &camera([0.0, 0.0, 1.0], [d, 0.0, 1.0], fov));
+        // Fully in sight, but its projected size is 2 · 0.9 r / d · (720 / 2) / tan(fov / 2).
+        let expected = 2.0 * INSET * r / d * 360.0 / (fov / 2.0).tan();
+        assert!(
+            (s.size_px - expected).abs() < 0.02 * expected,
+            "{s:?} vs {expected}"
+        );
+        assert_eq!(s.fraction, 1.0);
+        assert!(s.size_px < rules.min_size_px && !s.passes(&rules), "{s:?}");
+        // Ten times closer, the same pebble is large enough.
+        let near = body(
+            BodyKind::Dynamic,
+            ShapeSpec::Sphere { radius: r },
+            [d / 10.0, 0.0, 1.0],
+        );
+        let spec = scene(near, vec![], [0.0, 5.0]);
+        let s = sight_of(&spec, &camera([0.0, 0.0, 1.0], [d, 0.0, 1.0], fov));
+        assert!(s.passes(&rules), "{s:?}");
+    }
+
+    #[test]
+    fn a_hazard_whose_centre_is_seen_but_most_of_it_hidden_fails() {
+        let rules = Config::embedded().unwrap().validators.framing();
+        // A 2 m bar across the view; two fixed panels hide all of it but a 0.3 m gap
+        // around its middle.
+        let bar = body(
+            BodyKind::Dynamic,
+            ShapeSpec::Box {
+                half_extents: [0.05, 1.0, 0.05],
+            },
+            [3.0, 0.0, 1.0],
+        );
+        let panel = |y: f64| {
+            body(
+                BodyKind::Fixed,
+                ShapeSpec::Box {
+                    half_extents: [0.02, 0.5, 1.0],
+                },
+                [1.0, y, 1.0],
+            )
+        };
+        let spec = scene(bar, vec![panel(-0.65), panel(0.65)], [0.0, 4.0]);
+        let cam = camera([-3.0, 0.0, 1.0], [3.0, 0.0, 1.0], 0.8);
+        // The old centre-only test sees it ...
+        assert!(!Obstacles::of(&spec).blocks(cam.position, [3.0, 0.0, 1.0]));
+        // ... but only the points along the bar's middle are in sight: 5 of 15.
+        let s = sight_of(&spec, &cam);
+        assert!((s.fraction - 5.0 / 15.0).abs() < 1e-9, "{s:?}");
+        assert!(!s.passes(&rules));
+        // Without the panels the same view passes.
+        let open = scene(spec.bodies[0].clone(), vec![], [0.0, 4.0]);
+        assert!(sight_of(&open, &cam).passes(&rules));
+    }
+
+    #[test]
+    fn a_hazard_partly_outside_the_image_counts_only_its_inside() {
+        let ball = body(
+            BodyKind::Dynamic,
+            ShapeSpec::Sphere { radius: 0.2 },
+            [3.0, 0.0, 1.0],
+        );
+        let spec = scene(ball, vec![], [0.0, 4.0]);
+        // Aimed so that the ball's centre sits on the image's right border.
+        let (fov, aspect) = (0.6f64, 1280.0 / 720.0);
+        let side = 3.0 * (fov / 2.0).tan() * aspect;
+        let cam = camera([0.0, side, 1.0], [3.0, side, 1.0], fov);
+        let s = sight_of(&spec, &cam);
+        assert!(s.fraction > 0.3 && s.fraction < 0.7, "{s:?}");
+    }
+
+    #[test]
+    fn every_shape_gives_fifteen_points_inside_it() {
+        for shape in [
+            ShapeSpec::Box {
+                half_extents: [0.1, 0.2, 0.3],
+            },
+            ShapeSpec::Sphere { radius: 0.2 },
+            ShapeSpec::Cylinder {
+                half_height: 0.3,
+                radius: 0.1,
+            },
+            ShapeSpec::Capsule {
+                half_height: 0.3,
+                radius: 0.1,
+            },
+        ] {
+            let points = shape_points(&shape);
+            assert_eq!(points.len(), 15, "{shape:?}");
+            let reach = shape.bounding_radius();
+            assert!(points
+                .iter()
+                .all(|p| (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() < reach));
+        }
+    }
+}
