@@ -25,9 +25,7 @@ use crate::families;
 use crate::integrity::{self, FileSums};
 use crate::manifest::{Manifest, MANIFEST_FILE};
 pub use crate::records::FamilyRejections;
-use crate::records::{
-    gather_rejections, group_files, load_record, read_rejections, reopen_if_damaged,
-};
+use crate::records::{gather_rejections, group_files, load_record, reopen_if_damaged};
 pub use crate::records::{record_path, WORK_DIR};
 use crate::scene::{run_group, GroupError, RenderStage};
 use arrow::array::RecordBatch;
@@ -81,8 +79,9 @@ pub struct BuildSummary {
     /// Scenes in the `eval` config (whole builds only).
     pub eval_scenes: Option<usize>,
     /// Per family: scene-group attempts made and, per validator column, how many of them
-    /// it rejected (`valid_visible`: the visibility rule). `None` when the build was
-    /// already complete (the per-group records holding the counts are gone by then).
+    /// it rejected (`valid_visible`: the visibility rule). `None` when some group's counts
+    /// are not known: the build was already complete (the per-group records holding the
+    /// counts are gone by then), or a damaged finished build was repaired.
     pub rejections: Option<BTreeMap<String, FamilyRejections>>,
 }
 
@@ -465,9 +464,10 @@ pub fn build(
     for sub in ["specs", "data", ".rh-build/groups"] {
         std::fs::create_dir_all(out.join(sub)).map_err(|e| internal(&out.join(sub), e))?;
     }
-    let (done, todo): (Vec<u64>, Vec<u64>) = groups.iter().copied().partition(|&g| {
-        load_record(out, &manifest, g).is_some() && read_rejections(out, g).is_some()
-    });
+    let (done, todo): (Vec<u64>, Vec<u64>) = groups
+        .iter()
+        .copied()
+        .partition(|&g| load_record(out, &manifest, g).is_some());
     if !done.is_empty() && opts.progress {
         eprintln!(
             "resumed {} groups from {} (finished before the last run stopped)",
@@ -541,7 +541,7 @@ pub fn build(
         Ok(())
     };
     let sums = crate::records::gather_sums(out, &groups).map_err(BuildError::Internal)?;
-    let rejections = gather_rejections(out, &groups).map_err(BuildError::Internal)?;
+    let rejections = gather_rejections(out, &groups);
     let (rows, eval) = finalize(out, &manifest, &records, sums)?;
     // Retire the records in one atomic step (a rename), then delete them: a crash in
     // between leaves a finished build whose next run only removes the leftover.
@@ -550,7 +550,7 @@ pub fn build(
     std::fs::rename(&work, &retired).map_err(|e| internal(&work, e))?;
     std::fs::remove_dir_all(&retired).map_err(|e| internal(&retired, e))?;
     let mut summary = summarize(out, &rows, data_file, done.len(), todo.len(), eval);
-    summary.rejections = Some(rejections);
+    summary.rejections = rejections;
     Ok(summary)
 }
 

@@ -112,26 +112,19 @@ pub fn read_rejections(out: &Path, g: u64) -> Option<GroupRejections> {
     serde_json::from_str(&text).ok()
 }
 
-/// Every finished group's attempt counts, summed per family.
-pub fn gather_rejections(
-    out: &Path,
-    groups: &[u64],
-) -> Result<BTreeMap<String, FamilyRejections>, String> {
+/// Every finished group's attempt counts, summed per family; None when some group's
+/// are not known (a repaired finished build keeps its intact groups without them).
+pub fn gather_rejections(out: &Path, groups: &[u64]) -> Option<BTreeMap<String, FamilyRejections>> {
     let mut per_family: BTreeMap<String, FamilyRejections> = BTreeMap::new();
     for &g in groups {
-        let group = read_rejections(out, g).ok_or_else(|| {
-            format!(
-                "{}: attempt counts missing",
-                rejections_path(out, g).display()
-            )
-        })?;
+        let group = read_rejections(out, g)?;
         let family = per_family.entry(group.family).or_default();
         family.attempts += group.attempts;
         for (column, n) in group.rejected_by {
             *family.rejected_by.entry(column).or_default() += n;
         }
     }
-    Ok(per_family)
+    Some(per_family)
 }
 
 /// The checksums of every finished group's files, together.
