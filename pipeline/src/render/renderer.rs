@@ -7,7 +7,7 @@ use super::geometry::{FixedView, SceneGeometry};
 use super::gpu::{Gpu, OverlayJob, ViewJob};
 use super::regions::bounds;
 use super::{RenderError, RenderOptions, RenderedScene, Shading, CAMERAS, FRAME_TIMES, FULL_EVENT};
-use crate::scene::{SceneMedia, SceneResult};
+use crate::scene::{full_event_simulation, SceneMedia, SceneResult};
 use crate::simulate::{simulate, SimOptions, Simulation};
 use crate::spec::{CameraSpec, SceneSpec};
 use rh_catalog::Catalog;
@@ -90,9 +90,14 @@ impl Renderer {
         self.gpu
             .reserve(scene.statics.len() + scene.max_dynamic + 1024);
         self.gpu.set_static(&scene.statics);
+        // The full-event video shows the counterfactual run (the observer as a body),
+        // the observation videos the plain run (`scene::full_event_simulation`).
+        let counterfactual = full_event_simulation(spec, sim);
+        let full_sim = counterfactual.as_ref().unwrap_or(sim);
         // The cameras stand still within a scene: the room, furniture and observer are
         // drawn once per view and every frame starts from that image.
-        let full_cam = full_event_camera(spec, sim, self.opts.full_width, self.opts.full_height);
+        let full_cam =
+            full_event_camera(spec, full_sim, self.opts.full_width, self.opts.full_height);
         let mut all_cams = cams.clone();
         all_cams.push(&full_cam);
         let static_views: Vec<ViewJob> = all_cams
@@ -158,9 +163,9 @@ impl Renderer {
             }
         }
 
-        // Full-event video: the whole simulation from outside.
+        // Full-event video: the whole (counterfactual) simulation from outside.
         let full_fps = self.opts.full_fps.max(1);
-        let full_event_steps = full_event_steps(sim, full_fps);
+        let full_event_steps = full_event_steps(full_sim, full_fps);
         let full_rel = video_path(FULL_EVENT, id);
         let full_job = VideoJob::spawn(
             out_dir.join(&full_rel),
@@ -172,7 +177,7 @@ impl Renderer {
         );
         if result.is_ok() {
             for &step in &full_event_steps {
-                let mut images = self.draw_overlay_step(&scene, sim, step, full_view)?;
+                let mut images = self.draw_overlay_step(&scene, full_sim, step, full_view)?;
                 if !full_job.send(images.pop().unwrap()) {
                     break;
                 }
