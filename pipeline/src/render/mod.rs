@@ -77,6 +77,8 @@ pub struct RenderOptions {
     /// MSAA samples on a hardware GPU, and on a CPU rasterizer.
     pub msaa: u32,
     pub msaa_cpu: u32,
+    /// FXAA-style post-process anti-aliasing wherever MSAA is off.
+    pub fxaa: bool,
 }
 
 impl RenderOptions {
@@ -92,6 +94,7 @@ impl RenderOptions {
             },
             msaa: c.msaa,
             msaa_cpu: c.msaa_cpu,
+            fxaa: c.fxaa,
         }
     }
 }
@@ -109,6 +112,7 @@ impl Default for RenderOptions {
             },
             msaa: 4,
             msaa_cpu: 1,
+            fxaa: true,
         }
     }
 }

@@ -1,6 +1,7 @@
 //! The wgpu side: device, pipelines (shadow + lit MSAA), render targets per output slot,
 //! and one call that draws a set of views of the current geometry and reads them back.
 
+mod post;
 mod setup;
 
 use super::mesh::Vertex;
@@ -65,6 +66,9 @@ struct Target {
     /// copied in before each overlay frame.
     cache_color: wgpu::Texture,
     cache_depth: wgpu::Texture,
+    /// The FXAA pass's output, read back instead of `resolve` for lit views (`None`
+    /// without post-process anti-aliasing).
+    post: Option<post::PostTarget>,
     readback: wgpu::Buffer,
     padded_row: u32,
     uniform: wgpu::Buffer,
@@ -91,6 +95,8 @@ pub struct Gpu {
     shadow_sampler: wgpu::Sampler,
     shadow_uniform: wgpu::Buffer,
     shadow_bind: wgpu::BindGroup,
+    /// Post-process anti-aliasing (FXAA), where MSAA is off and it is enabled.
+    post: Option<post::Post>,
     vbuf: wgpu::Buffer,
     vcap: u64,
     static_len: u32,
@@ -191,8 +197,18 @@ impl Gpu {
             let v = t.create_view(&Default::default());
             (t, v)
         });
-        let resolve = tex(1, COLOR_FORMAT, attachment);
+        let resolve = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: None,
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: COLOR_FORMAT,
+            usage: attachment | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[post::SOURCE_VIEW_FORMAT],
+        });
         let resolve_view = resolve.create_view(&Default::default());
+        let post = self.post.as_ref().map(|p| p.target(&self.device, &resolve));
         let depth = tex(self.samples, DEPTH_FORMAT, attachment);
         let depth_view = depth.create_view(&Default::default());
         // Copies need no render usage, but a multisampled texture must be renderable.
@@ -239,6 +255,7 @@ impl Gpu {
             depth_view,
             cache_color,
             cache_depth,
+            post,
             readback,
             padded_row,
             uniform,
@@ -304,7 +321,7 @@ impl Gpu {
                 copy_whole(&mut enc, t.color(), &t.cache_color);
                 copy_whole(&mut enc, &t.depth, &t.cache_depth);
             } else {
-                Self::copy_to_readback(&mut enc, t);
+                self.copy_to_readback(&mut enc, t, lit(&v.uniforms));
             }
         }
         enc
@@ -353,7 +370,7 @@ impl Gpu {
             copy_whole(&mut enc, &t.cache_depth, &t.depth);
             let redraw = Redraw::Regions(rects);
             self.main_pass(&mut enc, t, redraw, &v.dynamic);
-            Self::copy_to_readback(&mut enc, t);
+            self.copy_to_readback(&mut enc, t, lit(&v.uniforms));
         }
         self.queue.submit([enc.finish()]);
         self.read_back(views.iter().map(|v| v.slot))
@@ -510,9 +527,18 @@ impl Gpu {
         }
     }
 
-    fn copy_to_readback(enc: &mut wgpu::CommandEncoder, t: &Target) {
+    /// Queues the frame's read-back: for a lit view (`aa`) through the FXAA pass when
+    /// there is one; diagnostic views (exact hazard masks) as drawn.
+    fn copy_to_readback(&self, enc: &mut wgpu::CommandEncoder, t: &Target, aa: bool) {
+        let source = match (&self.post, &t.post) {
+            (Some(post), Some(pt)) if aa => {
+                post.encode(enc, pt);
+                &pt.out
+            }
+            _ => &t.resolve,
+        };
         enc.copy_texture_to_buffer(
-            whole(&t.resolve),
+            whole(source),
             wgpu::TexelCopyBufferInfo {
                 buffer: &t.readback,
                 layout: wgpu::TexelCopyBufferLayout {
@@ -568,6 +594,11 @@ impl Target {
             None => &self.resolve,
         }
     }
+}
+
+/// Whether a view is shaded for the dataset (not an unlit diagnostic: `ambient.w`).
+fn lit(u: &Uniforms) -> bool {
+    u.ambient[3] <= 0.5
 }
 
 fn extent(width: u32, height: u32) -> wgpu::Extent3d {
