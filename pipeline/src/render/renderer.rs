@@ -332,13 +332,18 @@ impl Renderer {
         let moving = bounds(&dynamic);
         let jobs: Vec<OverlayJob> = views
             .iter()
-            .map(|v| OverlayJob {
-                slot: v.slot,
-                uniforms: v.uniforms,
-                redraw: moving
+            .map(|v| {
+                let redraw = moving
                     .map(|m| scene.shadow_redraws(v, m))
-                    .unwrap_or_default(),
-                dynamic: dyn_range.clone(),
+                    .unwrap_or_default();
+                let changed = moving.and_then(|m| scene.changed_rect(v, m, &redraw));
+                OverlayJob {
+                    slot: v.slot,
+                    uniforms: v.uniforms,
+                    redraw,
+                    dynamic: dyn_range.clone(),
+                    changed,
+                }
             })
             .collect();
         self.gpu

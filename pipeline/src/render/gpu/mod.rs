@@ -51,6 +51,9 @@ pub struct OverlayJob {
     pub uniforms: Uniforms,
     pub redraw: Vec<([u32; 4], Vec<Range<u32>>)>,
     pub dynamic: Range<u32>,
+    /// A rectangle (x, y, width, height) holding every pixel that may differ from the
+    /// static image (the redraws and the moving bodies); `None`: none.
+    pub changed: Option<[u32; 4]>,
 }
 
 struct Target {
@@ -320,6 +323,10 @@ impl Gpu {
             if cache {
                 copy_whole(&mut enc, t.color(), &t.cache_color);
                 copy_whole(&mut enc, &t.depth, &t.cache_depth);
+                if let (Some(post), Some(pt)) = (&self.post, &t.post) {
+                    post.encode(&mut enc, pt, None);
+                    copy_whole(&mut enc, &pt.out, &pt.cache);
+                }
             } else {
                 self.copy_to_readback(&mut enc, t, lit(&v.uniforms));
             }
@@ -370,7 +377,18 @@ impl Gpu {
             copy_whole(&mut enc, &t.cache_depth, &t.depth);
             let redraw = Redraw::Regions(rects);
             self.main_pass(&mut enc, t, redraw, &v.dynamic);
-            self.copy_to_readback(&mut enc, t, lit(&v.uniforms));
+            match (&self.post, &t.post) {
+                // Anti-aliased: the static image's, redone around what changed.
+                (Some(post), Some(pt)) if lit(&v.uniforms) => {
+                    copy_whole(&mut enc, &pt.cache, &pt.out);
+                    let grown = v.changed.and_then(|r| grow(r, post::REACH, t));
+                    if let Some(r) = grown {
+                        post.encode(&mut enc, pt, Some(r));
+                    }
+                    Self::copy_texture_to_readback(&mut enc, t, &pt.out);
+                }
+                _ => Self::copy_texture_to_readback(&mut enc, t, &t.resolve),
+            }
         }
         self.queue.submit([enc.finish()]);
         self.read_back(views.iter().map(|v| v.slot))
@@ -532,11 +550,19 @@ impl Gpu {
     fn copy_to_readback(&self, enc: &mut wgpu::CommandEncoder, t: &Target, aa: bool) {
         let source = match (&self.post, &t.post) {
             (Some(post), Some(pt)) if aa => {
-                post.encode(enc, pt);
+                post.encode(enc, pt, None);
                 &pt.out
             }
             _ => &t.resolve,
         };
+        Self::copy_texture_to_readback(enc, t, source);
+    }
+
+    fn copy_texture_to_readback(
+        enc: &mut wgpu::CommandEncoder,
+        t: &Target,
+        source: &wgpu::Texture,
+    ) {
         enc.copy_texture_to_buffer(
             whole(source),
             wgpu::TexelCopyBufferInfo {
@@ -594,6 +620,14 @@ impl Target {
             None => &self.resolve,
         }
     }
+}
+
+/// `r` grown by `by` pixels on every side, clamped to the target (`None` if empty).
+fn grow([x, y, w, h]: [u32; 4], by: u32, t: &Target) -> Option<[u32; 4]> {
+    let (x0, y0) = (x.saturating_sub(by), y.saturating_sub(by));
+    let x1 = (x + w + by).min(t.width);
+    let y1 = (y + h + by).min(t.height);
+    (x1 > x0 && y1 > y0).then_some([x0, y0, x1 - x0, y1 - y0])
 }
 
 /// Whether a view is shaded for the dataset (not an unlit diagnostic: `ambient.w`).

@@ -1,7 +1,7 @@
 //! Post-process anti-aliasing: an FXAA-style full-screen pass (`fxaa.wgsl`) from a
 //! target's resolved frame into the image that is read back. Used where MSAA is off
-//! (a CPU rasterizer): about a fifth of 4× MSAA's cost there, since it touches each
-//! pixel once and does more than copy it only on edges.
+//! (a CPU rasterizer). Like the lit pass, it runs over the whole static image once per
+//! view and scene (`cache`), and per frame only around what changed.
 
 /// The pass's output format: the frame's sRGB-encoded bytes, as they are (the resolved
 /// frame is read through a non-sRGB view, so FXAA works on display values).
@@ -14,12 +14,20 @@ pub(super) struct Post {
     sampler: wgpu::Sampler,
 }
 
-/// One target's FXAA output and the bind group reading its resolved frame.
+/// One target's FXAA output, the anti-aliased static image (see `Gpu::cache_static`)
+/// and the bind group reading the target's resolved frame.
 pub(super) struct PostTarget {
     pub out: wgpu::Texture,
+    pub cache: wgpu::Texture,
     view: wgpu::TextureView,
     bind: wgpu::BindGroup,
 }
+
+/// How far (pixels) an output pixel of the pass reads from: its four neighbours and
+/// diagonals (1), the taps along the edge (at most `SPAN_MAX / 2` = 4) with their
+/// bilinear footprint (1); with slack. Outside a rectangle grown by this much around
+/// every changed input pixel the pass's output is unchanged.
+pub(super) const REACH: u32 = 8;
 
 /// The view format the resolved colour texture must allow (`view_formats`).
 pub(super) const SOURCE_VIEW_FORMAT: wgpu::TextureFormat = POST_FORMAT;
@@ -104,7 +112,19 @@ impl Post {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: POST_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let cache = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("fxaa-cache"),
+            size: source.size(),
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: POST_FORMAT,
+            usage: wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
         let view = out.create_view(&Default::default());
@@ -126,11 +146,23 @@ impl Post {
                 },
             ],
         });
-        PostTarget { out, view, bind }
+        PostTarget {
+            out,
+            cache,
+            view,
+            bind,
+        }
     }
 
-    /// Encodes the pass: the target's resolved frame, anti-aliased, into `t.out`.
-    pub(super) fn encode(&self, enc: &mut wgpu::CommandEncoder, t: &PostTarget) {
+    /// Encodes the pass: the target's resolved frame, anti-aliased, into `t.out` —
+    /// everywhere, or only inside `rect` (x, y, width, height; the rest of `t.out` is
+    /// kept).
+    pub(super) fn encode(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        t: &PostTarget,
+        rect: Option<[u32; 4]>,
+    ) {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("fxaa"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -138,7 +170,11 @@ impl Post {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    load: if rect.is_some() {
+                        wgpu::LoadOp::Load
+                    } else {
+                        wgpu::LoadOp::Clear(wgpu::Color::BLACK)
+                    },
                     store: wgpu::StoreOp::Store,
                 },
             })],
@@ -149,6 +185,9 @@ impl Post {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &t.bind, &[]);
+        if let Some([x, y, w, h]) = rect {
+            pass.set_scissor_rect(x, y, w, h);
+        }
         pass.draw(0..3, 0..1);
     }
 }
