@@ -75,17 +75,7 @@ impl Renderer {
         out_dir: &Path,
     ) -> Result<RenderedScene, RenderError> {
         let id = &spec.scene_id;
-        let cams: Vec<&CameraSpec> = CAMERAS
-            .iter()
-            .map(|name| {
-                spec.cameras
-                    .iter()
-                    .find(|c| c.name == *name)
-                    .ok_or_else(|| {
-                        RenderError::Scene(id.clone(), format!("no '{name}' camera in the spec"))
-                    })
-            })
-            .collect::<Result<_, _>>()?;
+        let cams = observation_cameras(spec)?;
         let scene = SceneGeometry::build(spec, sim, catalog);
         self.gpu
             .reserve(scene.statics.len() + scene.max_dynamic + 1024);
@@ -373,6 +363,24 @@ pub fn render_stage(
         videos: rendered.videos,
         full_event: rendered.full_event,
     }))
+}
+
+/// The spec's observation cameras in `CAMERAS` order (an error names a missing one).
+fn observation_cameras(spec: &SceneSpec) -> Result<Vec<&CameraSpec>, RenderError> {
+    CAMERAS
+        .iter()
+        .map(|name| {
+            spec.cameras
+                .iter()
+                .find(|c| c.name == *name)
+                .ok_or_else(|| {
+                    RenderError::Scene(
+                        spec.scene_id.clone(),
+                        format!("no '{name}' camera in the spec"),
+                    )
+                })
+        })
+        .collect()
 }
 
 /// Full-event frame `j` shows physics step `round(j / fps / dt)` (at most the last).
