@@ -606,15 +606,10 @@ fn hazard_contact_flags(
 /// no body and a hazard may pass through it; in the counterfactual run it stays out up
 /// to the solver's contact tolerance (millimetres).
 pub fn observer_penetration(spec: &SceneSpec, sim: &Simulation) -> f64 {
-    let o = &spec.observer;
-    let radius = o.torso_radius as Real;
     // The same capsule, at the same place, as the counterfactual's static collider.
-    let capsule = SharedShape::capsule_z(((o.height as Real) / 2.0 - radius).max(0.0), radius);
-    let capsule_pose = Pose::from_translation(Vector::new(
-        o.x as Real,
-        o.y as Real,
-        (o.height / 2.0) as Real,
-    ));
+    let (centre, half, radius) = observer_capsule(&spec.observer, 0.0);
+    let capsule = SharedShape::capsule_z(half, radius);
+    let capsule_pose = Pose::from_translation(centre);
     let parts: Vec<Vec<(Pose, SharedShape)>> = sim
         .dynamic_bodies
         .iter()
