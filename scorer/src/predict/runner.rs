@@ -280,6 +280,7 @@ pub fn run(opts: &PredictOptions, scenes: &[String]) -> Result<Summary> {
         paid_requests: 0,
         paid_before: existing.paid_lines,
     };
+    limit_malloc_arenas();
     let rt = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .max_blocking_threads(std::thread::available_parallelism().map_or(2, |n| n.get()))
@@ -319,6 +320,19 @@ pub fn run(opts: &PredictOptions, scenes: &[String]) -> Result<Summary> {
             s.written
         ))
         .into()),
+    }
+}
+
+/// Makes glibc's malloc use one arena for the process. Prompts are built on blocking
+/// threads and freed on the runtime's workers; with an arena per thread that pattern
+/// fragments memory and the peak RSS grew with the number of scenes (32 → 41 MiB from
+/// 120 to 1,158 scenes; two arenas: 35 → 42 MiB; one: 36 → 36 MiB, at the same
+/// throughput: allocations are few and large). No effect on other allocators.
+fn limit_malloc_arenas() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: mallopt only sets an allocator parameter; M_ARENA_MAX is valid for glibc.
+    unsafe {
+        libc::mallopt(libc::M_ARENA_MAX, 1);
     }
 }
 
