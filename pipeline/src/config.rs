@@ -91,6 +91,14 @@ pub struct ValidatorConfig {
     /// that would need more is redrawn.
     #[serde(default = "default_max_fov_y")]
     pub max_fov_y: f64,
+    /// Hazard pixels the renderer's instance-id pass must count in every model-input
+    /// frame (the measured check of the visibility rule: test `visibility`).
+    #[serde(default = "default_visible_px_min")]
+    pub visible_px_min: u32,
+}
+
+fn default_visible_px_min() -> u32 {
+    64
 }
 
 fn default_max_fov_y() -> f64 {

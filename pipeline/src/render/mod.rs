@@ -8,7 +8,10 @@
 //! * `frames/<scene_id>/<cam>_t0.000.png` … `_t0.600.png` (the same pixels as the video
 //!   frames at those times, before compression);
 //! * `videos/full/<scene_id>.mp4`: the whole simulation from an outside camera, for
-//!   people (never model input).
+//!   people (never model input);
+//! * with `RenderOptions::masks`: `masks/<scene_id>/<cam>_t0.000.png` … (16-bit instance
+//!   ids) and `depth/<scene_id>/<cam>_t….png` (16-bit depth in mm) of the observation
+//!   frames; the id pass behind them always runs and measures the hazard's visibility.
 //!
 //! Entry points: [`Renderer::new`] (one per worker thread, reused across scenes, or
 //! [`with_thread_renderer`]), [`Renderer::render_scene`], and [`contact_sheet`].
@@ -25,6 +28,7 @@
 //! | `lighting` | sun, ambient and the shadow map's projection |
 //! | `camera` | view-projection matrices (basis from `cameras::View`), full-event camera |
 //! | `regions` | shadow-tile rectangle maths: where a moving shadow can change pixels |
+//! | `measure` | the instance-id pass at the observation frames: hazard visibility, masks, depth |
 //! | `gpu` | the wgpu device, pipelines, static cache and overlay drawing |
 //! | `encode` | H.264 encoding through FFmpeg |
 //! | `sheet` | the contact sheet (`rh-pipeline sheet`) |
@@ -35,6 +39,7 @@ mod font;
 mod geometry;
 pub mod gpu;
 mod lighting;
+mod measure;
 pub mod mesh;
 mod observer;
 pub mod recipes;
@@ -47,6 +52,7 @@ use encode::EncodeSettings;
 use std::collections::BTreeMap;
 
 pub use camera::{full_event_camera, view_proj};
+pub use measure::Observed;
 pub use renderer::{render_stage, with_thread_renderer, Renderer};
 pub use rh_contract::layout::{frame_file_name, frame_path};
 pub use rh_contract::{CAMERAS, FRAME_TIMES, FULL_EVENT};
@@ -76,6 +82,8 @@ pub struct RenderOptions {
     /// MSAA samples on a hardware GPU, and on a CPU rasterizer.
     pub msaa: u32,
     pub msaa_cpu: u32,
+    /// Also write the observation frames' instance-id and depth PNGs (`build --masks`).
+    pub masks: bool,
 }
 
 impl RenderOptions {
@@ -91,6 +99,7 @@ impl RenderOptions {
             },
             msaa: c.msaa,
             msaa_cpu: c.msaa_cpu,
+            masks: false,
         }
     }
 }
@@ -108,6 +117,7 @@ impl Default for RenderOptions {
             },
             msaa: 4,
             msaa_cpu: 1,
+            masks: false,
         }
     }
 }
@@ -127,6 +137,9 @@ pub struct RenderedScene {
     /// Full-event frame `j` shows physics step `full_event_steps[j]`.
     pub full_event_steps: Vec<u32>,
     pub full_event_fps: u32,
+    /// The id pass at the observation frames: the hazard's measured visibility per
+    /// camera, and the mask/depth files written (with `RenderOptions::masks`).
+    pub observed: Observed,
 }
 
 impl RenderedScene {

@@ -1,10 +1,12 @@
 //! The wgpu side: device, pipelines (shadow + lit MSAA), render targets per output slot,
 //! and one call that draws a set of views of the current geometry and reads them back.
 
+mod ids;
 mod setup;
 
 use super::mesh::Vertex;
 use super::RenderError;
+pub use ids::{IdImage, IdPass, IdView};
 use std::ops::Range;
 
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
