@@ -6,7 +6,11 @@
 //! taken round-robin over the families). Environment overrides: `RH_BENCH_JOBS`
 //! (workers; default: all cores), `RH_BENCH_PRESET`, `RH_BENCH_THREADS` (x264 threads
 //! per video), `RH_BENCH_MSAA` (samples on any adapter; default: the
-//! configuration's `msaa`, or `msaa_cpu` on a CPU rasterizer).
+//! configuration's `msaa`, or `msaa_cpu` on a CPU rasterizer), `RH_BENCH_MASKS=1` (also
+//! write the mask and depth PNGs, as `build --masks`).
+//!
+//! Also prints the instance-id pass alone (`Renderer::measure_hazard`: the five
+//! observation frames of the three cameras), which every rendered scene runs.
 //!
 //! Prints each scene's own time and the figure that matters for a build: wall-clock
 //! seconds per scene with every worker busy.
@@ -60,7 +64,10 @@ fn main() {
         let sim = simulate(&spec, SimOptions::default());
         scenes.push((spec, sim));
     }
-    let opts = RenderOptions::from_config(&config.render);
+    let opts = RenderOptions {
+        masks: std::env::var_os("RH_BENCH_MASKS").is_some(),
+        ..RenderOptions::from_config(&config.render)
+    };
     let dir = std::env::temp_dir().join(format!("rh-render-bench-{}", std::process::id()));
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
@@ -102,13 +109,22 @@ fn main() {
     });
     let wall = t.elapsed().as_secs_f64();
     let _ = std::fs::remove_dir_all(&dir);
+    // The id pass alone, one scene after another on this thread.
+    let t = Instant::now();
+    for (spec, sim) in &scenes {
+        with_thread_renderer(&opts, |r| r.measure_hazard(spec, sim, &catalog))
+            .unwrap()
+            .unwrap();
+    }
+    let id_pass = t.elapsed().as_secs_f64() / scenes.len().max(1) as f64;
     for (_, line) in &times {
         println!("{line}");
     }
     let count = times.len().max(1) as f64;
     println!(
         "render_throughput: {:.2} s/scene wall-clock over {} scenes with {jobs} workers \
-         (each scene {:.2} s on average; adapter {}, device setup {:.2} s, preset {}, msaa {}, x264 threads {})",
+         (each scene {:.2} s on average; adapter {}, device setup {:.2} s, preset {}, msaa {}, x264 threads {}, masks {}); \
+         instance-id pass alone {id_pass:.3} s/scene on one worker",
         wall / count,
         times.len(),
         times.iter().map(|(s, _)| s).sum::<f64>() / count,
@@ -116,6 +132,7 @@ fn main() {
         setup,
         opts.encode.preset,
         adapters[0].1,
-        opts.encode.threads
+        opts.encode.threads,
+        opts.masks
     );
 }
