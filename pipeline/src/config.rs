@@ -90,7 +90,7 @@ pub struct ValidatorConfig {
     pub energy_gain_absolute: f64,
     pub tunnel_tolerance: f64,
     /// Hazard pixels the renderer's instance-id pass must count in every model-input
-    /// frame (the measured check of the visibility rule: test `visibility`).
+    /// frame (the measured check of the visibility rule: test `render_visibility`).
     #[serde(default = "default_visible_px_min")]
     pub visible_px_min: u32,
     pub frame_margin: f64,
