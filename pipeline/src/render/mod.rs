@@ -8,10 +8,12 @@
 //! * `frames/<scene_id>/<cam>_t0.000.png` … `_t0.600.png` (the same pixels as the video
 //!   frames at those times, before compression);
 //! * `videos/full/<scene_id>.mp4`: the whole simulation from an outside camera, for
-//!   people (never model input);
-//! * with `RenderOptions::masks`: `masks/<scene_id>/<cam>_t0.000.png` … (16-bit instance
-//!   ids) and `depth/<scene_id>/<cam>_t….png` (16-bit depth in mm) of the observation
-//!   frames; the id pass behind them always runs and measures the hazard's visibility.
+//!   people (never model input).
+//!
+//! With `RenderOptions::masks` also `masks/<scene_id>/<cam>_t0.000.png` … (16-bit
+//! instance ids) and `depth/<scene_id>/<cam>_t….png` (16-bit depth in mm) of the
+//! observation frames; the id pass behind them always runs and measures the hazard's
+//! visibility (`RenderedScene::observed`).
 //!
 //! Entry points: [`Renderer::new`] (one per worker thread, reused across scenes, or
 //! [`with_thread_renderer`]), [`Renderer::render_scene`], and [`contact_sheet`].
@@ -75,6 +77,9 @@ pub enum RenderError {
 /// Renderer settings (from the `[render]` config section).
 #[derive(Debug, Clone)]
 pub struct RenderOptions {
+    /// Also write the observation frames' instance-id and depth PNGs (`build --masks`).
+    pub masks: bool,
+
     pub full_width: u32,
     pub full_height: u32,
     pub full_fps: u32,
@@ -82,13 +87,13 @@ pub struct RenderOptions {
     /// MSAA samples on a hardware GPU, and on a CPU rasterizer.
     pub msaa: u32,
     pub msaa_cpu: u32,
-    /// Also write the observation frames' instance-id and depth PNGs (`build --masks`).
-    pub masks: bool,
 }
 
 impl RenderOptions {
     pub fn from_config(c: &RenderConfig) -> RenderOptions {
         RenderOptions {
+            masks: false,
+
             full_width: c.full_width,
             full_height: c.full_height,
             full_fps: c.full_fps,
@@ -99,7 +104,6 @@ impl RenderOptions {
             },
             msaa: c.msaa,
             msaa_cpu: c.msaa_cpu,
-            masks: false,
         }
     }
 }
@@ -107,6 +111,8 @@ impl RenderOptions {
 impl Default for RenderOptions {
     fn default() -> Self {
         RenderOptions {
+            masks: false,
+
             full_width: 640,
             full_height: 360,
             full_fps: 30,
@@ -117,7 +123,6 @@ impl Default for RenderOptions {
             },
             msaa: 4,
             msaa_cpu: 1,
-            masks: false,
         }
     }
 }

@@ -1,8 +1,9 @@
 //! The wgpu side: device, pipelines (shadow + lit MSAA), render targets per output slot,
 //! and one call that draws a set of views of the current geometry and reads them back.
 
-mod ids;
 mod setup;
+
+mod ids;
 
 use super::mesh::Vertex;
 use super::RenderError;
