@@ -154,6 +154,13 @@ pub struct RenderConfig {
     /// cost about 3× the time.
     #[serde(default = "default_msaa_cpu")]
     pub msaa_cpu: u32,
+    /// FXAA-style post-process anti-aliasing where MSAA is off (a CPU rasterizer).
+    #[serde(default = "default_fxaa")]
+    pub fxaa: bool,
+}
+
+fn default_fxaa() -> bool {
+    true
 }
 
 fn default_msaa_cpu() -> u32 {

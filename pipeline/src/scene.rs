@@ -121,7 +121,27 @@ pub fn counterfactual_options(spec: &SceneSpec) -> SimOptions {
     SimOptions {
         observer_collider: true,
         strike_window_steps: (spec.labels.strike_window_s / spec.physics.dt).round() as u32,
+        run_past_strike: false,
     }
+}
+
+/// What the full-event video (`videos/full/<id>.mp4`) shows: the counterfactual of
+/// SPEC §6 — the standing observer as a static collider, what the labels mean — run to
+/// the end of the event rather than stopped after the strike window. `None` when no
+/// body ever comes near the observer: that run is then the plain run (see
+/// [`may_touch_observer`]), which the caller already has. The observation videos and
+/// frames always show the plain run (they end at Δ; in a valid scene nothing reaches the
+/// observer before Δ plus a reaction time). Labels, specs and hashes never depend on this run.
+pub fn full_event_simulation(spec: &SceneSpec, sim: &Simulation) -> Option<Simulation> {
+    may_touch_observer(spec, sim).then(|| {
+        simulate(
+            spec,
+            SimOptions {
+                run_past_strike: true,
+                ..counterfactual_options(spec)
+            },
+        )
+    })
 }
 
 /// Clearance kept beyond the bounding spheres before a body could touch the observer

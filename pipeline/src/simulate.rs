@@ -23,6 +23,10 @@ pub struct SimOptions {
     pub observer_collider: bool,
     /// How long a strike is followed to add up the impulse it delivers (steps).
     pub strike_window_steps: u32,
+    /// Keeps simulating after the strike window (until the scene settles or the
+    /// horizon) instead of stopping there: the full-event video's run. The strike's
+    /// numbers still cover only the window, so they equal the stopping run's.
+    pub run_past_strike: bool,
 }
 
 /// State of one dynamic body at one step (f32, exactly as the solver holds it).
@@ -390,7 +394,9 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         }
         if let Some(observer) = observer_collider {
             let window = options.strike_window_steps;
-            if track_strike(&mut sim, step, &world, hazard_collider, observer, window) {
+            let window_over =
+                track_strike(&mut sim, step, &world, hazard_collider, observer, window);
+            if window_over && !options.run_past_strike {
                 break;
             }
         }
@@ -511,6 +517,9 @@ fn track_strike(
     observer: ColliderHandle,
     window_steps: u32,
 ) -> bool {
+    if sim.strike.is_some_and(|s| step > s.step + window_steps) {
+        return true;
+    }
     if sim.hazard_contacts[step as usize] & TOUCH_OBSERVER != 0 {
         let speed = contact_point_speed(sim, step, world, hazard, observer);
         let strike = sim.strike.get_or_insert(Strike {
@@ -566,4 +575,50 @@ fn hazard_contact_flags(
         };
     }
     flags
+}
+
+/// The deepest any dynamic body of `sim` sinks into the standing observer's body — the
+/// static capsule of the counterfactual run (`simulate` with `observer_collider`) —
+/// over the whole run (m; 0 when nothing touches it). In the plain run the observer is
+/// no body and a hazard may pass through it; in the counterfactual run it stays out up
+/// to the solver's contact tolerance (millimetres).
+pub fn observer_penetration(spec: &SceneSpec, sim: &Simulation) -> f64 {
+    let o = &spec.observer;
+    let radius = o.torso_radius as Real;
+    // The same capsule, at the same place, as the counterfactual's static collider.
+    let capsule = SharedShape::capsule_z(((o.height as Real) / 2.0 - radius).max(0.0), radius);
+    let capsule_pose = Pose::from_translation(Vector::new(
+        o.x as Real,
+        o.y as Real,
+        (o.height / 2.0) as Real,
+    ));
+    let parts: Vec<Vec<(Pose, SharedShape)>> = sim
+        .dynamic_bodies
+        .iter()
+        .map(|&b| posed_parts(&spec.bodies[b].parts))
+        .collect();
+    let mut deepest = 0.0f64;
+    for step in 0..=sim.steps() {
+        for (slot, body_parts) in parts.iter().enumerate() {
+            let s = sim.state(step, slot);
+            let body_pose = Pose::from_parts(
+                Vector::new(s.position[0], s.position[1], s.position[2]),
+                Rotation::from_xyzw(s.rotation[0], s.rotation[1], s.rotation[2], s.rotation[3]),
+            );
+            for (part_pose, shape) in body_parts {
+                let pose = body_pose * *part_pose;
+                let contact = rapier3d::parry::query::contact(
+                    &capsule_pose,
+                    capsule.as_ref(),
+                    &pose,
+                    shape.as_ref(),
+                    0.0,
+                );
+                if let Ok(Some(c)) = contact {
+                    deepest = deepest.max(-(c.dist as f64));
+                }
+            }
+        }
+    }
+    deepest
 }

@@ -7,8 +7,9 @@
 //!   `spec.frame_step(k)`;
 //! * `frames/<scene_id>/<cam>_t0.000.png` … `_t0.600.png` (the same pixels as the video
 //!   frames at those times, before compression);
-//! * `videos/full/<scene_id>.mp4`: the whole simulation from an outside camera, for
-//!   people (never model input).
+//! * `videos/full/<scene_id>.mp4`: the whole event from an outside camera, for people
+//!   (never model input): the counterfactual run with the observer as a body
+//!   (`scene::full_event_simulation`), so what it shows is what the labels mean.
 //!
 //! With `RenderOptions::masks` also `masks/<scene_id>/<cam>_t0.000.png` … (16-bit
 //! instance ids) and `depth/<scene_id>/<cam>_t….png` (16-bit depth in mm) of the
@@ -87,6 +88,8 @@ pub struct RenderOptions {
     /// MSAA samples on a hardware GPU, and on a CPU rasterizer.
     pub msaa: u32,
     pub msaa_cpu: u32,
+    /// FXAA-style post-process anti-aliasing wherever MSAA is off.
+    pub fxaa: bool,
 }
 
 impl RenderOptions {
@@ -104,6 +107,7 @@ impl RenderOptions {
             },
             msaa: c.msaa,
             msaa_cpu: c.msaa_cpu,
+            fxaa: c.fxaa,
         }
     }
 }
@@ -123,6 +127,7 @@ impl Default for RenderOptions {
             },
             msaa: 4,
             msaa_cpu: 1,
+            fxaa: true,
         }
     }
 }
@@ -139,7 +144,8 @@ pub struct RenderedScene {
     /// Observation-video frame `k` shows physics step `frame_steps[k]`.
     pub frame_steps: Vec<u32>,
     pub fps: u32,
-    /// Full-event frame `j` shows physics step `full_event_steps[j]`.
+    /// Full-event frame `j` shows physics step `full_event_steps[j]` of the full-event
+    /// run (`scene::full_event_simulation`, else the plain run).
     pub full_event_steps: Vec<u32>,
     pub full_event_fps: u32,
     /// The id pass at the observation frames: the hazard's measured visibility per
