@@ -6,7 +6,7 @@
 //! state. The same spec gives the same hash in any process, thread count or shard: a
 //! scene is simulated single-threaded, and nothing here reads a clock or a hash map.
 
-use crate::spec::{BodyKind, JointKind, PartSpec, SceneSpec, ShapeSpec};
+use crate::spec::{BodyKind, JointKind, ObserverSpec, PartSpec, SceneSpec, ShapeSpec};
 use rapier3d::prelude::*;
 use sha2::{Digest, Sha256};
 
@@ -204,6 +204,24 @@ impl Obstacles {
         Obstacles { parts }
     }
 
+    /// Adds the observer's collision capsule (see `observer_capsule`), its radius widened
+    /// by `inflate` (m), as one more obstacle.
+    pub fn with_observer(mut self, observer: &ObserverSpec, inflate: f64) -> Obstacles {
+        let (centre, half, radius) = observer_capsule(observer, inflate);
+        self.parts.push((
+            Pose::from_parts(centre, Rotation::IDENTITY),
+            SharedShape::capsule_z(half, radius),
+        ));
+        self
+    }
+
+    /// Whether `p` lies inside one of the obstacles.
+    pub fn contains(&self, p: [f64; 3]) -> bool {
+        self.parts
+            .iter()
+            .any(|(pose, shape)| shape.contains_point(pose, v3(p)))
+    }
+
     /// Whether the straight segment from `a` to `b` passes through a fixed body.
     pub fn blocks(&self, a: [f64; 3], b: [f64; 3]) -> bool {
         let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
@@ -216,6 +234,17 @@ impl Obstacles {
             .iter()
             .any(|(pose, shape)| shape.cast_ray(pose, &ray, length as Real, true).is_some())
     }
+}
+
+/// The observer's body as a collider (the counterfactual of SPEC §6; the one definition
+/// of its geometry): a vertical capsule of the torso radius from the floor to the top of
+/// the head, as (centre, half height of the segment, radius); `inflate` widens the radius
+/// (line-of-sight queries use it to cover the drawn limbs).
+fn observer_capsule(o: &ObserverSpec, inflate: f64) -> (Vector, Real, Real) {
+    let radius = o.torso_radius as Real;
+    let half = ((o.height as Real) / 2.0 - radius).max(0.0);
+    let centre = Vector::new(o.x as Real, o.y as Real, (o.height / 2.0) as Real);
+    (centre, half, radius + inflate as Real)
 }
 
 /// Height of a collider's lowest point: the tightest of its parts' bounding boxes (a
@@ -294,16 +323,10 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
     insert_joints(&mut world, spec, &body_handles);
 
     let observer_collider = options.observer_collider.then(|| {
-        let o = &spec.observer;
-        let radius = o.torso_radius as Real;
-        let half = ((o.height as Real) / 2.0 - radius).max(0.0);
+        let (centre, half, radius) = observer_capsule(&spec.observer, 0.0);
         world
             .insert(
-                RigidBodyBuilder::fixed().translation(Vector::new(
-                    o.x as Real,
-                    o.y as Real,
-                    (o.height / 2.0) as Real,
-                )),
+                RigidBodyBuilder::fixed().translation(centre),
                 ColliderBuilder::capsule_z(half, radius),
             )
             .1
@@ -583,15 +606,10 @@ fn hazard_contact_flags(
 /// no body and a hazard may pass through it; in the counterfactual run it stays out up
 /// to the solver's contact tolerance (millimetres).
 pub fn observer_penetration(spec: &SceneSpec, sim: &Simulation) -> f64 {
-    let o = &spec.observer;
-    let radius = o.torso_radius as Real;
     // The same capsule, at the same place, as the counterfactual's static collider.
-    let capsule = SharedShape::capsule_z(((o.height as Real) / 2.0 - radius).max(0.0), radius);
-    let capsule_pose = Pose::from_translation(Vector::new(
-        o.x as Real,
-        o.y as Real,
-        (o.height / 2.0) as Real,
-    ));
+    let (centre, half, radius) = observer_capsule(&spec.observer, 0.0);
+    let capsule = SharedShape::capsule_z(half, radius);
+    let capsule_pose = Pose::from_translation(centre);
     let parts: Vec<Vec<(Pose, SharedShape)>> = sim
         .dynamic_bodies
         .iter()
