@@ -18,6 +18,7 @@ pub fn data_type(ty: ColumnType) -> DataType {
         }
         ColumnType::Utf8List => list(DataType::Utf8),
         ColumnType::UInt32List => list(DataType::UInt32),
+        ColumnType::Float64List => list(DataType::Float64),
         ColumnType::Vec4F32List => list(DataType::FixedSizeList(
             Arc::new(Field::new("item", DataType::Float32, false)),
             4,

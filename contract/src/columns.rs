@@ -17,6 +17,8 @@ pub enum ColumnType {
     Utf8List,
     /// List of uint32.
     UInt32List,
+    /// List of float64.
+    Float64List,
     /// List of fixed-size lists of 4 non-null float32 (`[t, x, y, z]` samples).
     Vec4F32List,
 }
@@ -97,6 +99,26 @@ pub const VALIDATOR_COLUMNS: [&str; 7] = [
     col::VALID_INTENDED_EVENT,
     col::VALID_REACTION_TIME,
 ];
+
+/// The `<cam>_hazard_visible_px` column of a camera (`CAMERAS`).
+pub fn visible_px_column(camera: &str) -> String {
+    format!("{camera}_hazard_visible_px")
+}
+
+/// The `<cam>_hazard_unoccluded_fraction` column of a camera.
+pub fn unoccluded_column(camera: &str) -> String {
+    format!("{camera}_hazard_unoccluded_fraction")
+}
+
+/// The `<cam>_mask_paths` column of a camera (instance-id PNGs, `build --masks`).
+pub fn mask_paths_column(camera: &str) -> String {
+    format!("{camera}_mask_paths")
+}
+
+/// The `<cam>_depth_paths` column of a camera (depth PNGs, `build --masks`).
+pub fn depth_paths_column(camera: &str) -> String {
+    format!("{camera}_depth_paths")
+}
 
 /// The `<cam>_file_name` column of a camera (`CAMERAS`) or of `full_event`.
 pub fn video_column(camera: &str) -> String {
@@ -433,6 +455,78 @@ pub const COLUMNS: &[Column] = &[
         false,
         "Hazard centre of mass [t (s), x, y, z (m)] over the whole simulation (t = 0 to its last step), sampled at the video rate (every 1/fps s, physics step round(t / dt)); the first entries, t ≤ the observation window, match the camera videos' frames (float32)",
     ),
+    c(
+        "ego_hazard_visible_px",
+        UInt32List,
+        true,
+        "Measured by the renderer's instance-id pass: pixels of the `ego` camera's image that show the hazard at each observation time t = 0, 0.15, 0.30, 0.45, 0.60 s (one value per time; the PNG frames' times); null when not rendered",
+    ),
+    c(
+        "closeup_hazard_visible_px",
+        UInt32List,
+        true,
+        "Measured by the renderer's instance-id pass: pixels of the `closeup` camera's image that show the hazard at each observation time t = 0, 0.15, 0.30, 0.45, 0.60 s (one value per time; the PNG frames' times); null when not rendered",
+    ),
+    c(
+        "overhead_hazard_visible_px",
+        UInt32List,
+        true,
+        "Measured by the renderer's instance-id pass: pixels of the `overhead` camera's image that show the hazard at each observation time t = 0, 0.15, 0.30, 0.45, 0.60 s (one value per time; the PNG frames' times); null when not rendered",
+    ),
+    c(
+        "ego_hazard_unoccluded_fraction",
+        Float64List,
+        true,
+        "Per observation time: `ego_hazard_visible_px` divided by the pixels the hazard covers in the `ego` image when drawn with nothing else (1 = nothing in front of it; 0 when it covers no pixel of the image); null when not rendered",
+    ),
+    c(
+        "closeup_hazard_unoccluded_fraction",
+        Float64List,
+        true,
+        "Per observation time: `closeup_hazard_visible_px` divided by the pixels the hazard covers in the `closeup` image when drawn with nothing else (1 = nothing in front of it; 0 when it covers no pixel of the image); null when not rendered",
+    ),
+    c(
+        "overhead_hazard_unoccluded_fraction",
+        Float64List,
+        true,
+        "Per observation time: `overhead_hazard_visible_px` divided by the pixels the hazard covers in the `overhead` image when drawn with nothing else (1 = nothing in front of it; 0 when it covers no pixel of the image); null when not rendered",
+    ),
+    c(
+        "ego_mask_paths",
+        Utf8List,
+        true,
+        "Relative paths `masks/<scene_id>/ego_t0.000.png` … `_t0.600.png`: 16-bit instance-id images of the `ego` observation frames (0 = room and background, i + 1 = spec body i, 65534 = ropes, 65535 = observer); null unless built with `--masks`",
+    ),
+    c(
+        "closeup_mask_paths",
+        Utf8List,
+        true,
+        "Relative paths `masks/<scene_id>/closeup_t0.000.png` … `_t0.600.png`: 16-bit instance-id images of the `closeup` observation frames (0 = room and background, i + 1 = spec body i, 65534 = ropes, 65535 = observer); null unless built with `--masks`",
+    ),
+    c(
+        "overhead_mask_paths",
+        Utf8List,
+        true,
+        "Relative paths `masks/<scene_id>/overhead_t0.000.png` … `_t0.600.png`: 16-bit instance-id images of the `overhead` observation frames (0 = room and background, i + 1 = spec body i, 65534 = ropes, 65535 = observer); null unless built with `--masks`",
+    ),
+    c(
+        "ego_depth_paths",
+        Utf8List,
+        true,
+        "Relative paths `depth/<scene_id>/ego_t0.000.png` … `_t0.600.png`: 16-bit depth images of the `ego` observation frames, Euclidean distance from the camera centre in millimetres (0 = no surface); null unless built with `--masks`",
+    ),
+    c(
+        "closeup_depth_paths",
+        Utf8List,
+        true,
+        "Relative paths `depth/<scene_id>/closeup_t0.000.png` … `_t0.600.png`: 16-bit depth images of the `closeup` observation frames, Euclidean distance from the camera centre in millimetres (0 = no surface); null unless built with `--masks`",
+    ),
+    c(
+        "overhead_depth_paths",
+        Utf8List,
+        true,
+        "Relative paths `depth/<scene_id>/overhead_t0.000.png` … `_t0.600.png`: 16-bit depth images of the `overhead` observation frames, Euclidean distance from the camera centre in millimetres (0 = no surface); null unless built with `--masks`",
+    ),
 ];
 
 /// The column called `name`.
@@ -461,6 +555,12 @@ mod tests {
         }
         for v in VALIDATOR_COLUMNS {
             assert_eq!(column(v).unwrap().ty, Bool);
+        }
+        for cam in CAMERAS {
+            assert_eq!(column(&visible_px_column(cam)).unwrap().ty, UInt32List);
+            assert_eq!(column(&unoccluded_column(cam)).unwrap().ty, Float64List);
+            assert_eq!(column(&mask_paths_column(cam)).unwrap().ty, Utf8List);
+            assert_eq!(column(&depth_paths_column(cam)).unwrap().ty, Utf8List);
         }
     }
 }

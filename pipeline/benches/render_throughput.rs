@@ -11,6 +11,10 @@
 //!
 //! Prints each scene's own time and the figure that matters for a build: wall-clock
 //! seconds per scene with every worker busy.
+//!
+//! `RH_BENCH_MASKS=1` also writes the mask and depth PNGs (as `build --masks`). The
+//! instance-id pass alone (`Renderer::measure_hazard`: the five observation frames of
+//! the three cameras), which every rendered scene runs, is timed last.
 
 use rayon::prelude::*;
 use rh_catalog::Catalog;
@@ -64,7 +68,10 @@ fn main() {
         let sim = simulate(&spec, SimOptions::default());
         scenes.push((spec, sim));
     }
-    let opts = RenderOptions::from_config(&config.render);
+    let opts = RenderOptions {
+        masks: std::env::var_os("RH_BENCH_MASKS").is_some(),
+        ..RenderOptions::from_config(&config.render)
+    };
     let dir = std::env::temp_dir().join(format!("rh-render-bench-{}", std::process::id()));
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
@@ -106,6 +113,14 @@ fn main() {
     });
     let wall = t.elapsed().as_secs_f64();
     let _ = std::fs::remove_dir_all(&dir);
+    // The id pass alone, one scene after another on this thread.
+    let t = Instant::now();
+    for (spec, sim) in &scenes {
+        with_thread_renderer(&opts, |r| r.measure_hazard(spec, sim, &catalog))
+            .unwrap()
+            .unwrap();
+    }
+    let id_pass = t.elapsed().as_secs_f64() / scenes.len().max(1) as f64;
     for (_, line) in &times {
         println!("{line}");
     }
@@ -122,5 +137,9 @@ fn main() {
         adapters[0].1,
         opts.fxaa,
         opts.encode.threads
+    );
+    println!(
+        "render_throughput: masks {}; instance-id pass alone {id_pass:.3} s/scene on one worker",
+        opts.masks
     );
 }

@@ -50,6 +50,8 @@ pub struct BuildOptions {
     /// `(i, N)`: build only the groups `g` with `g mod N == i`.
     pub shard: (u64, u64),
     pub render: bool,
+    /// Also write the observation frames' instance-id and depth PNGs (needs `render`).
+    pub masks: bool,
     pub progress: bool,
 }
 
@@ -102,6 +104,11 @@ pub fn check_options(
             "--shard {}/{}: need 0 <= i < N",
             opts.shard.0, opts.shard.1
         )));
+    }
+    if opts.masks && !opts.render {
+        return Err(BuildError::Input(
+            "--masks writes the rendered frames' segmentation and depth; it cannot be combined with --no-render".into(),
+        ));
     }
     if opts.families.is_empty() {
         return Err(BuildError::Input(
@@ -286,7 +293,7 @@ fn remove_stale_temporaries(out: &Path) {
         .iter()
         .map(|sub| out.join(sub))
         .collect();
-    for media in ["videos", "frames"] {
+    for media in ["videos", "frames", "masks", "depth"] {
         if let Ok(entries) = std::fs::read_dir(out.join(media)) {
             dirs.extend(entries.flatten().map(|e| e.path()).filter(|p| p.is_dir()));
         }
@@ -448,6 +455,7 @@ pub fn build(
         config,
     );
     manifest.selections = opts.selections.clone();
+    manifest.masks = opts.masks;
     let out = &opts.out;
     std::fs::create_dir_all(out)
         .map_err(|e| BuildError::Input(format!("cannot write to --out {}: {e}", out.display())))?;
@@ -478,7 +486,10 @@ pub fn build(
 
     // Stage 4 for the DAG driver (`scene::run_group`): a valid scene's videos and frames.
     #[cfg(feature = "render")]
-    let render_opts = crate::render::RenderOptions::from_config(&config.render);
+    let render_opts = crate::render::RenderOptions {
+        masks: opts.masks,
+        ..crate::render::RenderOptions::from_config(&config.render)
+    };
     #[cfg(feature = "render")]
     let render_stage = |r: &crate::scene::SceneResult| {
         crate::render::render_stage(r, catalog, &render_opts, out)

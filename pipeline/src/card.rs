@@ -325,6 +325,7 @@ pub fn render(input: &CardInput) -> String {
         },
     );
 
+    v.insert("masks_note", masks_note(m.masks));
     v.insert("family_table", family_table(input, &counts, total_eval));
 
     v.insert("features_table", features_table());
@@ -353,7 +354,11 @@ fn insert_provenance(input: &CardInput, v: &mut BTreeMap<&str, String>) {
             m.families.join(", "),
             m.shard[0],
             m.shard[1],
-            if m.render { "yes (valid scenes)" } else { "no (--no-render)" },
+            match (m.render, m.masks) {
+                (true, true) => "yes (valid scenes), with masks and depth (--masks)",
+                (true, false) => "yes (valid scenes)",
+                _ => "no (--no-render)",
+            },
             if default_config { "the default `configs/default.toml`" } else { "custom" },
             m.config_sha256,
             m.catalog_sha256,
@@ -378,7 +383,11 @@ fn insert_provenance(input: &CardInput, v: &mut BTreeMap<&str, String>) {
             m.n,
             m.seed,
             m.families.join(","),
-            if m.render { "" } else { " --no-render" },
+            match (m.render, m.masks) {
+                (true, true) => " --masks",
+                (true, false) => "",
+                _ => " --no-render",
+            },
             if m.is_whole() {
                 String::new()
             } else {
@@ -386,6 +395,29 @@ fn insert_provenance(input: &CardInput, v: &mut BTreeMap<&str, String>) {
             }
         ),
     );
+}
+
+/// What the measured-visibility columns mean, and the masks and depth of `--masks`.
+fn masks_note(masks: bool) -> String {
+    use rh_contract::layout::instance;
+    let mut s = format!(
+        "**Measured visibility.** For every rendered scene the renderer draws an instance-id          image of each camera at the five observation times (unlit, one sample per pixel,          the same geometry as the frames: the ego camera sits in the observer's head and          does not see its own body). `<cam>_hazard_visible_px` counts the pixels that show          the hazard; `<cam>_hazard_unoccluded_fraction` divides them by the pixels the          hazard covers when drawn with nothing else (1 = nothing in front of it; 0 when it          projects to no pixel of the image). Both are null for unrendered scenes.
+
+         **Segmentation and depth.** Instance ids: {} = room (floor, walls, ceiling) and          empty background; `i + 1` = the spec's body `bodies[i]` (the hazard is          `hazard + 1`); {} = ropes and rods drawn along joints; {} = the observer's body.          Depth: Euclidean distance of the surface from the camera centre in millimetres          (round(d · 1000); 0 = no surface, 65535 = 65.535 m or more). ",
+        instance::ROOM,
+        instance::ROPE,
+        instance::OBSERVER
+    );
+    if masks {
+        s.push_str(
+            "This build has them (`--masks`): `masks/<scene_id>/<cam>_t0.000.png` … and              `depth/<scene_id>/<cam>_t0.000.png` … (16-bit greyscale PNG, the size of the              frames), named by the `<cam>_mask_paths` and `<cam>_depth_paths` columns in              `FRAME_TIMES` order.",
+        );
+    } else {
+        s.push_str(
+            "This build has none: they are written by `rh-pipeline build --masks`, and the              `<cam>_mask_paths` / `<cam>_depth_paths` columns are null.",
+        );
+    }
+    s
 }
 
 /// The per-family table, in the build's family order (label counts over valid scenes).

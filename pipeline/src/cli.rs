@@ -57,6 +57,12 @@ pub enum Command {
         /// Skip rendering (videos and frames); labels, specs and Parquet only.
         #[arg(long)]
         no_render: bool,
+        /// Also write each observation frame's segmentation and depth: 16-bit PNGs of
+        /// instance ids (`masks/<scene_id>/<cam>_t….png`) and of the distance from the
+        /// camera in mm (`depth/…`), named by the `<cam>_mask_paths` / `<cam>_depth_paths`
+        /// columns.
+        #[arg(long, conflicts_with = "no_render")]
+        masks: bool,
         /// Build only shard i of N (scene groups g with g mod N = i), e.g. 0/4.
         #[arg(long, value_name = "i/N")]
         shard: Option<String>,
@@ -576,6 +582,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             seed,
             families,
             no_render,
+            masks,
             shard,
             jobs,
             json,
@@ -627,6 +634,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                     None => (0, 1),
                 },
                 render: !no_render,
+                masks,
                 progress: !quiet,
             };
             run_build(&opts, &catalog, &config, json)

@@ -77,6 +77,10 @@ pub struct ObserverConfig {
     pub max_walk_speed: f64,
 }
 
+fn default_visible_px_min() -> u32 {
+    64
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ValidatorConfig {
@@ -85,6 +89,10 @@ pub struct ValidatorConfig {
     pub energy_gain_relative: f64,
     pub energy_gain_absolute: f64,
     pub tunnel_tolerance: f64,
+    /// Hazard pixels the renderer's instance-id pass must count in every model-input
+    /// frame (the measured check of the visibility rule: test `render_visibility`).
+    #[serde(default = "default_visible_px_min")]
+    pub visible_px_min: u32,
     pub frame_margin: f64,
     pub frame_check_until_within: f64,
     /// The widest vertical field of view a camera may be given (rad); a camera draw

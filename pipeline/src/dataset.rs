@@ -233,12 +233,14 @@ pub fn record_batch(results: &[SceneResult], catalog: &Catalog) -> RecordBatch {
         trajectories.append(true);
     }
     columns.push(Arc::new(trajectories.finish()));
+    columns.extend(crate::media::measured_columns(results));
     RecordBatch::try_new(Arc::new(schema()), columns).expect("columns match the schema")
 }
 
 /// Every file a row refers to, relative to the dataset root: its spec, its videos
 /// (`<cam>_file_name`, `full_event_file_name`) and, for a rendered scene, its observation
-/// frames (`frames/<scene_id>/<cam>_t….png`). Row order, then the order above.
+/// frames (`frames/<scene_id>/<cam>_t….png`) and, built with `--masks`, its mask and
+/// depth images (`<cam>_mask_paths`, `<cam>_depth_paths`). Row order, then the order above.
 pub fn referenced_files(batch: &RecordBatch) -> Vec<String> {
     let ids = string_column(batch, "scene_id");
     let specs = string_column(batch, "spec_file");
@@ -260,6 +262,7 @@ pub fn referenced_files(batch: &RecordBatch) -> Vec<String> {
         if rendered {
             files.extend(frame_files(id));
         }
+        files.extend(crate::media::mask_files(batch, row));
     }
     files
 }

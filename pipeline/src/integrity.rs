@@ -137,7 +137,9 @@ pub fn read_group_sums(record: &Path) -> Option<FileSums> {
 /// someone added them after the build.
 pub fn unlisted(root: &Path, sums: &FileSums) -> Vec<String> {
     let mut extra = Vec::new();
-    for top in ["data", "eval", "specs", "videos", "frames"] {
+    for top in [
+        "data", "eval", "specs", "videos", "frames", "masks", "depth",
+    ] {
         let mut stack = vec![root.join(top)];
         while let Some(dir) = stack.pop() {
             let Ok(entries) = std::fs::read_dir(&dir) else {

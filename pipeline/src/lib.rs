@@ -25,6 +25,7 @@ pub mod integrity;
 pub mod label;
 pub mod llm_plan;
 pub mod manifest;
+pub mod media;
 pub mod merge;
 pub mod selection;
 /// The old name of [`selection`], kept so that code written against `plan` still builds.

@@ -30,6 +30,10 @@ pub struct Manifest {
     pub shard: [u64; 2],
     /// Whether videos and frames were requested.
     pub render: bool,
+    /// Whether the observation frames' mask and depth PNGs were requested (`--masks`;
+    /// absent when not, so manifests without masks read as before).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub masks: bool,
     /// SHA-256 of the configuration below, as JSON.
     pub config_sha256: String,
     /// SHA-256 of the catalog (objects and rooms) the scenes were drawn from.
@@ -85,6 +89,7 @@ impl Manifest {
             families: families.to_vec(),
             shard: [shard.0, shard.1],
             render,
+            masks: false,
             config_sha256: config_sha256(config),
             catalog_sha256: catalog_sha256(catalog),
             config: serde_json::to_value(config).expect("config serializes"),
@@ -167,6 +172,7 @@ impl Manifest {
             format!("{}/{}", other.shard[0], other.shard[1]),
         );
         cmp("render", self.render.to_string(), other.render.to_string());
+        cmp("masks", self.masks.to_string(), other.masks.to_string());
         if self.config_sha256 != other.config_sha256 || self.config != other.config {
             d.push("configuration".into());
         }

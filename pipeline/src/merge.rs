@@ -31,17 +31,24 @@ fn input(msg: String) -> BuildError {
     BuildError::Input(msg)
 }
 
-/// The columns a shard's checks and file copies read (`dataset::referenced_files`); the
-/// full rows are streamed from the shard files by `finalize` instead of held in memory.
-const FILE_COLUMNS: [&str; 7] = [
-    "scene_id",
-    "scene_index",
-    "spec_file",
-    "ego_file_name",
-    "closeup_file_name",
-    "overhead_file_name",
-    "full_event_file_name",
-];
+/// The columns a shard's checks and file copies read (`dataset::referenced_files`: specs,
+/// videos, and the mask/depth path lists); the full rows are streamed from the shard
+/// files by `finalize` instead of held in memory.
+fn file_columns() -> Vec<String> {
+    [
+        "scene_id",
+        "scene_index",
+        "spec_file",
+        "ego_file_name",
+        "closeup_file_name",
+        "overhead_file_name",
+        "full_event_file_name",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .chain(crate::media::path_columns())
+    .collect()
+}
 
 /// Reads and checks one shard directory; returns its manifest and its rows' scene ids,
 /// indices and file columns.
@@ -64,7 +71,9 @@ fn read_shard(dir: &Path) -> Result<(Manifest, arrow::array::RecordBatch), Build
             manifest.shard[1]
         )));
     }
-    let rows = dataset::read_columns(&data, &FILE_COLUMNS).map_err(input)?;
+    let columns = file_columns();
+    let names: Vec<&str> = columns.iter().map(String::as_str).collect();
+    let rows = dataset::read_columns(&data, &names).map_err(input)?;
     let indices = dataset::u64_column(&rows, "scene_index");
     let expected: Vec<u64> = manifest
         .groups()

@@ -36,6 +36,13 @@ pub struct SceneMedia {
     pub videos: std::collections::BTreeMap<String, String>,
     /// `videos/full/<scene_id>.mp4`.
     pub full_event: String,
+    /// Camera name → the hazard measured in its observation frames (instance-id pass).
+    pub visibility: std::collections::BTreeMap<String, crate::media::HazardVisibility>,
+    /// Camera name → `masks/<scene_id>/<cam>_t….png` at `FRAME_TIMES` (empty without
+    /// `build --masks`).
+    pub masks: std::collections::BTreeMap<String, Vec<String>>,
+    /// Camera name → `depth/<scene_id>/<cam>_t….png` at `FRAME_TIMES` (likewise).
+    pub depth: std::collections::BTreeMap<String, Vec<String>>,
 }
 
 /// Stage 4 (render) as the DAG driver sees it: writes a labelled scene's videos and

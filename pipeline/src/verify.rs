@@ -17,7 +17,7 @@ use crate::dataset;
 use crate::integrity::{self, FileProblem};
 use crate::manifest::{catalog_sha256, Manifest, MANIFEST_FILE};
 use crate::plan::plan_group;
-use crate::scene::{produce_group, SceneMedia, SceneResult};
+use crate::scene::{produce_group, SceneResult};
 use crate::simulate::{simulate, SimOptions};
 use crate::spec::SceneSpec;
 use arrow::array::{Array, RecordBatch};
@@ -249,22 +249,9 @@ fn check_group(
     }
     // Media file names are not derived (rendering is not redone): take them from the
     // row; the files themselves are covered by their checksums.
-    let media_columns: Vec<Vec<Option<String>>> = crate::cameras::CAMERA_NAMES
-        .iter()
-        .map(|c| format!("{c}_file_name"))
-        .chain(["full_event_file_name".to_string()])
-        .map(|c| dataset::optional_string_column(stored, &c))
-        .collect();
+    // So are the renderer's measurements (visible pixels) and the mask/depth files.
     for (row, r) in results.iter_mut().enumerate() {
-        let full = media_columns.last().expect("full column")[row].clone();
-        r.media = full.map(|full_event| SceneMedia {
-            videos: crate::cameras::CAMERA_NAMES
-                .iter()
-                .zip(&media_columns)
-                .filter_map(|(c, col)| col[row].clone().map(|v| (c.to_string(), v)))
-                .collect(),
-            full_event,
-        });
+        r.media = crate::media::media_of_row(stored, row);
     }
     let derived = dataset::record_batch(results, catalog);
     for (i, field) in derived.schema().fields().iter().enumerate() {

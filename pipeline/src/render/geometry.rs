@@ -15,6 +15,7 @@ use crate::simulate::Simulation;
 use crate::spec::vec3::{add, norm, sub};
 use crate::spec::{BodyKind, CameraSpec, JointKind, SceneSpec, Vec3};
 use rh_catalog::Catalog;
+use rh_contract::layout::instance;
 use std::ops::Range;
 
 /// One static mesh piece: its vertices in `statics`, its bounding box, and the
@@ -65,6 +66,8 @@ struct Wall {
 struct DynamicBody {
     slot: usize,
     hazard: bool,
+    /// Instance id (`rh_contract::layout::instance::body` of its spec index).
+    id: u16,
     mesh: Mesh,
 }
 
@@ -96,6 +99,8 @@ pub(super) struct SceneGeometry {
     pieces: Vec<Piece>,
     /// Distance (m) from a shadow volume within which shading may depend on it.
     shadow_reach: f64,
+    /// Each fixed body's vertex range with its instance id (the id pass: `ids`).
+    fixed_ids: Vec<(Range<u32>, u16)>,
 }
 
 fn fixed_color(name: &str, wall: Rgba) -> Rgba {
@@ -130,7 +135,13 @@ impl SceneGeometry {
         let floor_c = mat(hex(&room.floor_color), MAT_FLOOR);
 
         // Fixed bodies (furniture, event geometry) and the observer: shadow casters.
-        for body in spec.bodies.iter().filter(|b| b.kind == BodyKind::Fixed) {
+        let mut fixed_ids = Vec::new();
+        for (bi, body) in spec
+            .bodies
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| b.kind == BodyKind::Fixed)
+        {
             let mesh = match body
                 .catalog_id
                 .as_deref()
@@ -146,6 +157,7 @@ impl SceneGeometry {
             };
             let from = statics.len();
             mesh.transformed_into(&Xf::from_quat(body.rotation, body.position), &mut statics);
+            fixed_ids.push((from as u32..statics.len() as u32, instance::body(bi)));
             pieces.extend(piece(&statics, from));
         }
         let fixed = 0..statics.len() as u32;
@@ -180,6 +192,7 @@ impl SceneGeometry {
             background: [0.04, 0.045, 0.05, 1.0],
             pieces,
             shadow_reach: light.shadow_reach,
+            fixed_ids,
         }
     }
 
@@ -342,6 +355,38 @@ impl SceneGeometry {
         }
     }
 
+    /// The static ranges `cam` sees (`ranges_for`) split by instance id: each fixed body
+    /// its own, the observer `OBSERVER`, the room shell `ROOM`.
+    pub(super) fn id_ranges_for(&self, cam: &CameraSpec) -> Vec<(Range<u32>, u16)> {
+        let mut out = Vec::new();
+        for r in self.ranges_for(cam) {
+            if r == self.fixed {
+                out.extend(self.fixed_ids.iter().cloned());
+            } else if r == self.observer {
+                out.push((r, instance::OBSERVER));
+            } else {
+                out.push((r, instance::ROOM));
+            }
+        }
+        out
+    }
+
+    /// The moving geometry uploaded at `dynamic` (from `dynamic_at`) split by instance id:
+    /// each body its own, the ropes after them `ROPE`.
+    pub(super) fn dynamic_ids(&self, dynamic: &Range<u32>) -> Vec<(Range<u32>, u16)> {
+        let mut out = Vec::new();
+        let mut at = dynamic.start;
+        for d in &self.dynamic {
+            let end = at + d.mesh.verts.len() as u32;
+            out.push((at..end, d.id));
+            at = end;
+        }
+        if at < dynamic.end {
+            out.push((at..dynamic.end, instance::ROPE));
+        }
+        out
+    }
+
     fn uniforms(&self, cam: &CameraSpec, shading: Shading) -> Uniforms {
         Uniforms {
             view_proj: view_proj(cam),
@@ -484,6 +529,7 @@ fn moving_bodies(
         dynamic.push(DynamicBody {
             slot,
             hazard: bi == spec.hazard,
+            id: instance::body(bi),
             mesh,
         });
     }

@@ -11,6 +11,11 @@
 //!   (never model input): the counterfactual run with the observer as a body
 //!   (`scene::full_event_simulation`), so what it shows is what the labels mean.
 //!
+//! With `RenderOptions::masks` also `masks/<scene_id>/<cam>_t0.000.png` … (16-bit
+//! instance ids) and `depth/<scene_id>/<cam>_t….png` (16-bit depth in mm) of the
+//! observation frames; the id pass behind them always runs and measures the hazard's
+//! visibility (`RenderedScene::observed`).
+//!
 //! Entry points: [`Renderer::new`] (one per worker thread, reused across scenes, or
 //! [`with_thread_renderer`]), [`Renderer::render_scene`], and [`contact_sheet`].
 //! Every file is written atomically (temporary sibling + rename).
@@ -26,6 +31,7 @@
 //! | `lighting` | sun, ambient and the shadow map's projection |
 //! | `camera` | view-projection matrices (basis from `cameras::View`), full-event camera |
 //! | `regions` | shadow-tile rectangle maths: where a moving shadow can change pixels |
+//! | `measure` | the instance-id pass at the observation frames: hazard visibility, masks, depth |
 //! | `gpu` | the wgpu device, pipelines, static cache and overlay drawing |
 //! | `encode` | H.264 encoding through FFmpeg |
 //! | `sheet` | the contact sheet (`rh-pipeline sheet`) |
@@ -36,6 +42,7 @@ mod font;
 mod geometry;
 pub mod gpu;
 mod lighting;
+mod measure;
 pub mod mesh;
 mod observer;
 pub mod recipes;
@@ -48,6 +55,7 @@ use encode::EncodeSettings;
 use std::collections::BTreeMap;
 
 pub use camera::{full_event_camera, view_proj};
+pub use measure::Observed;
 pub use renderer::{render_stage, with_thread_renderer, Renderer};
 pub use rh_contract::layout::{frame_file_name, frame_path};
 pub use rh_contract::{CAMERAS, FRAME_TIMES, FULL_EVENT};
@@ -70,6 +78,9 @@ pub enum RenderError {
 /// Renderer settings (from the `[render]` config section).
 #[derive(Debug, Clone)]
 pub struct RenderOptions {
+    /// Also write the observation frames' instance-id and depth PNGs (`build --masks`).
+    pub masks: bool,
+
     pub full_width: u32,
     pub full_height: u32,
     pub full_fps: u32,
@@ -84,6 +95,8 @@ pub struct RenderOptions {
 impl RenderOptions {
     pub fn from_config(c: &RenderConfig) -> RenderOptions {
         RenderOptions {
+            masks: false,
+
             full_width: c.full_width,
             full_height: c.full_height,
             full_fps: c.full_fps,
@@ -102,6 +115,8 @@ impl RenderOptions {
 impl Default for RenderOptions {
     fn default() -> Self {
         RenderOptions {
+            masks: false,
+
             full_width: 640,
             full_height: 360,
             full_fps: 30,
@@ -133,6 +148,9 @@ pub struct RenderedScene {
     /// run (`scene::full_event_simulation`, else the plain run).
     pub full_event_steps: Vec<u32>,
     pub full_event_fps: u32,
+    /// The id pass at the observation frames: the hazard's measured visibility per
+    /// camera, and the mask/depth files written (with `RenderOptions::masks`).
+    pub observed: Observed,
 }
 
 impl RenderedScene {

@@ -18,8 +18,10 @@ use std::path::{Path, PathBuf};
 
 /// The wgpu device and pipelines; create one per worker thread and reuse it.
 pub struct Renderer {
-    gpu: Gpu,
+    pub(super) gpu: Gpu,
     opts: RenderOptions,
+    /// The instance-id pass (`measure`), built on first use.
+    pub(super) ids: Option<super::gpu::IdPass>,
 }
 
 thread_local! {
@@ -49,7 +51,11 @@ impl Renderer {
     pub fn new(opts: RenderOptions) -> Result<Renderer, RenderError> {
         encode::init().map_err(RenderError::Encode)?;
         let gpu = Gpu::new(opts.msaa, opts.msaa_cpu, opts.fxaa)?;
-        Ok(Renderer { gpu, opts })
+        Ok(Renderer {
+            gpu,
+            opts,
+            ids: None,
+        })
     }
 
     pub fn adapter_name(&self) -> &str {
@@ -104,6 +110,11 @@ impl Renderer {
             .map(|(slot, cam)| scene.fixed_view(slot, cam))
             .collect();
         let (window_views, full_view) = fixed_views.split_at(cams.len());
+        // The id pass at the observation frames: measured visibility, and the mask and
+        // depth PNGs (written on their own thread while the frames below render).
+        let masks_root = self.opts.masks.then_some(out_dir);
+        let (observed, pngs) = self.observe(spec, sim, &scene, &cams, masks_root)?;
+        let mask_thread = super::measure::write_pngs(pngs);
 
         let fps = spec.video.fps;
         let frame_steps = spec.observation_frame_steps(sim.steps());
@@ -115,13 +126,7 @@ impl Renderer {
 
         let (videos, jobs) = self.spawn_videos(&cams, id, fps, out_dir);
         let mut frame_files = vec![String::new(); cams.len() * FRAME_TIMES.len()];
-        let (png_tx, png_rx) = std::sync::mpsc::channel::<(PathBuf, u32, u32, Vec<u8>)>();
-        let png_thread = std::thread::spawn(move || -> Result<(), String> {
-            for (path, w, h, rgba) in png_rx {
-                write_png(&path, w, h, &rgba)?;
-            }
-            Ok(())
-        });
+        let (png_tx, png_thread) = png_writer();
 
         let debug = std::env::var_os("RH_RENDER_DEBUG").is_some();
         let t_start = std::time::Instant::now();
@@ -188,10 +193,12 @@ impl Renderer {
             finish_video(job, &cam.name, frame_steps.len(), &mut errors);
         }
         finish_video(full_job, "full", full_event_steps.len(), &mut errors);
-        match png_thread.join() {
-            Ok(Ok(())) => {}
-            Ok(Err(e)) => errors.push(e),
-            Err(_) => errors.push("PNG writer panicked".into()),
+        for thread in [png_thread, mask_thread] {
+            match thread.join() {
+                Ok(Ok(())) => {}
+                Ok(Err(e)) => errors.push(e),
+                Err(_) => errors.push("PNG writer panicked".into()),
+            }
         }
         if !errors.is_empty() {
             return Err(RenderError::Encode(format!(
@@ -207,6 +214,7 @@ impl Renderer {
             fps,
             full_event_steps,
             full_event_fps: full_fps,
+            observed,
         })
     }
 
@@ -362,6 +370,9 @@ pub fn render_stage(
     Ok(Some(SceneMedia {
         videos: rendered.videos,
         full_event: rendered.full_event,
+        visibility: rendered.observed.visibility,
+        masks: rendered.observed.masks,
+        depth: rendered.observed.depth,
     }))
 }
 
@@ -399,6 +410,24 @@ fn finish_video(job: VideoJob, name: &str, frames: usize, errors: &mut Vec<Strin
         Ok(n) => errors.push(format!("{name}: {n} frames written")),
         Err(e) => errors.push(format!("{name}: {e}")),
     }
+}
+
+/// A PNG frame to write: (path, width, height, RGBA).
+type PngJob = (PathBuf, u32, u32, Vec<u8>);
+
+/// A thread that writes the PNG frames sent to it (join it for the first error).
+fn png_writer() -> (
+    std::sync::mpsc::Sender<PngJob>,
+    std::thread::JoinHandle<Result<(), String>>,
+) {
+    let (tx, rx) = std::sync::mpsc::channel::<PngJob>();
+    let thread = std::thread::spawn(move || -> Result<(), String> {
+        for (path, w, h, rgba) in rx {
+            write_png(&path, w, h, &rgba)?;
+        }
+        Ok(())
+    });
+    (tx, thread)
 }
 
 fn write_png(path: &Path, w: u32, h: u32, rgba: &[u8]) -> Result<(), String> {

@@ -4,8 +4,11 @@
 mod post;
 mod setup;
 
+mod ids;
+
 use super::mesh::Vertex;
 use super::RenderError;
+pub use ids::{IdImage, IdPass, IdView};
 use std::ops::Range;
 
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;

@@ -1,0 +1,392 @@
+//! The instance-id pass: per view, an unlit single-sample image of (instance id, depth in
+//! mm) per pixel, plus the pixels one body (the hazard) covers when drawn with nothing
+//! else. Cheap by construction: no lighting, no shadow map, no MSAA, flat outputs, and
+//! run only at the observation frames. Its pipelines are built on first use
+//! ([`IdPass::new`]), so a renderer that never measures pays nothing.
+
+use super::super::mesh::Vertex;
+use super::RenderError;
+use super::{extent, whole, Gpu, DEPTH_FORMAT};
+use std::ops::Range;
+
+const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Uint;
+const COVER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
+
+/// Per-view uniforms (matches `U` in ids.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct IdUniforms {
+    view_proj: [[f32; 4]; 4],
+    cam_pos: [f32; 4],
+}
+
+/// One view of the id pass: its slot (own targets), camera, the vertex ranges to draw
+/// with their instance ids, and the ranges drawn alone for the coverage count.
+pub struct IdView {
+    pub slot: usize,
+    pub width: u32,
+    pub height: u32,
+    pub view_proj: [[f32; 4]; 4],
+    pub cam_pos: [f32; 3],
+    pub ranges: Vec<(Range<u32>, u16)>,
+    pub alone: Vec<Range<u32>>,
+}
+
+/// What the id pass read back for one view (row-major, top row first).
+pub struct IdImage {
+    pub width: u32,
+    pub height: u32,
+    /// Instance id per pixel.
+    pub ids: Vec<u16>,
+    /// Distance from the camera centre per pixel (mm; 0 = no surface).
+    pub depth_mm: Vec<u16>,
+    /// Pixels the `alone` ranges cover with nothing else drawn.
+    pub covered: u32,
+}
+
+struct IdTarget {
+    width: u32,
+    height: u32,
+    ids: wgpu::Texture,
+    ids_view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
+    cover: wgpu::Texture,
+    cover_view: wgpu::TextureView,
+    ids_readback: wgpu::Buffer,
+    ids_row: u32,
+    cover_readback: wgpu::Buffer,
+    cover_row: u32,
+    uniform: wgpu::Buffer,
+    bind: wgpu::BindGroup,
+}
+
+/// The id pass's pipelines and per-slot targets.
+pub struct IdPass {
+    ids: wgpu::RenderPipeline,
+    cover: wgpu::RenderPipeline,
+    bgl: wgpu::BindGroupLayout,
+    targets: Vec<Option<IdTarget>>,
+}
+
+impl IdPass {
+    pub fn new(gpu: &Gpu) -> IdPass {
+        let device = &gpu.device;
+        let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("ids-bgl"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: None,
+            bind_group_layouts: &[Some(&bgl)],
+            immediate_size: 0,
+        });
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("rh-ids"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("ids.wgsl").into()),
+        });
+        let pipeline = |label, vs, fs, format, depth: bool| {
+            let attrs = [wgpu::VertexAttribute {
+                format: wgpu::VertexFormat::Float32x3,
+                offset: 0,
+                shader_location: 0,
+            }];
+            // The shared vertex buffer (`Vertex`); only the position is read.
+            let buffers = [Some(wgpu::VertexBufferLayout {
+                array_stride: std::mem::size_of::<Vertex>() as u64,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &attrs,
+            })];
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &shader,
+                    entry_point: Some(vs),
+                    compilation_options: Default::default(),
+                    buffers: &buffers,
+                },
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: depth.then(|| wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &shader,
+                    entry_point: Some(fs),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        IdPass {
+            ids: pipeline("ids", "vs_ids", "fs_ids", ID_FORMAT, true),
+            cover: pipeline("cover", "vs_cover", "fs_cover", COVER_FORMAT, false),
+            bgl,
+            targets: Vec::new(),
+        }
+    }
+
+    fn target(&mut self, device: &wgpu::Device, slot: usize, width: u32, height: u32) {
+        if self.targets.len() <= slot {
+            self.targets.resize_with(slot + 1, || None);
+        }
+        let fits = self.targets[slot]
+            .as_ref()
+            .is_some_and(|t| t.width == width && t.height == height);
+        if !fits {
+            self.targets[slot] = Some(make_target(device, &self.bgl, width, height));
+        }
+    }
+}
+
+fn make_target(
+    device: &wgpu::Device,
+    bgl: &wgpu::BindGroupLayout,
+    width: u32,
+    height: u32,
+) -> IdTarget {
+    let tex = |format, usage| {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("ids"),
+            size: extent(width, height),
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+    };
+    let color = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let ids = tex(ID_FORMAT, color);
+    let depth = tex(DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
+    let cover = tex(COVER_FORMAT, color);
+    let readback = |row: u32| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ids-readback"),
+            size: row as u64 * height as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        })
+    };
+    let ids_row = (width * 4).div_ceil(256) * 256;
+    let cover_row = width.div_ceil(256) * 256;
+    let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("ids-uniform"),
+        size: std::mem::size_of::<IdUniforms>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: bgl,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: uniform.as_entire_binding(),
+        }],
+    });
+    IdTarget {
+        width,
+        height,
+        ids_view: ids.create_view(&Default::default()),
+        ids,
+        depth_view: depth.create_view(&Default::default()),
+        cover_view: cover.create_view(&Default::default()),
+        cover,
+        ids_readback: readback(ids_row),
+        ids_row,
+        cover_readback: readback(cover_row),
+        cover_row,
+        uniform,
+        bind,
+    }
+}
+
+impl Gpu {
+    /// Draws each view's id image and coverage image from the vertex buffer as it is
+    /// (statics and the current moving geometry) and reads them back, in view order.
+    pub fn draw_ids(
+        &mut self,
+        pass: &mut IdPass,
+        views: &[IdView],
+    ) -> Result<Vec<IdImage>, RenderError> {
+        for v in views {
+            pass.target(&self.device, v.slot, v.width, v.height);
+            let t = pass.targets[v.slot].as_ref().unwrap();
+            let u = IdUniforms {
+                view_proj: v.view_proj,
+                cam_pos: [v.cam_pos[0], v.cam_pos[1], v.cam_pos[2], 1.0],
+            };
+            self.queue
+                .write_buffer(&t.uniform, 0, bytemuck::bytes_of(&u));
+        }
+        let mut enc = self.encoder();
+        for v in views {
+            let t = pass.targets[v.slot].as_ref().unwrap();
+            self.id_pass(&mut enc, pass, t, v);
+            copy_out(&mut enc, &t.ids, &t.ids_readback, t.ids_row, t.height);
+            copy_out(&mut enc, &t.cover, &t.cover_readback, t.cover_row, t.height);
+        }
+        self.queue.submit([enc.finish()]);
+        for v in views {
+            let t = pass.targets[v.slot].as_ref().unwrap();
+            t.ids_readback
+                .slice(..)
+                .map_async(wgpu::MapMode::Read, |_| {});
+            t.cover_readback
+                .slice(..)
+                .map_async(wgpu::MapMode::Read, |_| {});
+        }
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| RenderError::Gpu(format!("poll: {e}")))?;
+        views
+            .iter()
+            .map(|v| read_id_image(pass.targets[v.slot].as_ref().unwrap()))
+            .collect()
+    }
+
+    /// The id pass (cleared: id 0, depth 0) and the coverage pass of one view.
+    fn id_pass(&self, enc: &mut wgpu::CommandEncoder, pass: &IdPass, t: &IdTarget, v: &IdView) {
+        {
+            let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("ids"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &t.ids_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &t.depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            rp.set_pipeline(&pass.ids);
+            rp.set_bind_group(0, &t.bind, &[]);
+            rp.set_vertex_buffer(0, self.vbuf.slice(..));
+            for (r, id) in v.ranges.iter().filter(|(r, _)| !r.is_empty()) {
+                let id = *id as u32;
+                rp.draw(r.clone(), id..id + 1);
+            }
+        }
+        let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("cover"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &t.cover_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        rp.set_pipeline(&pass.cover);
+        rp.set_bind_group(0, &t.bind, &[]);
+        rp.set_vertex_buffer(0, self.vbuf.slice(..));
+        for r in v.alone.iter().filter(|r| !r.is_empty()) {
+            rp.draw(r.clone(), 0..1);
+        }
+    }
+}
+
+fn copy_out(
+    enc: &mut wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+    buffer: &wgpu::Buffer,
+    row: u32,
+    height: u32,
+) {
+    enc.copy_texture_to_buffer(
+        whole(texture),
+        wgpu::TexelCopyBufferInfo {
+            buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(height),
+            },
+        },
+        texture.size(),
+    );
+}
+
+/// Unpacks a view's mapped read-back buffers and unmaps them.
+fn read_id_image(t: &IdTarget) -> Result<IdImage, RenderError> {
+    let (w, h) = (t.width as usize, t.height as usize);
+    let map_err = |e| RenderError::Gpu(format!("map id readback: {e:?}"));
+    let mut ids = Vec::with_capacity(w * h);
+    let mut depth_mm = Vec::with_capacity(w * h);
+    {
+        let data = t
+            .ids_readback
+            .slice(..)
+            .get_mapped_range()
+            .map_err(map_err)?;
+        for y in 0..h {
+            let row = &data[y * t.ids_row as usize..][..w * 4];
+            for px in row.chunks_exact(4) {
+                ids.push(u16::from_le_bytes([px[0], px[1]]));
+                depth_mm.push(u16::from_le_bytes([px[2], px[3]]));
+            }
+        }
+    }
+    t.ids_readback.unmap();
+    let mut covered = 0u32;
+    {
+        let data = t
+            .cover_readback
+            .slice(..)
+            .get_mapped_range()
+            .map_err(map_err)?;
+        for y in 0..h {
+            let row = &data[y * t.cover_row as usize..][..w];
+            covered += row.iter().filter(|&&b| b != 0).count() as u32;
+        }
+    }
+    t.cover_readback.unmap();
+    Ok(IdImage {
+        width: t.width,
+        height: t.height,
+        ids,
+        depth_mm,
+        covered,
+    })
+}
