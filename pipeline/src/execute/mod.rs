@@ -30,7 +30,7 @@ pub use outcome::{Outcome, OutcomeKind, StrikeRecord};
 
 /// Version of the executor's code (humanoid, controller, outcome rule); part of the
 /// execution cache key together with the config's own `version`.
-pub const EXECUTOR_VERSION: &str = "exec-1";
+pub const EXECUTOR_VERSION: &str = "exec-2";
 
 /// One hand keyframe (body frame; `t` in seconds after the decision moment).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -96,6 +96,7 @@ pub struct ExecConfig {
     pub strike_impulse_min: f64,
     pub strike_impulse_heavy: f64,
     pub strike_window_s: f64,
+    pub hand_strike_impulse: f64,
     pub hold_time_s: f64,
     pub hold_speed_max: f64,
     pub attempt_reach: f64,
@@ -142,6 +143,7 @@ impl ExecConfig {
             ("strike_speed_min", self.strike_speed_min),
             ("strike_impulse_min", self.strike_impulse_min),
             ("strike_impulse_heavy", self.strike_impulse_heavy),
+            ("hand_strike_impulse", self.hand_strike_impulse),
             ("hold_speed_max", self.hold_speed_max),
             ("attempt_reach", self.attempt_reach),
             ("attempt_radius", self.attempt_radius),

@@ -7,6 +7,8 @@
 //!   `strike_impulse_min`, or the impulse alone is ≥ `strike_impulse_heavy` (the
 //!   counterfactual label's test, on the moving body). The part that took the most
 //!   impulse, the impulse and the time of the first touch are recorded.
+//!   The hands/forearms count as struck only under a blow of `hand_strike_impulse` or
+//!   more within the window (a slamming door, not a caught ball).
 //! * `caught` — not struck, and the hazard was held: touching the hands/forearms, not the
 //!   floor, moving with the touching link (relative speed ≤ `hold_speed_max`) for
 //!   `hold_time_s` without a break, before it ever touched the floor after Δ.
@@ -138,6 +140,8 @@ struct Window {
 struct Monitor {
     first_contact: Option<(u32, Part)>,
     window: Option<Window>,
+    /// Impulse on the hands/forearms since their first touch (a slamming door).
+    hand_window: Option<Window>,
     strike: Option<StrikeRecord>,
     floor_step: Option<u32>,
     held_steps: u32,
@@ -184,6 +188,7 @@ pub(super) fn run(
     let mut m = Monitor {
         first_contact: None,
         window: None,
+        hand_window: None,
         strike: None,
         floor_step: None,
         held_steps: 0,
@@ -284,6 +289,7 @@ fn observe(
     let (mut on_floor, mut touching_hands, mut body_touch) = (false, false, None::<(Part, f64)>);
     let mut hold_speed = f64::INFINITY;
     let mut impulses = [0.0f64; 13];
+    let mut hand_impulses = [0.0f64; 13];
     for pair in world.narrow_phase.contact_pairs_with(hazard_c) {
         if !pair.has_any_active_contact() {
             continue;
@@ -308,6 +314,7 @@ fn observe(
         if part.is_catching() {
             touching_hands = true;
             m.hand_touched = true;
+            hand_impulses[i] += pair.total_impulse_magnitude() as f64;
             hold_speed = hold_speed.min(norm(v_hazard - link_v));
         } else {
             impulses[i] += pair.total_impulse_magnitude() as f64;
@@ -336,6 +343,9 @@ fn observe(
         m.floor_step = Some(step);
     }
     follow_strike(m, body_touch, &impulses, step, window_steps, cfg);
+    if m.strike.is_none() {
+        follow_hand_strike(m, touching_hands, &hand_impulses, step, window_steps, cfg);
+    }
     let holding =
         touching_hands && !on_floor && hold_speed <= cfg.hold_speed_max && m.floor_step.is_none();
     m.held_steps = if holding { m.held_steps + 1 } else { 0 };
@@ -395,5 +405,48 @@ fn follow_strike(
             s.t = w.start as f64;
         }
         m.window = None;
+    }
+}
+
+/// The hands and forearms are struck only by a blow no catch could take: an impulse of at
+/// least `hand_strike_impulse` within `strike_window_s` of their first touch.
+fn follow_hand_strike(
+    m: &mut Monitor,
+    touching: bool,
+    impulses: &[f64; 13],
+    step: u32,
+    window_steps: u32,
+    cfg: &ExecConfig,
+) {
+    if m.hand_window.is_none() && touching {
+        m.hand_window = Some(Window {
+            start: step,
+            speed: 0.0,
+            impulse: 0.0,
+            per_part: [0.0; 13],
+        });
+    }
+    let Some(w) = m.hand_window.as_mut() else {
+        return;
+    };
+    for (acc, x) in w.per_part.iter_mut().zip(impulses) {
+        *acc += x;
+    }
+    w.impulse += impulses.iter().sum::<f64>();
+    if w.impulse >= cfg.hand_strike_impulse {
+        let (i, _) = w
+            .per_part
+            .iter()
+            .enumerate()
+            .fold((0, f64::MIN), |best, (i, &x)| if x > best.1 { (i, x) } else { best });
+        m.strike = Some(StrikeRecord {
+            part: Part::ALL[i].name().to_string(),
+            impulse: w.impulse,
+            speed: 0.0,
+            t: w.start as f64,
+        });
+        m.hand_window = None;
+    } else if step >= w.start + window_steps {
+        m.hand_window = None;
     }
 }
