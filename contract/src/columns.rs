@@ -76,6 +76,7 @@ pub mod col {
     pub const VALID_ENERGY: &str = "valid_energy";
     pub const VALID_NO_TUNNELLING: &str = "valid_no_tunnelling";
     pub const VALID_IN_FRAME: &str = "valid_in_frame";
+    pub const VALID_VISIBLE: &str = "valid_visible";
     pub const VALID_INTENDED_EVENT: &str = "valid_intended_event";
     pub const VALID_REACTION_TIME: &str = "valid_reaction_time";
     pub const SPEC_FILE: &str = "spec_file";
@@ -88,11 +89,12 @@ pub mod col {
 }
 
 /// The validator verdict columns, in column order (each `true` when that check passed).
-pub const VALIDATOR_COLUMNS: [&str; 6] = [
+pub const VALIDATOR_COLUMNS: [&str; 7] = [
     col::VALID_NO_INTERPENETRATION,
     col::VALID_ENERGY,
     col::VALID_NO_TUNNELLING,
     col::VALID_IN_FRAME,
+    col::VALID_VISIBLE,
     col::VALID_INTENDED_EVENT,
     col::VALID_REACTION_TIME,
 ];
@@ -377,6 +379,12 @@ pub const COLUMNS: &[Column] = &[
         Bool,
         false,
         "Validator: the hazard stays in all three cameras' frames during the observation window",
+    ),
+    c(
+        col::VALID_VISIBLE,
+        Bool,
+        false,
+        "Validator: every camera sees enough of the hazard (share of sample points on its collision shapes in the image and in sight, past fixed bodies and the observer's body), large enough in pixels, during the observation window",
     ),
     c(
         col::VALID_INTENDED_EVENT,

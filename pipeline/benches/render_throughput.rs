@@ -6,7 +6,8 @@
 //! taken round-robin over the families). Environment overrides: `RH_BENCH_JOBS`
 //! (workers; default: all cores), `RH_BENCH_PRESET`, `RH_BENCH_THREADS` (x264 threads
 //! per video), `RH_BENCH_MSAA` (samples on any adapter; default: the
-//! configuration's `msaa`, or `msaa_cpu` on a CPU rasterizer).
+//! configuration's `msaa`, or `msaa_cpu` on a CPU rasterizer), `RH_BENCH_FXAA` (0 or 1:
+//! the post-process anti-aliasing pass; default: the configuration's `fxaa`).
 //!
 //! Prints each scene's own time and the figure that matters for a build: wall-clock
 //! seconds per scene with every worker busy.
@@ -40,6 +41,9 @@ fn main() {
     if let Some(m) = env_parse("RH_BENCH_MSAA") {
         config.render.msaa = m;
         config.render.msaa_cpu = m;
+    }
+    if let Some(f) = env_parse::<u8>("RH_BENCH_FXAA") {
+        config.render.fxaa = f != 0;
     }
     let jobs: usize = env_parse("RH_BENCH_JOBS").unwrap_or_else(|| {
         std::thread::available_parallelism()
@@ -108,7 +112,7 @@ fn main() {
     let count = times.len().max(1) as f64;
     println!(
         "render_throughput: {:.2} s/scene wall-clock over {} scenes with {jobs} workers \
-         (each scene {:.2} s on average; adapter {}, device setup {:.2} s, preset {}, msaa {}, x264 threads {})",
+         (each scene {:.2} s on average; adapter {}, device setup {:.2} s, preset {}, msaa {}, fxaa {}, x264 threads {})",
         wall / count,
         times.len(),
         times.iter().map(|(s, _)| s).sum::<f64>() / count,
@@ -116,6 +120,7 @@ fn main() {
         setup,
         opts.encode.preset,
         adapters[0].1,
+        opts.fxaa,
         opts.encode.threads
     );
 }

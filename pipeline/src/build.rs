@@ -24,7 +24,8 @@ use crate::dataset;
 use crate::families;
 use crate::integrity::{self, FileSums};
 use crate::manifest::{Manifest, MANIFEST_FILE};
-use crate::records::{group_files, load_record, reopen_if_damaged};
+pub use crate::records::FamilyRejections;
+use crate::records::{gather_rejections, group_files, load_record, reopen_if_damaged};
 pub use crate::records::{record_path, WORK_DIR};
 use crate::scene::{run_group, GroupError, RenderStage};
 use arrow::array::RecordBatch;
@@ -77,6 +78,11 @@ pub struct BuildSummary {
     pub computed_groups: usize,
     /// Scenes in the `eval` config (whole builds only).
     pub eval_scenes: Option<usize>,
+    /// Per family: scene-group attempts made and, per validator column, how many of them
+    /// it rejected (`valid_visible`: the visibility rule). `None` when some group's counts
+    /// are not known: the build was already complete (the per-group records holding the
+    /// counts are gone by then), or a damaged finished build was repaired.
+    pub rejections: Option<BTreeMap<String, FamilyRejections>>,
 }
 
 /// Checks the options against the catalog and configuration before any work.
@@ -497,7 +503,7 @@ pub fn build(
         todo.par_iter()
             .try_for_each(|&g| -> Result<(), BuildError> {
                 let count = manifest.group_size(g);
-                let results = run_group(
+                let (results, rejections) = run_group(
                     catalog,
                     &opts.families,
                     opts.selections.as_deref(),
@@ -513,7 +519,8 @@ pub fn build(
                 })?;
                 // Specs, then the checksums of every file the rows name, and the record
                 // last: its presence says the group (specs, media, sums) is done.
-                let files = group_files(out, g, &results, catalog).map_err(BuildError::Internal)?;
+                let files = group_files(out, g, &results, &rejections, catalog)
+                    .map_err(BuildError::Internal)?;
                 syncer.submit(files)?;
                 progress.advance(count, opts.progress);
                 Ok(())
@@ -534,6 +541,7 @@ pub fn build(
         Ok(())
     };
     let sums = crate::records::gather_sums(out, &groups).map_err(BuildError::Internal)?;
+    let rejections = gather_rejections(out, &groups);
     let (rows, eval) = finalize(out, &manifest, &records, sums)?;
     // Retire the records in one atomic step (a rename), then delete them: a crash in
     // between leaves a finished build whose next run only removes the leftover.
@@ -541,14 +549,9 @@ pub fn build(
     let retired = out.join(format!("{WORK_DIR}.done.{}", std::process::id()));
     std::fs::rename(&work, &retired).map_err(|e| internal(&work, e))?;
     std::fs::remove_dir_all(&retired).map_err(|e| internal(&retired, e))?;
-    Ok(summarize(
-        out,
-        &rows,
-        data_file,
-        done.len(),
-        todo.len(),
-        eval,
-    ))
+    let mut summary = summarize(out, &rows, data_file, done.len(), todo.len(), eval);
+    summary.rejections = rejections;
+    Ok(summary)
 }
 
 /// Receives a dataset's rows, a batch at a time.
@@ -671,6 +674,7 @@ fn summarize(
         resumed_groups,
         computed_groups,
         eval_scenes,
+        rejections: None,
     };
     for i in 0..rows.num_rows() {
         if valid[i] {

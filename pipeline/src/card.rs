@@ -306,7 +306,17 @@ pub fn render(input: &CardInput) -> String {
              columns). Video frame `k` of a camera video shows physics step \
              `round(k / fps / dt)` of the spec (`video.fps`, `physics.dt`), clamped to the \
              scene's last step; the PNG at time t is video frame `round(t · fps)` before \
-             compression. Full-event frame `j` shows step `round(j / full_fps / dt)`."
+             compression.\n\n**The full-event video** (`videos/full/<id>.mp4`, for people, never \
+             model input) shows what the labels mean: the counterfactual run of the label \
+             rule, in which the standing observer is a static collider (a capsule of radius \
+             `observer.torso_radius` and the observer's height), run to the end of the event \
+             (the run the labels use stops after the strike window). A hazard that would \
+             strike the observer stops at its body there, instead of passing through it as \
+             in the plain run, where the observer is drawn but is no body. Where nothing \
+             comes near the observer the two runs are the same. The camera videos and \
+             frames show the plain run: they end at Δ, before anything reaches the observer \
+             in a valid scene. The drawn robot's arms reach a few centimetres past the \
+             capsule. Full-event frame `j` shows step `round(j / full_fps / dt)` of that run."
                 .into()
         } else {
             "This build has no rendered videos: the `*_file_name` columns are null and there is \
@@ -449,6 +459,12 @@ fn features_table() -> String {
 /// The label rule in words, with the build's thresholds.
 fn label_rule(m: &Manifest, labels: &crate::config::LabelConfig) -> String {
     let l = labels;
+    let validator = |key: &str, default: f64| {
+        m.config
+            .pointer(&format!("/validators/{key}"))
+            .and_then(|x| x.as_f64())
+            .unwrap_or(default)
+    };
     let shoulder = m
         .config
         .pointer("/observer/shoulder_z")
@@ -471,6 +487,7 @@ approach to the torso axis after Δ if within {closest} m (`closest_approach`); 
 * **Reaction time** (validator `valid_reaction_time`): the hazard must not reach the \
 observer — the same interception computed from t = 0, a closest approach within {reach} m, \
 or a strike of the standing body — before Δ + {reaction} s; such a scene is resampled.
+* **Visibility** (validator `valid_visible`): at every frame of the observation window until the hazard comes within {until} m of the torso axis, in each of the three model-input views, at least {vis_fraction} of 15 points per collision shape sampled on the hazard (corners, face centres, rims and centre, 10% inside its surface) lie inside the image with no fixed body and no part of the observer's body — its collision capsule widened by {vis_margin} m; the ego camera, inside it, excepted — in the way, and the hazard's projected size (largest side of the box around its points) is at least {vis_px} px at the videos' resolution. The three cameras are the same for the four speed bands of a group (framed on the union of their paths), so the bands differ only in speed. Failing layouts are resampled.
 * **time_to_floor**: the first floor contact of the hazard's lowest point (within {eps} m), \
 refined by its ballistic fall from the last step above the floor; for a body that starts on \
 the floor (a toppling wardrobe, a ladder), the moment the top corners of its bounding box \
@@ -487,6 +504,10 @@ door or wardrobe pressing into the body).
 danger is present.
 * **gt_action**: `NO_ACTION` when not reachable; else `DODGE` when dangerous, or the impact \
 speed is > {fast} m/s, or the impact kinetic energy is > {energy} J; else `CATCH`.",
+        until = validator("frame_check_until_within", 0.45),
+        vis_fraction = validator("visible_fraction_min", 0.5),
+        vis_margin = validator("visibility_observer_margin", 0.08),
+        vis_px = validator("visible_size_px_min", 8.0),
         window = m
             .config
             .pointer("/observation/window_s")

@@ -381,6 +381,28 @@ fn run_build(
             .map(|(a, c)| format!("{a} {c}"))
             .collect();
         println!("labels: {}", actions.join(", "));
+        if let Some(rejections) = &summary.rejections {
+            let attempts: u32 = rejections.values().map(|f| f.attempts).sum();
+            let by_family: Vec<String> = rejections
+                .iter()
+                .filter_map(|(family, f)| {
+                    let n = f.rejected_by.get("valid_visible").copied().unwrap_or(0);
+                    (n > 0).then(|| format!("{family} {n}/{}", f.attempts))
+                })
+                .collect();
+            println!(
+                "visibility rejected {} of {attempts} group attempts{}",
+                rejections
+                    .values()
+                    .map(|f| f.rejected_by.get("valid_visible").copied().unwrap_or(0))
+                    .sum::<u32>(),
+                if by_family.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", by_family.join(", "))
+                }
+            );
+        }
         if !summary.invalid_scene_ids.is_empty() {
             println!(
                 "warning: {} scene(s) failed validation after every attempt: {}",

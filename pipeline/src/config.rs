@@ -91,10 +91,39 @@ pub struct ValidatorConfig {
     /// that would need more is redrawn.
     #[serde(default = "default_max_fov_y")]
     pub max_fov_y: f64,
+    /// Visibility rule (`visibility`): the share of the hazard's sample points that must
+    /// be in the image and in sight of every camera at every checked frame.
+    #[serde(default = "default_visible_fraction_min")]
+    pub visible_fraction_min: f64,
+    /// Visibility rule: the smallest projected size of the hazard (px at the configured
+    /// resolution, largest side of its projected sample points' box).
+    #[serde(default = "default_visible_size_px_min")]
+    pub visible_size_px_min: f64,
+    /// Visibility rule: widening of the observer's collision capsule for line of sight
+    /// (m), so that it also covers the drawn shoulders and arms.
+    #[serde(default = "default_visibility_observer_margin")]
+    pub visibility_observer_margin: f64,
+    /// Camera placement: the band of projected hazard sizes (px) that a camera's field of
+    /// view aims for — wide enough that the hazard never fills the frame, no wider than
+    /// its path needs.
+    #[serde(default = "default_frame_size_px")]
+    pub frame_size_px: [f64; 2],
 }
 
 fn default_max_fov_y() -> f64 {
     2.1
+}
+fn default_visible_fraction_min() -> f64 {
+    0.5
+}
+fn default_visible_size_px_min() -> f64 {
+    8.0
+}
+fn default_visibility_observer_margin() -> f64 {
+    0.08
+}
+fn default_frame_size_px() -> [f64; 2] {
+    [24.0, 400.0]
 }
 
 /// Framing policy (from the `[validators]` config), for `cameras::frame`.
@@ -106,6 +135,14 @@ pub struct FramingRules {
     pub until_within: f64,
     /// The widest vertical field of view a camera may get (rad).
     pub max_fov_y: f64,
+    /// Least share of the hazard's sample points in the image and in sight.
+    pub visible_fraction: f64,
+    /// Least projected size of the hazard (px).
+    pub min_size_px: f64,
+    /// Widening of the observer's capsule for line of sight (m).
+    pub observer_margin: f64,
+    /// Band of projected hazard sizes (px) that placement aims for.
+    pub size_band_px: [f64; 2],
 }
 
 impl ValidatorConfig {
@@ -114,6 +151,10 @@ impl ValidatorConfig {
             margin: self.frame_margin,
             until_within: self.frame_check_until_within,
             max_fov_y: self.max_fov_y,
+            visible_fraction: self.visible_fraction_min,
+            min_size_px: self.visible_size_px_min,
+            observer_margin: self.visibility_observer_margin,
+            size_band_px: self.frame_size_px,
         }
     }
 }
@@ -146,6 +187,13 @@ pub struct RenderConfig {
     /// cost about 3× the time.
     #[serde(default = "default_msaa_cpu")]
     pub msaa_cpu: u32,
+    /// FXAA-style post-process anti-aliasing where MSAA is off (a CPU rasterizer).
+    #[serde(default = "default_fxaa")]
+    pub fxaa: bool,
+}
+
+fn default_fxaa() -> bool {
+    true
 }
 
 fn default_msaa_cpu() -> u32 {
@@ -294,6 +342,26 @@ impl Config {
             return Err(fail(
                 "physics.min_duration_s",
                 "must cover the observation window".into(),
+            ));
+        }
+        let v = &self.validators;
+        if !(0.0..=1.0).contains(&v.visible_fraction_min) {
+            return Err(fail(
+                "validators.visible_fraction_min",
+                "must be within [0, 1]".into(),
+            ));
+        }
+        if !(v.visibility_observer_margin >= 0.0) {
+            return Err(fail(
+                "validators.visibility_observer_margin",
+                "must not be negative".into(),
+            ));
+        }
+        let [lo, hi] = v.frame_size_px;
+        if !(v.visible_size_px_min >= 0.0 && lo >= v.visible_size_px_min && hi > lo) {
+            return Err(fail(
+                "validators.frame_size_px",
+                "needs visible_size_px_min <= min < max".into(),
             ));
         }
         if self.validators.max_attempts == 0 {

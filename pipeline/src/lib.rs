@@ -40,3 +40,4 @@ pub mod simulate;
 pub mod spec;
 pub mod validate;
 pub mod verify;
+pub mod visibility;

@@ -8,9 +8,12 @@ use crate::dataset;
 use crate::fsio::{write_unsynced, Unsynced};
 use crate::integrity::{self, FileSums};
 use crate::manifest::Manifest;
-use crate::scene::SceneResult;
+use crate::scene::{Rejections, SceneResult};
+use crate::validate::VALIDATOR_COLUMNS;
 use arrow::array::RecordBatch;
 use rh_catalog::Catalog;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Work-in-progress folder of an unfinished build (removed when the build completes).
@@ -35,9 +38,10 @@ pub fn group_files(
     out: &Path,
     g: u64,
     results: &[SceneResult],
+    rejections: &Rejections,
     catalog: &Catalog,
 ) -> Result<Vec<Unsynced>, String> {
-    let mut files = Vec::with_capacity(results.len() + 2);
+    let mut files = Vec::with_capacity(results.len() + 3);
     let mut spec_sums = FileSums::new();
     for r in results {
         let rel = dataset::spec_path(&r.spec.scene_id);
@@ -52,9 +56,75 @@ pub fn group_files(
     let sums_path = integrity::group_sums_path(&path);
     let text = integrity::sums_json(&sums);
     files.push(write_unsynced(&sums_path, text.as_bytes()).map_err(|e| internal(&sums_path, e))?);
+    if let Some(first) = results.first() {
+        let attempts = GroupRejections::of(&first.spec.family, rejections);
+        let rej_path = rejections_path(out, g);
+        let text = serde_json::to_string(&attempts).expect("rejections serialize");
+        files.push(write_unsynced(&rej_path, text.as_bytes()).map_err(|e| internal(&rej_path, e))?);
+    }
     let bytes = dataset::parquet_bytes(&batch);
     files.push(write_unsynced(&path, &bytes).map_err(|e| internal(&path, e))?);
     Ok(files)
+}
+
+/// How a group's rejection-sampling attempts went, kept beside its record
+/// (`<g>.rejections.json`) for the build summary.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GroupRejections {
+    pub family: String,
+    pub attempts: u32,
+    /// Validator column → attempts it rejected.
+    pub rejected_by: BTreeMap<String, u32>,
+}
+
+impl GroupRejections {
+    pub fn of(family: &str, r: &Rejections) -> GroupRejections {
+        GroupRejections {
+            family: family.to_string(),
+            attempts: r.attempts,
+            rejected_by: VALIDATOR_COLUMNS
+                .iter()
+                .zip(r.rejected_by)
+                .map(|(c, n)| (c.to_string(), n))
+                .collect(),
+        }
+    }
+}
+
+/// One family's attempts over a build: scene-group attempts made and, per validator
+/// column, how many of them it rejected.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct FamilyRejections {
+    pub attempts: u32,
+    pub rejected_by: BTreeMap<String, u32>,
+}
+
+/// Path of group `g`'s attempt counts.
+pub fn rejections_path(out: &Path, g: u64) -> PathBuf {
+    out.join(WORK_DIR)
+        .join("groups")
+        .join(format!("{g:08}.rejections.json"))
+}
+
+/// Group `g`'s attempt counts, if written.
+pub fn read_rejections(out: &Path, g: u64) -> Option<GroupRejections> {
+    let text = std::fs::read_to_string(rejections_path(out, g)).ok()?;
+    serde_json::from_str(&text).ok()
+}
+
+/// Every finished group's attempt counts, summed per family; None when some group's
+/// are not known (a repaired finished build keeps its intact groups without them).
+pub fn gather_rejections(out: &Path, groups: &[u64]) -> Option<BTreeMap<String, FamilyRejections>> {
+    let mut per_family: BTreeMap<String, FamilyRejections> = BTreeMap::new();
+    for &g in groups {
+        let group = read_rejections(out, g)?;
+        let family = per_family.entry(group.family).or_default();
+        family.attempts += group.attempts;
+        for (column, n) in group.rejected_by {
+            *family.rejected_by.entry(column).or_default() += n;
+        }
+    }
+    Some(per_family)
 }
 
 /// The checksums of every finished group's files, together.

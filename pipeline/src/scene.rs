@@ -12,7 +12,7 @@ use crate::randomize::{randomize, RandomizeError, SceneKey};
 use crate::selection::plan_group;
 use crate::simulate::{simulate, SimOptions, Simulation};
 use crate::spec::{SceneSpec, Selection};
-use crate::validate::{validate, Verdicts};
+use crate::validate::{validate, Verdicts, VALIDATOR_COLUMNS};
 use rh_catalog::Catalog;
 
 /// Everything the dataset needs about one finished scene.
@@ -56,7 +56,8 @@ pub enum GroupError {
 
 /// The whole DAG for scene group `g` of a build (`count` speed bands, scenes
 /// `4g … 4g + count − 1`): plan the group's selection, produce its labelled scenes
-/// ([`produce_group`]), then render each (`render`; `None` for a label-only build).
+/// ([`produce_group_counted`]), then render each (`render`; `None` for a label-only
+/// build). Also returns the group's family and how its attempts went.
 pub fn run_group(
     catalog: &Catalog,
     families: &[String],
@@ -66,7 +67,7 @@ pub fn run_group(
     count: u64,
     config: &Config,
     render: Option<&RenderStage>,
-) -> Result<Vec<SceneResult>, GroupError> {
+) -> Result<(Vec<SceneResult>, Rejections), GroupError> {
     // Selections planned from descriptions (`build --descriptions`): group g takes g mod D.
     let selection = match planned {
         Some(s) if !s.is_empty() => s[(g % s.len() as u64) as usize].clone(),
@@ -74,30 +75,37 @@ pub fn run_group(
             plan_group(catalog, families, seed, g).map_err(|e| GroupError::Input(e.to_string()))?
         }
     };
-    let mut results = produce_group(&selection, seed, g * 4, count, catalog, config)
-        .map_err(|e| GroupError::Input(e.to_string()))?;
+    let (mut results, rejections) =
+        produce_group_counted(&selection, seed, g * 4, count, catalog, config)
+            .map_err(|e| GroupError::Input(e.to_string()))?;
     if let Some(render) = render {
         for r in results.iter_mut() {
             r.media = render(r).map_err(GroupError::Render)?;
         }
     }
-    Ok(results)
+    Ok((results, rejections))
 }
 
-/// Simulates one spec (plain and counterfactual), frames its cameras, labels and validates.
+/// Simulates one spec (plain and counterfactual), frames its cameras (as a group of
+/// one; a build frames a group's bands together, see `produce_group`), labels and
+/// validates.
 pub fn run_scene(mut spec: SceneSpec, config: &Config) -> SceneResult {
-    let family = families::get(&spec.family).expect("randomize only emits implemented families");
     let sim = simulate(&spec, SimOptions::default());
-    let framed = cameras::frame(&spec, &sim, &config.validators.framing());
-    let in_frame = framed.is_some();
-    spec.cameras = framed.unwrap_or_default();
+    spec.cameras = cameras::frame(&spec, &sim, &config.validators.framing()).unwrap_or_default();
+    label_scene(spec, sim, config)
+}
+
+/// The stages after framing: the counterfactual run where needed, labels and verdicts
+/// of a simulated spec that carries its cameras.
+pub fn label_scene(spec: SceneSpec, sim: Simulation, config: &Config) -> SceneResult {
+    let family = families::get(&spec.family).expect("randomize only emits implemented families");
     let strike = if may_touch_observer(&spec, &sim) {
         simulate(&spec, counterfactual_options(&spec)).strike
     } else {
         None
     };
     let labels = label(&spec, &sim, strike);
-    let verdicts = validate(&spec, &sim, family, &config.validators, in_frame, &labels);
+    let verdicts = validate(&spec, &sim, family, &config.validators, &labels);
     let trajectory = hazard_trajectory(&spec, &sim);
     SceneResult {
         state_hash: sim.state_hash.clone(),
@@ -117,7 +125,27 @@ pub fn counterfactual_options(spec: &SceneSpec) -> SimOptions {
     SimOptions {
         observer_collider: true,
         strike_window_steps: (spec.labels.strike_window_s / spec.physics.dt).round() as u32,
+        run_past_strike: false,
     }
+}
+
+/// What the full-event video (`videos/full/<id>.mp4`) shows: the counterfactual of
+/// SPEC §6 — the standing observer as a static collider, what the labels mean — run to
+/// the end of the event rather than stopped after the strike window. `None` when no
+/// body ever comes near the observer: that run is then the plain run (see
+/// [`may_touch_observer`]), which the caller already has. The observation videos and
+/// frames always show the plain run (they end at Δ; in a valid scene nothing reaches the
+/// observer before Δ plus a reaction time). Labels, specs and hashes never depend on this run.
+pub fn full_event_simulation(spec: &SceneSpec, sim: &Simulation) -> Option<Simulation> {
+    may_touch_observer(spec, sim).then(|| {
+        simulate(
+            spec,
+            SimOptions {
+                run_past_strike: true,
+                ..counterfactual_options(spec)
+            },
+        )
+    })
 }
 
 /// Clearance kept beyond the bounding spheres before a body could touch the observer
@@ -159,7 +187,7 @@ fn hazard_trajectory(spec: &SceneSpec, sim: &Simulation) -> Vec<[f32; 4]> {
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Rejections {
     pub attempts: u32,
-    pub rejected_by: [u32; 6],
+    pub rejected_by: [u32; VALIDATOR_COLUMNS.len()],
 }
 
 /// Produces scenes `first_index .. first_index + count` (one group, `count` ≤ 4 bands).
@@ -178,6 +206,11 @@ pub fn produce_group(
 }
 
 /// `produce_group`, also saying which validators rejected which attempts.
+///
+/// Each attempt simulates every band, frames ONE set of cameras for the group on the
+/// union of the bands' hazard paths (`cameras::frame_group`, from the group's "cameras"
+/// stream), then labels and validates each band with those cameras: the bands differ
+/// only in speed.
 pub fn produce_group_counted(
     selection: &Selection,
     build_seed: u64,
@@ -189,8 +222,8 @@ pub fn produce_group_counted(
     let mut results = Vec::new();
     let mut rejections = Rejections::default();
     for attempt in 0..config.validators.max_attempts {
-        results.clear();
         rejections.attempts += 1;
+        let mut runs = Vec::with_capacity(count as usize);
         for index in first_index..first_index + count {
             let spec = randomize(
                 selection,
@@ -201,8 +234,18 @@ pub fn produce_group_counted(
             // Simulate what the file will say: a JSON round trip is exact (serde_json
             // float_roundtrip), and this makes "replay equals build" hold by construction.
             let spec = SceneSpec::from_json(&spec.to_json()).expect("a spec parses back");
-            results.push(run_scene(spec, config));
+            let sim = simulate(&spec, SimOptions::default());
+            runs.push((spec, sim));
         }
+        let bands: Vec<(&SceneSpec, &Simulation)> = runs.iter().map(|(s, m)| (s, m)).collect();
+        let framed = cameras::frame_group(&bands, &config.validators.framing()).unwrap_or_default();
+        results = runs
+            .into_iter()
+            .map(|(mut spec, sim)| {
+                spec.cameras = framed.clone();
+                label_scene(spec, sim, config)
+            })
+            .collect();
         if results.iter().all(|r| r.verdicts.all()) {
             break;
         }

@@ -6,7 +6,7 @@
 //! state. The same spec gives the same hash in any process, thread count or shard: a
 //! scene is simulated single-threaded, and nothing here reads a clock or a hash map.
 
-use crate::spec::{BodyKind, JointKind, PartSpec, SceneSpec, ShapeSpec};
+use crate::spec::{BodyKind, JointKind, ObserverSpec, PartSpec, SceneSpec, ShapeSpec};
 use rapier3d::prelude::*;
 use sha2::{Digest, Sha256};
 
@@ -23,6 +23,10 @@ pub struct SimOptions {
     pub observer_collider: bool,
     /// How long a strike is followed to add up the impulse it delivers (steps).
     pub strike_window_steps: u32,
+    /// Keeps simulating after the strike window (until the scene settles or the
+    /// horizon) instead of stopping there: the full-event video's run. The strike's
+    /// numbers still cover only the window, so they equal the stopping run's.
+    pub run_past_strike: bool,
 }
 
 /// State of one dynamic body at one step (f32, exactly as the solver holds it).
@@ -212,6 +216,24 @@ impl Obstacles {
         Obstacles { parts }
     }
 
+    /// Adds the observer's collision capsule (see `observer_capsule`), its radius widened
+    /// by `inflate` (m), as one more obstacle.
+    pub fn with_observer(mut self, observer: &ObserverSpec, inflate: f64) -> Obstacles {
+        let (centre, half, radius) = observer_capsule(observer, inflate);
+        self.parts.push((
+            Pose::from_parts(centre, Rotation::IDENTITY),
+            SharedShape::capsule_z(half, radius),
+        ));
+        self
+    }
+
+    /// Whether `p` lies inside one of the obstacles.
+    pub fn contains(&self, p: [f64; 3]) -> bool {
+        self.parts
+            .iter()
+            .any(|(pose, shape)| shape.contains_point(pose, v3(p)))
+    }
+
     /// Whether the straight segment from `a` to `b` passes through a fixed body.
     pub fn blocks(&self, a: [f64; 3], b: [f64; 3]) -> bool {
         let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
@@ -224,6 +246,17 @@ impl Obstacles {
             .iter()
             .any(|(pose, shape)| shape.cast_ray(pose, &ray, length as Real, true).is_some())
     }
+}
+
+/// The observer's body as a collider (the counterfactual of SPEC §6; the one definition
+/// of its geometry): a vertical capsule of the torso radius from the floor to the top of
+/// the head, as (centre, half height of the segment, radius); `inflate` widens the radius
+/// (line-of-sight queries use it to cover the drawn limbs).
+fn observer_capsule(o: &ObserverSpec, inflate: f64) -> (Vector, Real, Real) {
+    let radius = o.torso_radius as Real;
+    let half = ((o.height as Real) / 2.0 - radius).max(0.0);
+    let centre = Vector::new(o.x as Real, o.y as Real, (o.height / 2.0) as Real);
+    (centre, half, radius + inflate as Real)
 }
 
 /// Height of a collider's lowest point: the tightest of its parts' bounding boxes (a
@@ -374,16 +407,10 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
     } = build_world(spec);
 
     let observer_collider = options.observer_collider.then(|| {
-        let o = &spec.observer;
-        let radius = o.torso_radius as Real;
-        let half = ((o.height as Real) / 2.0 - radius).max(0.0);
+        let (centre, half, radius) = observer_capsule(&spec.observer, 0.0);
         world
             .insert(
-                RigidBodyBuilder::fixed().translation(Vector::new(
-                    o.x as Real,
-                    o.y as Real,
-                    (o.height / 2.0) as Real,
-                )),
+                RigidBodyBuilder::fixed().translation(centre),
                 ColliderBuilder::capsule_z(half, radius),
             )
             .1
@@ -454,7 +481,9 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         }
         if let Some(observer) = observer_collider {
             let window = options.strike_window_steps;
-            if track_strike(&mut sim, step, &world, hazard_collider, observer, window) {
+            let window_over =
+                track_strike(&mut sim, step, &world, hazard_collider, observer, window);
+            if window_over && !options.run_past_strike {
                 break;
             }
         }
@@ -587,6 +616,9 @@ fn track_strike(
     observer: ColliderHandle,
     window_steps: u32,
 ) -> bool {
+    if sim.strike.is_some_and(|s| step > s.step + window_steps) {
+        return true;
+    }
     if sim.hazard_contacts[step as usize] & TOUCH_OBSERVER != 0 {
         let speed = contact_point_speed(sim, step, world, hazard, observer);
         let strike = sim.strike.get_or_insert(Strike {
@@ -642,4 +674,45 @@ fn hazard_contact_flags(
         };
     }
     flags
+}
+
+/// The deepest any dynamic body of `sim` sinks into the standing observer's body — the
+/// static capsule of the counterfactual run (`simulate` with `observer_collider`) —
+/// over the whole run (m; 0 when nothing touches it). In the plain run the observer is
+/// no body and a hazard may pass through it; in the counterfactual run it stays out up
+/// to the solver's contact tolerance (millimetres).
+pub fn observer_penetration(spec: &SceneSpec, sim: &Simulation) -> f64 {
+    // The same capsule, at the same place, as the counterfactual's static collider.
+    let (centre, half, radius) = observer_capsule(&spec.observer, 0.0);
+    let capsule = SharedShape::capsule_z(half, radius);
+    let capsule_pose = Pose::from_translation(centre);
+    let parts: Vec<Vec<(Pose, SharedShape)>> = sim
+        .dynamic_bodies
+        .iter()
+        .map(|&b| posed_parts(&spec.bodies[b].parts))
+        .collect();
+    let mut deepest = 0.0f64;
+    for step in 0..=sim.steps() {
+        for (slot, body_parts) in parts.iter().enumerate() {
+            let s = sim.state(step, slot);
+            let body_pose = Pose::from_parts(
+                Vector::new(s.position[0], s.position[1], s.position[2]),
+                Rotation::from_xyzw(s.rotation[0], s.rotation[1], s.rotation[2], s.rotation[3]),
+            );
+            for (part_pose, shape) in body_parts {
+                let pose = body_pose * *part_pose;
+                let contact = rapier3d::parry::query::contact(
+                    &capsule_pose,
+                    capsule.as_ref(),
+                    &pose,
+                    shape.as_ref(),
+                    0.0,
+                );
+                if let Ok(Some(c)) = contact {
+                    deepest = deepest.max(-(c.dist as f64));
+                }
+            }
+        }
+    }
+    deepest
 }

@@ -7,6 +7,7 @@ use crate::families::Family;
 use crate::label::Labels;
 use crate::simulate::Simulation;
 use crate::spec::SceneSpec;
+use crate::visibility;
 use serde::{Deserialize, Serialize};
 
 /// The verdict columns, in `Verdicts::as_array` order (the data contract's list).
@@ -22,6 +23,9 @@ pub struct Verdicts {
     pub no_tunnelling: bool,
     /// The hazard stays in all three cameras' frames through the observation window.
     pub in_frame: bool,
+    /// Every camera sees enough of the hazard, large enough (`visibility`): no fixed body
+    /// and not the observer's body in the way.
+    pub visible: bool,
     /// The family's intended event happened.
     pub intended_event: bool,
     /// The hazard reaches the observer no earlier than Δ + `labels.reaction_time_min`
@@ -34,12 +38,13 @@ impl Verdicts {
         self.as_array().iter().all(|&v| v)
     }
 
-    pub fn as_array(&self) -> [bool; 6] {
+    pub fn as_array(&self) -> [bool; 7] {
         [
             self.no_interpenetration,
             self.energy,
             self.no_tunnelling,
             self.in_frame,
+            self.visible,
             self.intended_event,
             self.reaction_time,
         ]
@@ -56,16 +61,16 @@ impl Verdicts {
     }
 }
 
-/// Runs every validator. `cameras_in_frame` is the framing outcome (see `cameras::frame`);
+/// Runs every validator on a spec with its cameras (see `cameras::frame_group`);
 /// `labels` are the scene's labels (the reaction-time rule reads their times).
 pub fn validate(
     spec: &SceneSpec,
     sim: &Simulation,
     family: &dyn Family,
     cfg: &ValidatorConfig,
-    cameras_in_frame: bool,
     labels: &Labels,
 ) -> Verdicts {
+    let framing = cfg.framing();
     let e0 = sim.energy[0];
     let energy_limit = e0 + (cfg.energy_gain_relative * e0.abs()).max(cfg.energy_gain_absolute);
     Verdicts {
@@ -75,8 +80,8 @@ pub fn validate(
             .hazard_lowest_z
             .iter()
             .all(|&z| z >= -cfg.tunnel_tolerance),
-        in_frame: cameras_in_frame
-            && cameras::hazard_in_frame(spec, sim, &spec.cameras, &cfg.framing()),
+        in_frame: cameras::hazard_in_frame(spec, sim, &spec.cameras, &framing),
+        visible: visibility::assess(spec, sim, &framing).passes(&framing),
         intended_event: family.event_happened(spec, sim),
         reaction_time: reaction_time_ok(spec, labels),
     }

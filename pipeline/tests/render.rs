@@ -11,7 +11,7 @@ use rh_pipeline::render::{
     contact_sheet, frame_file_name, RenderOptions, RenderedScene, Renderer, Shading, CAMERAS,
     FRAME_TIMES, HAZARD_MASK_RGB,
 };
-use rh_pipeline::scene::produce_group;
+use rh_pipeline::scene::{full_event_simulation, produce_group};
 use rh_pipeline::selection::plan_group;
 use rh_pipeline::simulate::{simulate, SimOptions, Simulation};
 use rh_pipeline::spec::SceneSpec;
@@ -186,6 +186,27 @@ fn decode(path: &Path, w: u32, h: u32) -> Vec<Vec<u8>> {
         .chunks_exact((w * h * 3) as usize)
         .map(|c| c.to_vec())
         .collect()
+}
+
+/// The full-event video shows the counterfactual run (`scene::full_event_simulation`,
+/// the observer as a body) to its end; the observation videos the plain run.
+#[test]
+fn the_full_event_video_shows_the_counterfactual_run_to_its_end() {
+    let f = fixture();
+    for (spec, sim, r) in &f.scenes {
+        let full = full_event_simulation(spec, sim);
+        let full_steps = full.as_ref().map_or(sim.steps(), |s| s.steps());
+        let duration = full_steps as f64 * sim.dt;
+        let frames = (duration * f.options.full_fps as f64 + 1e-9).floor() as usize + 1;
+        assert_eq!(r.full_event_steps.len(), frames, "{}", spec.scene_id);
+        assert_eq!(
+            *r.full_event_steps.last().unwrap() as f64,
+            (((frames - 1) as f64 / f.options.full_fps as f64 / sim.dt).round())
+                .min(full_steps as f64),
+            "{}",
+            spec.scene_id
+        );
+    }
 }
 
 #[test]

@@ -159,6 +159,7 @@ print(json.dumps({{"columns": t.column_names, "n": t.num_rows,
         "valid_energy",
         "valid_no_tunnelling",
         "valid_in_frame",
+        "valid_visible",
         "valid_intended_event",
     ] {
         assert!(columns.contains(&required), "missing column {required}");
@@ -367,6 +368,23 @@ fn all_seventeen_families_build_valid_and_replay() {
     let per_family = summary["per_family"].as_object().unwrap();
     assert_eq!(per_family.len(), 17);
     assert!(per_family.values().all(|c| c == 20), "{per_family:?}");
+    // How many attempts each validator rejected, per family (issue 12: visibility).
+    let rejections = summary["rejections"].as_object().unwrap();
+    assert_eq!(rejections.len(), 17);
+    let mut attempts = 0;
+    let mut visible = 0;
+    for (family, r) in rejections {
+        let a = r["attempts"].as_u64().unwrap();
+        assert!(a >= 5, "{family}: five groups need at least five attempts");
+        let v = r["rejected_by"]["valid_visible"].as_u64().unwrap();
+        assert!(v < a, "{family}: {v} of {a}");
+        attempts += a;
+        visible += v;
+    }
+    assert!(
+        visible * 5 <= attempts,
+        "visibility rejected {visible} of {attempts}"
+    );
     let script = format!(
         "import pyarrow.parquet as pq, collections\nt = pq.read_table('{}/data/test-00000-of-00001.parquet').to_pylist()\nc = collections.Counter((r['family'], r['speed_band']) for r in t)\nprint(len(c), min(c.values()))",
         out.display()

@@ -23,8 +23,19 @@ fn small_config(dir: &Path) -> PathBuf {
         .replace("\nwidth = 1280\n", &format!("\nwidth = {W}\n"))
         .replace("\nheight = 720\n", &format!("\nheight = {H}\n"))
         .replace("\nfull_width = 640\n", &format!("\nfull_width = {W}\n"))
-        .replace("\nfull_height = 360\n", &format!("\nfull_height = {H}\n"));
+        .replace("\nfull_height = 360\n", &format!("\nfull_height = {H}\n"))
+        // The visibility rule's sizes are pixels at the configured resolution: scaled
+        // down with it (1280 × 720 → 160 × 96), so these small builds keep their scenes.
+        .replace("\nvisible_size_px_min = 8\n", "\nvisible_size_px_min = 1\n")
+        .replace(
+            "\nframe_size_px = [24, 400]\n",
+            "\nframe_size_px = [3, 53]\n",
+        );
     assert_ne!(small, default, "the [render] keys moved; update this test");
+    assert!(
+        small.contains("visible_size_px_min = 1\n"),
+        "the [validators] keys moved"
+    );
     let path = dir.join("small.toml");
     std::fs::write(&path, small).unwrap();
     path

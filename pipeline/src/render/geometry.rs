@@ -298,6 +298,27 @@ impl SceneGeometry {
         .collect()
     }
 
+    /// One rectangle (x, y, width, height) holding every pixel of view `v` that may
+    /// differ from its static image: the moving bodies' screen bounds (`moving`) and
+    /// the `redraw` rectangles. `None` when nothing can differ.
+    pub(super) fn changed_rect(
+        &self,
+        v: &FixedView,
+        moving: [Vec3; 2],
+        redraw: &[([u32; 4], Vec<Range<u32>>)],
+    ) -> Option<[u32; 4]> {
+        screen_rect(v.cam, v.view.as_ref(), moving)
+            .into_iter()
+            .chain(redraw.iter().map(|(r, _)| *r))
+            .filter(|r| r[2] > 0 && r[3] > 0)
+            .reduce(|a, b| {
+                let (x0, y0) = (a[0].min(b[0]), a[1].min(b[1]));
+                let x1 = (a[0] + a[2]).max(b[0] + b[2]);
+                let y1 = (a[1] + a[3]).max(b[1] + b[3]);
+                [x0, y0, x1 - x0, y1 - y0]
+            })
+    }
+
     /// Fixed bodies and the observer: the shadow casters that never move.
     pub(super) fn static_casters(&self) -> Vec<Range<u32>> {
         vec![self.fixed.clone(), self.observer.clone()]

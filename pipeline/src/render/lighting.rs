@@ -34,10 +34,11 @@ impl Lighting {
         let amb = (l.ambient * 1.3) as f32;
         let (light_vp, light_radius) = light_matrix(dir, room.size, room.ceiling_height);
         // How far from a moving body's shadow volume a static pixel's shading can still
-        // see it: the shader's normal offset, the comparison filter's 2×2 texels (with a
-        // texel to spare), and a centimetre of slack.
+        // see it: the shader's normal offset (constant plus slope-scaled), the filter's
+        // footprint (with a texel to spare), and a centimetre of slack.
         let texel = 2.0 * light_radius / gpu::SHADOW_SIZE as f64;
-        let shadow_reach = SHADOW_NORMAL_OFFSET + 3.0 * texel + 0.01;
+        let shadow_reach =
+            SHADOW_NORMAL_OFFSET + (SHADOW_SLOPE_OFFSET + SHADOW_PCF_TEXELS + 1.0) * texel + 0.01;
         Lighting {
             light_vp,
             sun_dir: [dir[0] as f32, dir[1] as f32, dir[2] as f32, 0.0],
@@ -101,3 +102,10 @@ fn light_matrix(dir: Vec3, size: [f64; 2], ceiling: f64) -> ([[f32; 4]; 4], f64)
 
 /// The shader's shadow lookup offset along the surface normal (m; `shadow_factor`).
 const SHADOW_NORMAL_OFFSET: f64 = 0.025;
+/// The shader's largest slope-scaled extra normal offset, in shadow-map texels (on
+/// surfaces the light grazes).
+const SHADOW_SLOPE_OFFSET: f64 = 2.5;
+/// How far (texels) the shader's filter reads from the lookup point: four bilinear
+/// taps half a texel off diagonally each read one more texel: 1.5 texels per axis,
+/// 1.5·√2 along the diagonal, which 2.5 bounds.
+const SHADOW_PCF_TEXELS: f64 = 2.5;

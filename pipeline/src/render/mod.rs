@@ -7,8 +7,9 @@
 //!   `spec.frame_step(k)`;
 //! * `frames/<scene_id>/<cam>_t0.000.png` … `_t0.600.png` (the same pixels as the video
 //!   frames at those times, before compression);
-//! * `videos/full/<scene_id>.mp4`: the whole simulation from an outside camera, for
-//!   people (never model input).
+//! * `videos/full/<scene_id>.mp4`: the whole event from an outside camera, for people
+//!   (never model input): the counterfactual run with the observer as a body
+//!   (`scene::full_event_simulation`), so what it shows is what the labels mean.
 //!
 //! Entry points: [`Renderer::new`] (one per worker thread, reused across scenes, or
 //! [`with_thread_renderer`]), [`Renderer::render_scene`], and [`contact_sheet`].
@@ -76,6 +77,8 @@ pub struct RenderOptions {
     /// MSAA samples on a hardware GPU, and on a CPU rasterizer.
     pub msaa: u32,
     pub msaa_cpu: u32,
+    /// FXAA-style post-process anti-aliasing wherever MSAA is off.
+    pub fxaa: bool,
 }
 
 impl RenderOptions {
@@ -91,6 +94,7 @@ impl RenderOptions {
             },
             msaa: c.msaa,
             msaa_cpu: c.msaa_cpu,
+            fxaa: c.fxaa,
         }
     }
 }
@@ -108,6 +112,7 @@ impl Default for RenderOptions {
             },
             msaa: 4,
             msaa_cpu: 1,
+            fxaa: true,
         }
     }
 }
@@ -124,7 +129,8 @@ pub struct RenderedScene {
     /// Observation-video frame `k` shows physics step `frame_steps[k]`.
     pub frame_steps: Vec<u32>,
     pub fps: u32,
-    /// Full-event frame `j` shows physics step `full_event_steps[j]`.
+    /// Full-event frame `j` shows physics step `full_event_steps[j]` of the full-event
+    /// run (`scene::full_event_simulation`, else the plain run).
     pub full_event_steps: Vec<u32>,
     pub full_event_fps: u32,
 }

@@ -7,7 +7,7 @@ use super::geometry::{FixedView, SceneGeometry};
 use super::gpu::{Gpu, OverlayJob, ViewJob};
 use super::regions::bounds;
 use super::{RenderError, RenderOptions, RenderedScene, Shading, CAMERAS, FRAME_TIMES, FULL_EVENT};
-use crate::scene::{SceneMedia, SceneResult};
+use crate::scene::{full_event_simulation, SceneMedia, SceneResult};
 use crate::simulate::{simulate, SimOptions, Simulation};
 use crate::spec::{CameraSpec, SceneSpec};
 use rh_catalog::Catalog;
@@ -48,7 +48,7 @@ impl Renderer {
     /// that FFmpeg has an H.264 encoder.
     pub fn new(opts: RenderOptions) -> Result<Renderer, RenderError> {
         encode::init().map_err(RenderError::Encode)?;
-        let gpu = Gpu::new(opts.msaa, opts.msaa_cpu)?;
+        let gpu = Gpu::new(opts.msaa, opts.msaa_cpu, opts.fxaa)?;
         Ok(Renderer { gpu, opts })
     }
 
@@ -75,24 +75,19 @@ impl Renderer {
         out_dir: &Path,
     ) -> Result<RenderedScene, RenderError> {
         let id = &spec.scene_id;
-        let cams: Vec<&CameraSpec> = CAMERAS
-            .iter()
-            .map(|name| {
-                spec.cameras
-                    .iter()
-                    .find(|c| c.name == *name)
-                    .ok_or_else(|| {
-                        RenderError::Scene(id.clone(), format!("no '{name}' camera in the spec"))
-                    })
-            })
-            .collect::<Result<_, _>>()?;
+        let cams = observation_cameras(spec)?;
         let scene = SceneGeometry::build(spec, sim, catalog);
         self.gpu
             .reserve(scene.statics.len() + scene.max_dynamic + 1024);
         self.gpu.set_static(&scene.statics);
+        // The full-event video shows the counterfactual run (the observer as a body),
+        // the observation videos the plain run (`scene::full_event_simulation`).
+        let counterfactual = full_event_simulation(spec, sim);
+        let full_sim = counterfactual.as_ref().unwrap_or(sim);
         // The cameras stand still within a scene: the room, furniture and observer are
         // drawn once per view and every frame starts from that image.
-        let full_cam = full_event_camera(spec, sim, self.opts.full_width, self.opts.full_height);
+        let full_cam =
+            full_event_camera(spec, full_sim, self.opts.full_width, self.opts.full_height);
         let mut all_cams = cams.clone();
         all_cams.push(&full_cam);
         let static_views: Vec<ViewJob> = all_cams
@@ -158,9 +153,9 @@ impl Renderer {
             }
         }
 
-        // Full-event video: the whole simulation from outside.
+        // Full-event video: the whole (counterfactual) simulation from outside.
         let full_fps = self.opts.full_fps.max(1);
-        let full_event_steps = full_event_steps(sim, full_fps);
+        let full_event_steps = full_event_steps(full_sim, full_fps);
         let full_rel = video_path(FULL_EVENT, id);
         let full_job = VideoJob::spawn(
             out_dir.join(&full_rel),
@@ -172,7 +167,7 @@ impl Renderer {
         );
         if result.is_ok() {
             for &step in &full_event_steps {
-                let mut images = self.draw_overlay_step(&scene, sim, step, full_view)?;
+                let mut images = self.draw_overlay_step(&scene, full_sim, step, full_view)?;
                 if !full_job.send(images.pop().unwrap()) {
                     break;
                 }
@@ -327,13 +322,18 @@ impl Renderer {
         let moving = bounds(&dynamic);
         let jobs: Vec<OverlayJob> = views
             .iter()
-            .map(|v| OverlayJob {
-                slot: v.slot,
-                uniforms: v.uniforms,
-                redraw: moving
+            .map(|v| {
+                let redraw = moving
                     .map(|m| scene.shadow_redraws(v, m))
-                    .unwrap_or_default(),
-                dynamic: dyn_range.clone(),
+                    .unwrap_or_default();
+                let changed = moving.and_then(|m| scene.changed_rect(v, m, &redraw));
+                OverlayJob {
+                    slot: v.slot,
+                    uniforms: v.uniforms,
+                    redraw,
+                    dynamic: dyn_range.clone(),
+                    changed,
+                }
             })
             .collect();
         self.gpu
@@ -363,6 +363,24 @@ pub fn render_stage(
         videos: rendered.videos,
         full_event: rendered.full_event,
     }))
+}
+
+/// The spec's observation cameras in `CAMERAS` order (an error names a missing one).
+fn observation_cameras(spec: &SceneSpec) -> Result<Vec<&CameraSpec>, RenderError> {
+    CAMERAS
+        .iter()
+        .map(|name| {
+            spec.cameras
+                .iter()
+                .find(|c| c.name == *name)
+                .ok_or_else(|| {
+                    RenderError::Scene(
+                        spec.scene_id.clone(),
+                        format!("no '{name}' camera in the spec"),
+                    )
+                })
+        })
+        .collect()
 }
 
 /// Full-event frame `j` shows physics step `round(j / fps / dt)` (at most the last).

@@ -72,17 +72,36 @@ fn vs_shadow(v: VIn) -> @builtin(position) vec4<f32> {
     return u.light_vp * vec4<f32>(v.pos, 1.0);
 }
 
-fn shadow_factor(world: vec3<f32>, n: vec3<f32>) -> f32 {
-    // Offset along the normal: SHADOW_NORMAL_OFFSET in mod.rs.
-    let lp = u.light_vp * vec4<f32>(world + n * 0.025, 1.0);
+// Shadow lookup. Must agree with lighting.rs, whose `shadow_reach` bounds how far from
+// a caster's shadow volume a pixel's shading can depend on it: the normal offset (at
+// most SHADOW_NORMAL_OFFSET + SHADOW_SLOPE_OFFSET texels) plus the filter's footprint
+// (SHADOW_PCF_TEXELS).
+fn shadow_factor(world: vec3<f32>, n: vec3<f32>, ndl: f32) -> f32 {
+    let size = vec2<f32>(textureDimensions(shadow_tex));
+    // World size of a shadow-map texel: the orthographic light matrix scales x by
+    // 1 / half-width (its first row).
+    let sx = length(vec3<f32>(u.light_vp[0].x, u.light_vp[1].x, u.light_vp[2].x));
+    let texel = 2.0 / (sx * size.x);
+    // Normal offset: a constant (2.5 cm) plus up to 2.5 texels on surfaces the light
+    // grazes (a wall lit at a low angle spans many depths within one texel: without
+    // it the lookup compares a surface against itself and shows acne hatching).
+    let sin_t = sqrt(max(1.0 - ndl * ndl, 0.0));
+    let lp = u.light_vp * vec4<f32>(world + n * (0.025 + 2.5 * texel * sin_t), 1.0);
     let ndc = lp.xyz / lp.w;
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
     if (uv.x < 0.0 || uv.x > 1.0 || uv.y < 0.0 || uv.y > 1.0 || ndc.z > 1.0) {
         return 1.0;
     }
-    // One comparison tap; the linear comparison sampler filters 2×2 texels (cheap
-    // soft edges on a CPU rasterizer, where every extra tap costs).
-    return textureSampleCompareLevel(shadow_tex, shadow_smp, uv, ndc.z - 0.002);
+    // Percentage-closer filtering: four bilinear comparison taps half a texel off
+    // diagonally (together a tent-weighted 3×3-texel footprint) for soft,
+    // staircase-free edges at the cost of four taps.
+    let d = ndc.z - 0.002;
+    let o = 0.5 / size;
+    var sum = textureSampleCompareLevel(shadow_tex, shadow_smp, uv + vec2<f32>(-o.x, -o.y), d);
+    sum = sum + textureSampleCompareLevel(shadow_tex, shadow_smp, uv + vec2<f32>(o.x, -o.y), d);
+    sum = sum + textureSampleCompareLevel(shadow_tex, shadow_smp, uv + vec2<f32>(-o.x, o.y), d);
+    sum = sum + textureSampleCompareLevel(shadow_tex, shadow_smp, uv + vec2<f32>(o.x, o.y), d);
+    return sum * 0.25;
 }
 
 @fragment
@@ -113,7 +132,7 @@ fn fs_main(i: VOut) -> @location(0) vec4<f32> {
     let ndl = max(dot(n, l), 0.0);
     var sh = 1.0;
     if (ndl > 0.0) {
-        sh = shadow_factor(i.world, n);
+        sh = shadow_factor(i.world, n, ndl);
     }
     let hemi = 0.8 + 0.2 * n.z;
     var color = base * (u.ambient.rgb * hemi + u.sun_color.rgb * ndl * sh);

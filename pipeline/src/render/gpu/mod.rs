@@ -1,6 +1,7 @@
 //! The wgpu side: device, pipelines (shadow + lit MSAA), render targets per output slot,
 //! and one call that draws a set of views of the current geometry and reads them back.
 
+mod post;
 mod setup;
 
 use super::mesh::Vertex;
@@ -50,6 +51,9 @@ pub struct OverlayJob {
     pub uniforms: Uniforms,
     pub redraw: Vec<([u32; 4], Vec<Range<u32>>)>,
     pub dynamic: Range<u32>,
+    /// A rectangle (x, y, width, height) holding every pixel that may differ from the
+    /// static image (the redraws and the moving bodies); `None`: none.
+    pub changed: Option<[u32; 4]>,
 }
 
 struct Target {
@@ -65,6 +69,9 @@ struct Target {
     /// copied in before each overlay frame.
     cache_color: wgpu::Texture,
     cache_depth: wgpu::Texture,
+    /// The FXAA pass's output, read back instead of `resolve` for lit views (`None`
+    /// without post-process anti-aliasing).
+    post: Option<post::PostTarget>,
     readback: wgpu::Buffer,
     padded_row: u32,
     uniform: wgpu::Buffer,
@@ -91,6 +98,8 @@ pub struct Gpu {
     shadow_sampler: wgpu::Sampler,
     shadow_uniform: wgpu::Buffer,
     shadow_bind: wgpu::BindGroup,
+    /// Post-process anti-aliasing (FXAA), where MSAA is off and it is enabled.
+    post: Option<post::Post>,
     vbuf: wgpu::Buffer,
     vcap: u64,
     static_len: u32,
@@ -191,8 +200,18 @@ impl Gpu {
             let v = t.create_view(&Default::default());
             (t, v)
         });
-        let resolve = tex(1, COLOR_FORMAT, attachment);
+        let resolve = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: None,
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: COLOR_FORMAT,
+            usage: attachment | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[post::SOURCE_VIEW_FORMAT],
+        });
         let resolve_view = resolve.create_view(&Default::default());
+        let post = self.post.as_ref().map(|p| p.target(&self.device, &resolve));
         let depth = tex(self.samples, DEPTH_FORMAT, attachment);
         let depth_view = depth.create_view(&Default::default());
         // Copies need no render usage, but a multisampled texture must be renderable.
@@ -239,6 +258,7 @@ impl Gpu {
             depth_view,
             cache_color,
             cache_depth,
+            post,
             readback,
             padded_row,
             uniform,
@@ -303,8 +323,12 @@ impl Gpu {
             if cache {
                 copy_whole(&mut enc, t.color(), &t.cache_color);
                 copy_whole(&mut enc, &t.depth, &t.cache_depth);
+                if let (Some(post), Some(pt)) = (&self.post, &t.post) {
+                    post.encode(&mut enc, pt, None);
+                    copy_whole(&mut enc, &pt.out, &pt.cache);
+                }
             } else {
-                Self::copy_to_readback(&mut enc, t);
+                self.copy_to_readback(&mut enc, t, lit(&v.uniforms));
             }
         }
         enc
@@ -353,7 +377,18 @@ impl Gpu {
             copy_whole(&mut enc, &t.cache_depth, &t.depth);
             let redraw = Redraw::Regions(rects);
             self.main_pass(&mut enc, t, redraw, &v.dynamic);
-            Self::copy_to_readback(&mut enc, t);
+            match (&self.post, &t.post) {
+                // Anti-aliased: the static image's, redone around what changed.
+                (Some(post), Some(pt)) if lit(&v.uniforms) => {
+                    copy_whole(&mut enc, &pt.cache, &pt.out);
+                    let grown = v.changed.and_then(|r| grow(r, post::REACH, t));
+                    if let Some(r) = grown {
+                        post.encode(&mut enc, pt, Some(r));
+                    }
+                    Self::copy_texture_to_readback(&mut enc, t, &pt.out);
+                }
+                _ => Self::copy_texture_to_readback(&mut enc, t, &t.resolve),
+            }
         }
         self.queue.submit([enc.finish()]);
         self.read_back(views.iter().map(|v| v.slot))
@@ -510,9 +545,26 @@ impl Gpu {
         }
     }
 
-    fn copy_to_readback(enc: &mut wgpu::CommandEncoder, t: &Target) {
+    /// Queues the frame's read-back: for a lit view (`aa`) through the FXAA pass when
+    /// there is one; diagnostic views (exact hazard masks) as drawn.
+    fn copy_to_readback(&self, enc: &mut wgpu::CommandEncoder, t: &Target, aa: bool) {
+        let source = match (&self.post, &t.post) {
+            (Some(post), Some(pt)) if aa => {
+                post.encode(enc, pt, None);
+                &pt.out
+            }
+            _ => &t.resolve,
+        };
+        Self::copy_texture_to_readback(enc, t, source);
+    }
+
+    fn copy_texture_to_readback(
+        enc: &mut wgpu::CommandEncoder,
+        t: &Target,
+        source: &wgpu::Texture,
+    ) {
         enc.copy_texture_to_buffer(
-            whole(&t.resolve),
+            whole(source),
             wgpu::TexelCopyBufferInfo {
                 buffer: &t.readback,
                 layout: wgpu::TexelCopyBufferLayout {
@@ -568,6 +620,19 @@ impl Target {
             None => &self.resolve,
         }
     }
+}
+
+/// `r` grown by `by` pixels on every side, clamped to the target (`None` if empty).
+fn grow([x, y, w, h]: [u32; 4], by: u32, t: &Target) -> Option<[u32; 4]> {
+    let (x0, y0) = (x.saturating_sub(by), y.saturating_sub(by));
+    let x1 = (x + w + by).min(t.width);
+    let y1 = (y + h + by).min(t.height);
+    (x1 > x0 && y1 > y0).then_some([x0, y0, x1 - x0, y1 - y0])
+}
+
+/// Whether a view is shaded for the dataset (not an unlit diagnostic: `ambient.w`).
+fn lit(u: &Uniforms) -> bool {
+    u.ambient[3] <= 0.5
 }
 
 fn extent(width: u32, height: u32) -> wgpu::Extent3d {

@@ -242,9 +242,11 @@ fn pipelines(
 
 impl Gpu {
     /// Opens the adapter and builds the pipelines with `samples` MSAA samples on a
-    /// hardware GPU, `cpu_samples` on a CPU rasterizer (4 or 1 each).
-    pub fn new(samples: u32, cpu_samples: u32) -> Result<Gpu, RenderError> {
+    /// hardware GPU, `cpu_samples` on a CPU rasterizer (4 or 1 each); `fxaa`: a
+    /// post-process anti-aliasing pass on lit frames wherever MSAA is off.
+    pub fn new(samples: u32, cpu_samples: u32, fxaa: bool) -> Result<Gpu, RenderError> {
         let (device, queue, adapter_name, samples) = open_device(samples, cpu_samples)?;
+        let post = (fxaa && samples == 1).then(|| post::Post::new(&device));
         let (shadow_bgl, main_bgl) = bind_group_layouts(&device);
         let layout = |bgl: &wgpu::BindGroupLayout| {
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -310,6 +312,7 @@ impl Gpu {
             shadow_sampler,
             shadow_uniform,
             shadow_bind,
+            post,
             vbuf,
             vcap,
             static_len: 0,

@@ -86,21 +86,28 @@ fn sphere_fruit(m: &mut Mesh, k: &Kit) {
 
 fn ball(m: &mut Mesh, k: &Kit) {
     let Kit { c, s, id, r, .. } = *k;
-    let big = r >= 0.15;
-    let seam = r * 0.09;
-    let paint = move |p: V3| {
-        if big {
-            // Beach ball: six coloured gores.
+    if r >= 0.15 {
+        // Beach ball: six coloured gores and white caps. Triangles take the colour at
+        // their centroid, so every colour boundary lies on mesh edges (no sawtooth):
+        // 48 segments around (8 per 60° gore, boundaries at multiples of 60°) and 24
+        // rings of 7.5°, the caps being the first two (cos 15° ≈ 0.966; every cap
+        // triangle's centroid is above 0.96 r, every other one below).
+        let paint = move |p: V3| {
             let a = p[1].atan2(p[0]);
             let k = ((a + PI) / TAU * 6.0) as i32;
-            return if p[2].abs() > r * 0.93 {
+            if p[2].abs() > r * 0.96 {
                 WHITE
             } else if k % 2 == 0 {
                 mat(c, MAT_GLOSSY)
             } else {
                 mat(s, MAT_GLOSSY)
-            };
-        }
+            }
+        };
+        m.sphere(&id, r, 48, &paint);
+        return;
+    }
+    let seam = r * 0.09;
+    let paint = move |p: V3| {
         // Two crossing seams (tennis/basketball/baseball-like), plus an equator
         // on larger balls.
         let curve = p[2] - 0.35 * r * (2.0 * p[1].atan2(p[0])).sin();

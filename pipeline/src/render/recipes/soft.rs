@@ -109,14 +109,29 @@ fn pillow(m: &mut Mesh, k: &Kit) {
 fn punching_bag(m: &mut Mesh, k: &Kit) {
     let Kit { c, s, h, id, .. } = *k;
     let (rp, hz) = (h[0], h[2]);
-    let paint = move |p: V3| {
-        if p[2].abs() > hz * 0.7 || (p[2] - hz * 0.35).abs() < hz * 0.03 {
-            s
-        } else {
-            mat(c, MAT_GLOSSY)
-        }
-    };
-    m.capsule(&id, rp, hz - rp, 24, &paint);
+    let hh = (hz - rp).max(0.0);
+    let leather = mat(c, MAT_GLOSSY);
+    // Red leather body with a dark band, and a dark end cap on each hemisphere.
+    // Triangles take the colour at their centroid, so boundaries lie on mesh edges:
+    // the body is one band of quads (the band is a ring of its own), and the caps are
+    // the hemispheres' first two rings of 15° (24 segments: centroids above 0.85 r).
+    m.frustum(&id, rp, rp, hh, 24, (false, false), &solid(leather));
+    let band = hz * 0.35;
+    if band + rp * 0.15 < hh {
+        m.frustum(
+            &id.then(&Xf::at([0.0, 0.0, band])),
+            rp * 1.01,
+            rp * 1.01,
+            hz * 0.03,
+            24,
+            (false, false),
+            &solid(s),
+        );
+    }
+    for sz in [-1.0f32, 1.0] {
+        let cap = move |p: V3| if p[2] * sz > rp * 0.85 { s } else { leather };
+        m.sphere(&id.then(&Xf::at([0.0, 0.0, sz * hh])), rp, 24, &cap);
+    }
 }
 
 fn tyre(m: &mut Mesh, k: &Kit) {

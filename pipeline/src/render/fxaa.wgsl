@@ -1,0 +1,69 @@
+// FXAA-style post-process anti-aliasing (after Lottes' FXAA, the compact variant):
+// a full-screen pass over a resolved frame, in display (sRGB-encoded) values. Pixels
+// whose four neighbours differ little in luma are copied unchanged (most pixels: five
+// texel loads); on an edge, the blur direction is taken from the luma gradient and the
+// frame is sampled along it (four more filtered taps).
+
+@group(0) @binding(0) var src: texture_2d<f32>;
+@group(0) @binding(1) var smp: sampler;
+
+// One triangle covering the target.
+@vertex
+fn vs_post(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let x = f32((i << 1u) & 2u);
+    let y = f32(i & 2u);
+    return vec4<f32>(x * 2.0 - 1.0, y * 2.0 - 1.0, 0.0, 1.0);
+}
+
+fn luma(c: vec3<f32>) -> f32 {
+    return dot(c, vec3<f32>(0.299, 0.587, 0.114));
+}
+
+fn tap(uv: vec2<f32>) -> vec3<f32> {
+    return textureSampleLevel(src, smp, uv, 0.0).rgb;
+}
+
+// Edge detection: local contrast below max(EDGE_MIN, EDGE_REL · brightest) is left alone.
+const EDGE_MIN: f32 = 0.0312;
+const EDGE_REL: f32 = 0.125;
+const REDUCE_MUL: f32 = 0.125;
+const REDUCE_MIN: f32 = 0.0078125;
+const SPAN_MAX: f32 = 8.0;
+
+@fragment
+fn fs_fxaa(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    let dims = vec2<i32>(textureDimensions(src));
+    let p = vec2<i32>(pos.xy);
+    let hi = dims - vec2<i32>(1, 1);
+    let m = textureLoad(src, p, 0).rgb;
+    let lm = luma(m);
+    let ln = luma(textureLoad(src, clamp(p + vec2<i32>(0, -1), vec2<i32>(0, 0), hi), 0).rgb);
+    let ls = luma(textureLoad(src, clamp(p + vec2<i32>(0, 1), vec2<i32>(0, 0), hi), 0).rgb);
+    let lw = luma(textureLoad(src, clamp(p + vec2<i32>(-1, 0), vec2<i32>(0, 0), hi), 0).rgb);
+    let le = luma(textureLoad(src, clamp(p + vec2<i32>(1, 0), vec2<i32>(0, 0), hi), 0).rgb);
+    let lmin = min(lm, min(min(ln, ls), min(lw, le)));
+    let lmax = max(lm, max(max(ln, ls), max(lw, le)));
+    if (lmax - lmin < max(EDGE_MIN, lmax * EDGE_REL)) {
+        return vec4<f32>(m, 1.0);
+    }
+    let inv = 1.0 / vec2<f32>(dims);
+    let uv = pos.xy * inv;
+    // Diagonal neighbours: the gradient's direction.
+    let lnw = luma(tap(uv + vec2<f32>(-1.0, -1.0) * inv));
+    let lne = luma(tap(uv + vec2<f32>(1.0, -1.0) * inv));
+    let lsw = luma(tap(uv + vec2<f32>(-1.0, 1.0) * inv));
+    let lse = luma(tap(uv + vec2<f32>(1.0, 1.0) * inv));
+    var dir = vec2<f32>(-((lnw + lne) - (lsw + lse)), (lnw + lsw) - (lne + lse));
+    let reduce = max((lnw + lne + lsw + lse) * 0.25 * REDUCE_MUL, REDUCE_MIN);
+    let scale = 1.0 / (min(abs(dir.x), abs(dir.y)) + reduce);
+    dir = clamp(dir * scale, vec2<f32>(-SPAN_MAX), vec2<f32>(SPAN_MAX)) * inv;
+    let a = 0.5 * (tap(uv + dir * (1.0 / 3.0 - 0.5)) + tap(uv + dir * (2.0 / 3.0 - 0.5)));
+    let b = a * 0.5 + 0.25 * (tap(uv - dir * 0.5) + tap(uv + dir * 0.5));
+    let lb = luma(b);
+    let lo = min(lmin, min(min(lnw, lne), min(lsw, lse)));
+    let up = max(lmax, max(max(lnw, lne), max(lsw, lse)));
+    if (lb < lo || lb > up) {
+        return vec4<f32>(a, 1.0);
+    }
+    return vec4<f32>(b, 1.0);
+}
