@@ -71,6 +71,7 @@ pub mod col {
     pub const OBSERVER_POSE: &str = "observer_pose";
     pub const LABEL_RULE: &str = "label_rule";
     pub const STATE_HASH: &str = "state_hash";
+    pub const DECISION_STATE_HASH: &str = "decision_state_hash";
     pub const SIM_STEPS: &str = "sim_steps";
     pub const VALID: &str = "valid";
     pub const VALID_NO_INTERPENETRATION: &str = "valid_no_interpenetration";
@@ -358,6 +359,12 @@ pub const COLUMNS: &[Column] = &[
         Utf8,
         false,
         "SHA-256 (first 16 bytes, hex) of every dynamic body's state at every physics step; `rh-pipeline verify` replays specs against it",
+    ),
+    c(
+        col::DECISION_STATE_HASH,
+        Utf8,
+        false,
+        "The same hash over steps 0 to the decision moment Δ only (or to sim_steps if the scene ended earlier); `rh-score --execute` checks its replay up to Δ against it",
     ),
     c(
         col::SIM_STEPS,

@@ -190,6 +190,7 @@ pub fn record_batch(results: &[SceneResult], catalog: &Catalog) -> RecordBatch {
         vec3s(&|r| Some([r.spec.observer.x, r.spec.observer.y, r.spec.observer.yaw])),
         strings!(|r: &SceneResult| Some(r.spec.labels.rule_version.clone())),
         strings!(|r: &SceneResult| Some(r.state_hash.clone())),
+        strings!(|r: &SceneResult| Some(r.decision_state_hash.clone())),
         prim!(UInt32Builder, |r: &SceneResult| Some(r.steps)),
         bools(&|r| r.verdicts.all()),
     ];

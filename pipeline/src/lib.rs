@@ -19,6 +19,7 @@ pub mod cli;
 pub mod config;
 pub mod dataset;
 pub mod dataset_stream;
+pub mod execute;
 pub mod families;
 pub mod fsio;
 pub mod integrity;

@@ -22,6 +22,8 @@ pub struct SceneResult {
     pub labels: Labels,
     pub verdicts: Verdicts,
     pub state_hash: String,
+    /// The state hash of steps 0..=Δ (`Simulation::state_hash_through`).
+    pub decision_state_hash: String,
     /// The hazard's centre of mass at each video frame: `[t, x, y, z]` until the scene ends.
     pub trajectory: Vec<[f32; 4]>,
     pub steps: u32,
@@ -114,6 +116,7 @@ pub fn label_scene(spec: SceneSpec, sim: Simulation, config: &Config) -> SceneRe
     let trajectory = hazard_trajectory(&spec, &sim);
     SceneResult {
         state_hash: sim.state_hash.clone(),
+        decision_state_hash: sim.state_hash_through(crate::label::decision_step(&spec)),
         steps: sim.steps(),
         spec,
         labels,

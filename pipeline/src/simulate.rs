@@ -104,6 +104,18 @@ impl Simulation {
         self.hazard_com[step as usize]
     }
 
+    /// The state hash of steps `0..=step` only (`step` ≤ `steps()`): the same SHA-256
+    /// over the same numbers, stopped early. At the decision step Δ it is the
+    /// `decision_state_hash` column, which `execute` checks its replay against.
+    pub fn state_hash_through(&self, step: u32) -> String {
+        let mut hasher = Sha256::new();
+        let n = (step.min(self.steps()) as usize + 1) * self.dynamic_bodies.len();
+        for state in &self.states[..n] {
+            state.hash_into(&mut hasher);
+        }
+        hash_hex(hasher)
+    }
+
     /// First step (≥ 1) whose hazard touches anything.
     pub fn first_contact_step(&self) -> Option<u32> {
         (1..=self.steps()).find(|&k| self.hazard_contacts[k as usize] != 0)
@@ -249,7 +261,7 @@ fn observer_capsule(o: &ObserverSpec, inflate: f64) -> (Vector, Real, Real) {
 
 /// Height of a collider's lowest point: the tightest of its parts' bounding boxes (a
 /// compound's own box is its local box rotated, which can reach far below its parts).
-fn lowest_z(collider: &Collider) -> f64 {
+pub(crate) fn lowest_z(collider: &Collider) -> f64 {
     let pose = collider.position();
     match collider.shape().as_compound() {
         Some(compound) => compound
@@ -300,8 +312,59 @@ fn contact_point_speed(
 const FLOOR_HALF_EXTENT: Real = 50.0;
 const FLOOR_HALF_THICKNESS: Real = 0.5;
 
-/// Runs the scene. Pure in `spec` and `options`.
-pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
+/// A spec's world as built for stepping: the floor, every body and joint, in spec
+/// order — the one place the physics setup lives (`simulate` and `execute` both start
+/// from it, so a replay cannot drift from the build).
+pub struct SceneWorld {
+    pub world: PhysicsWorld,
+    pub floor: ColliderHandle,
+    /// Per spec body.
+    pub body_handles: Vec<RigidBodyHandle>,
+    /// Per spec body.
+    pub collider_handles: Vec<ColliderHandle>,
+    /// Spec indices of the dynamic bodies, in spec order (the hashed state's order).
+    pub dynamic_bodies: Vec<usize>,
+}
+
+impl SceneWorld {
+    /// State of spec body `i` as the solver holds it.
+    pub fn body_state(&self, i: usize) -> BodyState {
+        state_of(&self.world.bodies[self.body_handles[i]])
+    }
+
+    /// Folds every dynamic body's current state into `hasher`, in the state hash's order.
+    pub fn hash_step(&self, hasher: &mut Sha256) {
+        for &i in &self.dynamic_bodies {
+            self.body_state(i).hash_into(hasher);
+        }
+    }
+}
+
+impl BodyState {
+    /// The state's 13 numbers, little-endian, in the state hash's order.
+    pub fn hash_into(&self, hasher: &mut Sha256) {
+        for value in self
+            .position
+            .iter()
+            .chain(&self.rotation)
+            .chain(&self.linvel)
+            .chain(&self.angvel)
+        {
+            hasher.update(value.to_le_bytes());
+        }
+    }
+}
+
+/// Hex of the first 16 bytes of a SHA-256 digest (the state hash's format).
+pub fn hash_hex(hasher: Sha256) -> String {
+    hasher.finalize()[..16]
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// Builds the spec's world at t0 (no observer). Pure in `spec`.
+pub fn build_world(spec: &SceneSpec) -> SceneWorld {
     let mut world = PhysicsWorld::new();
     world.gravity = v3(spec.physics.gravity);
     world.integration_parameters.dt = spec.physics.dt as Real;
@@ -321,6 +384,27 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
     let (body_handles, collider_handles) = insert_bodies(&mut world, spec);
 
     insert_joints(&mut world, spec, &body_handles);
+    let dynamic_bodies: Vec<usize> = (0..spec.bodies.len())
+        .filter(|&i| spec.bodies[i].kind == BodyKind::Dynamic)
+        .collect();
+    SceneWorld {
+        world,
+        floor,
+        body_handles,
+        collider_handles,
+        dynamic_bodies,
+    }
+}
+
+/// Runs the scene. Pure in `spec` and `options`.
+pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
+    let SceneWorld {
+        mut world,
+        floor,
+        body_handles,
+        collider_handles,
+        dynamic_bodies,
+    } = build_world(spec);
 
     let observer_collider = options.observer_collider.then(|| {
         let (centre, half, radius) = observer_capsule(&spec.observer, 0.0);
@@ -332,9 +416,6 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
             .1
     });
 
-    let dynamic_bodies: Vec<usize> = (0..spec.bodies.len())
-        .filter(|&i| spec.bodies[i].kind == BodyKind::Dynamic)
-        .collect();
     let hazard_slot = dynamic_bodies
         .iter()
         .position(|&i| i == spec.hazard)
@@ -373,25 +454,8 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         let mut energy = 0.0f64;
         for &i in &dynamic_bodies {
             let rb = &world.bodies[body_handles[i]];
-            let t = rb.translation();
-            let q = rb.rotation();
-            let v = rb.linvel();
-            let w = rb.angvel();
-            let state = BodyState {
-                position: [t.x, t.y, t.z],
-                rotation: [q.x, q.y, q.z, q.w],
-                linvel: [v.x, v.y, v.z],
-                angvel: [w.x, w.y, w.z],
-            };
-            for value in state
-                .position
-                .iter()
-                .chain(&state.rotation)
-                .chain(&state.linvel)
-                .chain(&state.angvel)
-            {
-                hasher.update(value.to_le_bytes());
-            }
+            let state = state_of(rb);
+            state.hash_into(&mut hasher);
             sim.states.push(state);
             let com = rb.center_of_mass();
             energy += rb.kinetic_energy() as f64 - rb.mass() as f64 * (gravity.dot(com) as f64);
@@ -433,9 +497,21 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
             break;
         }
     }
-    let digest = hasher.finalize();
-    sim.state_hash = digest[..16].iter().map(|b| format!("{b:02x}")).collect();
+    sim.state_hash = hash_hex(hasher);
     sim
+}
+
+fn state_of(rb: &RigidBody) -> BodyState {
+    let t = rb.translation();
+    let q = rb.rotation();
+    let v = rb.linvel();
+    let w = rb.angvel();
+    BodyState {
+        position: [t.x, t.y, t.z],
+        rotation: [q.x, q.y, q.z, q.w],
+        linvel: [v.x, v.y, v.z],
+        angvel: [w.x, w.y, w.z],
+    }
 }
 
 /// Inserts every body of the spec with its collider, in spec order.
@@ -562,7 +638,7 @@ fn track_strike(
 }
 
 /// Total normal impulse between two colliders in the last step (N·s).
-fn contact_impulse(world: &PhysicsWorld, a: ColliderHandle, b: ColliderHandle) -> f64 {
+pub(crate) fn contact_impulse(world: &PhysicsWorld, a: ColliderHandle, b: ColliderHandle) -> f64 {
     world
         .narrow_phase
         .contact_pair(a, b)

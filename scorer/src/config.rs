@@ -17,6 +17,10 @@ pub struct Config {
     pub sanity: SanityConfig,
     pub analyses: AnalysesConfig,
     pub aia: AiaConfig,
+    /// `[execution]`: the physics executor's limits and outcome thresholds (`--execute`);
+    /// the embedded default's when a config file has none.
+    #[serde(default = "rh_pipeline::execute::ExecConfig::embedded_default")]
+    pub execution: rh_pipeline::execute::ExecConfig,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -109,6 +113,9 @@ impl Config {
             if !(v.is_finite() && v > 0.0) {
                 bail!("config field {name} must be a positive finite number, got {v}");
             }
+        }
+        if let Err(e) = self.execution.validate() {
+            bail!("config field {e}");
         }
         if self.sanity.max_line_bytes < 1024 {
             bail!("config field sanity.max_line_bytes must be at least 1024");

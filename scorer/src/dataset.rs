@@ -412,3 +412,63 @@ fn read_parquet(file: &Path) -> Result<Vec<SceneInput>> {
     }
     Ok(out)
 }
+
+/// What `--execute` needs to replay one scene: its spec file and the stored state hashes.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ReplayKey {
+    /// `spec_file`, relative to the dataset root (default `specs/<scene_id>.json`).
+    pub spec_file: String,
+    /// `state_hash` (whole run), when the column exists.
+    pub state_hash: Option<String>,
+    /// `decision_state_hash` (steps 0..=Δ), when the column exists.
+    pub decision_state_hash: Option<String>,
+}
+
+/// Reads the replay columns of `DIR/data/*.parquet` (absent optional columns are `None`).
+pub fn read_replay_keys(dir: &Path) -> Result<FastMap<String, ReplayKey>> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir.join("data"))
+        .map_err(|e| {
+            InputError(format!(
+                "dataset {} has no readable data/: {e}",
+                dir.display()
+            ))
+        })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
+        .collect();
+    files.sort();
+    let mut out = FastMap::default();
+    for file in &files {
+        let f = std::fs::File::open(file)
+            .map_err(|e| InputError(format!("cannot open {}: {e}", file.display())))?;
+        let reader = ParquetRecordBatchReaderBuilder::try_new(f)
+            .map_err(|e| InputError(format!("{}: {e}", file.display())))?
+            .build()
+            .with_context(|| format!("reading {}", file.display()))?;
+        for batch in reader {
+            let batch = batch.map_err(|e| InputError(format!("{}: {e}", file.display())))?;
+            let optional = |name: &str| -> Result<Vec<Option<String>>> {
+                if batch.column_by_name(name).is_some() {
+                    strings(&batch, file, name)
+                } else {
+                    Ok(vec![None; batch.num_rows()])
+                }
+            };
+            let ids = required_strings(&batch, file, col::SCENE_ID)?;
+            let specs = optional(col::SPEC_FILE)?;
+            let full = optional(col::STATE_HASH)?;
+            let decision = optional(col::DECISION_STATE_HASH)?;
+            for (i, id) in ids.into_iter().enumerate() {
+                let key = ReplayKey {
+                    spec_file: specs[i]
+                        .clone()
+                        .unwrap_or_else(|| rh_contract::layout::spec_path(&id)),
+                    state_hash: full[i].clone(),
+                    decision_state_hash: decision[i].clone(),
+                };
+                out.entry(id).or_insert(key);
+            }
+        }
+    }
+    Ok(out)
+}

@@ -33,6 +33,7 @@ pub mod aia;
 pub mod baseline;
 pub mod config;
 pub mod dataset;
+pub mod execution;
 pub mod explain;
 pub mod figures;
 pub mod fixture;

@@ -98,6 +98,8 @@ pub enum LineOutcome {
         notes: Vec<&'static str>,
         /// The line's `prompt_version` (rh-score predict), if any.
         prompt_version: Option<String>,
+        /// The parsed plan (`None`: lost or R1), for `--execute`.
+        plan: Option<Box<Plan>>,
     },
 }
 
@@ -284,6 +286,7 @@ fn decide(
             result: None,
             notes: Vec::new(),
             prompt_version,
+            plan: None,
         };
     }
     let (plan, none) = plan();
@@ -310,6 +313,7 @@ fn decide(
         result: Some(result),
         notes,
         prompt_version,
+        plan: plan.map(Box::new),
     }
 }
 

@@ -256,6 +256,9 @@ pub struct Report {
     /// All models pooled (`model` = "ALL").
     pub pooled: ModelReport,
     pub analyses: Analyses,
+    /// `--execute`: outcomes in physics (SPEC §12).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub execution: Option<crate::execution::ExecutionReport>,
 }
 
 fn ratio(a: u64, b: u64) -> Option<f64> {
@@ -662,6 +665,7 @@ impl Report {
             models: owned.iter().map(|m| model_report(m, ds)).collect(),
             pooled: model_report(&pooled, ds),
             analyses,
+            execution: None,
         }
     }
 }

@@ -45,6 +45,19 @@ pub struct Scoring<'a> {
     pub lost: u64,
     pub duplicates: u64,
     decisions_out: Option<Box<dyn Write + 'a>>,
+    /// With `--execute`: the decisions to execute, and the decision lines held back until
+    /// their outcomes are known.
+    exec: Option<ExecCollect>,
+}
+
+/// What `--execute` collects while scoring.
+#[derive(Default)]
+pub struct ExecCollect {
+    /// One per (model, scene): the counted decision (a retry replaces a lost one).
+    pub pending: Vec<crate::execution::Pending>,
+    index: FastMap<(usize, u32), usize>,
+    /// Decision lines (model, scene, JSON), written after execution.
+    pub deferred: Vec<(usize, u32, serde_json::Value)>,
 }
 
 impl<'a> Scoring<'a> {
@@ -62,7 +75,27 @@ impl<'a> Scoring<'a> {
             lost: 0,
             duplicates: 0,
             decisions_out: None,
+            exec: None,
         }
+    }
+
+    /// Also collect every scored decision's plan for `--execute` (decision lines are then
+    /// held back: see [`Scoring::take_execution`]).
+    pub fn with_execution(mut self) -> Self {
+        self.exec = Some(ExecCollect::default());
+        self
+    }
+
+    /// The collected decisions and the model names (index = `Pending::model`); the held
+    /// back decision lines are for the caller to complete and write.
+    pub fn take_execution(&mut self) -> Option<(ExecCollect, Vec<String>)> {
+        let names = self.models.iter().map(|m| m.name.clone()).collect();
+        self.exec.take().map(|c| (c, names))
+    }
+
+    /// Where decision lines go (for writing the held-back ones).
+    pub fn decisions_output(&mut self) -> Option<&mut (dyn Write + 'a)> {
+        self.decisions_out.as_deref_mut()
     }
 
     /// Also write one JSON line per decision (scored, lost or duplicate) to `w`.
@@ -163,6 +196,7 @@ impl<'a> Scoring<'a> {
                 result,
                 notes,
                 prompt_version,
+                plan,
             } => {
                 for n in notes {
                     self.warn(n, line, None);
@@ -201,6 +235,9 @@ impl<'a> Scoring<'a> {
                 } else {
                     self.lost += 1;
                 }
+                if let Some(c) = self.exec.as_mut() {
+                    c.collect(counted, mi, scene, line, result.as_ref(), plan.as_deref());
+                }
                 if let Some(w) = self.decisions_out.as_mut() {
                     let status = match (counted, &result) {
                         (false, _) => "duplicate",
@@ -222,8 +259,13 @@ impl<'a> Scoring<'a> {
                         }),
                         result: result.as_ref(),
                     };
-                    serde_json::to_writer(&mut *w, &rec)?;
-                    w.write_all(b"\n")?;
+                    match self.exec.as_mut() {
+                        Some(c) => c.deferred.push((mi, scene, serde_json::to_value(&rec)?)),
+                        None => {
+                            serde_json::to_writer(&mut *w, &rec)?;
+                            w.write_all(b"\n")?;
+                        }
+                    }
                 }
             }
         }
@@ -241,4 +283,35 @@ struct DecisionLine<'a> {
     rules: Vec<&'static str>,
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     result: Option<&'a DecisionResult>,
+}
+
+impl ExecCollect {
+    fn collect(
+        &mut self,
+        counted: bool,
+        model: usize,
+        scene: u32,
+        line: u64,
+        result: Option<&DecisionResult>,
+        plan: Option<&crate::plan::Plan>,
+    ) {
+        let Some(r) = result.filter(|_| counted) else {
+            return;
+        };
+        let p = crate::execution::Pending {
+            line,
+            scene,
+            model,
+            plan: plan.map(crate::execution::exec_plan),
+            action: r.action,
+            saa: r.saa,
+        };
+        match self.index.get(&(model, scene)) {
+            Some(&i) => self.pending[i] = p,
+            None => {
+                self.index.insert((model, scene), self.pending.len());
+                self.pending.push(p);
+            }
+        }
+    }
 }

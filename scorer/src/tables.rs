@@ -571,6 +571,9 @@ pub fn markdown(r: &Report) -> String {
         s.push_str(&warnings_text(r));
         s.push_str("```\n");
     }
+    if let Some(e) = &r.execution {
+        s.push_str(&crate::execution::report::markdown(e));
+    }
     s
 }
 

@@ -429,12 +429,14 @@ fn bad_inputs_exit_2_with_a_message() {
         Some(2)
     );
     assert_eq!(run("rh-score", &["--no-such-flag"]).status.code(), Some(2));
-    // --execute is not in this build.
+    // --execute on a dataset without scene specs (a fixture) is an input error naming
+    // the missing spec file.
     let out = run(
         "rh-score",
-        &[p.to_str().unwrap(), "--dataset", d, "--execute"],
+        &[p.to_str().unwrap(), "--dataset", d, "--execute", "--no-exec-cache"],
     );
     assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("specs/"));
 }
 
 #[test]

@@ -70,9 +70,19 @@ struct Cli {
     #[arg(long, value_name = "FILE")]
     config: Option<PathBuf>,
 
-    /// Execute plans in physics (SPEC §12; not available in this build).
+    /// Execute every scored plan in physics (SPEC §12): replay the scene from its spec to
+    /// the decision moment (checked against the stored state hash), add the humanoid, and
+    /// report caught / struck / missed / clear per model, with agreement with the labels.
     #[arg(long)]
     execute: bool,
+
+    /// Execution cache directory (default: $RH_EXEC_CACHE, else ~/.cache/reacthuman/execute).
+    #[arg(long, value_name = "DIR", requires = "execute")]
+    exec_cache: Option<PathBuf>,
+
+    /// Neither read nor write the execution cache.
+    #[arg(long, requires = "execute")]
+    no_exec_cache: bool,
 
     /// Do not print the terminal report.
     #[arg(long, short)]
@@ -380,13 +390,6 @@ fn score(cli: Cli) -> Result<()> {
             return Ok(());
         }
     }
-    if cli.execute {
-        return Err(InputError(
-            "--execute (physics execution of plans, SPEC §12) is not available in this build"
-                .into(),
-        )
-        .into());
-    }
     let Some(preds) = cli.preds else {
         return Err(InputError(
             "missing the predictions file: rh-score PREDS.jsonl --dataset DIR (see --help)".into(),
@@ -406,12 +409,23 @@ fn score(cli: Cli) -> Result<()> {
             .map_err(|e| InputError(format!("cannot write decisions to {}: {e}", p.display())))?;
         scoring = scoring.with_decisions_output(Box::new(std::io::BufWriter::new(f)));
     }
+    if cli.execute {
+        scoring = scoring.with_execution();
+    }
     if preds.as_os_str() == "-" {
         scoring.score_reader(std::io::BufReader::with_capacity(1 << 20, std::io::stdin()))?;
     } else {
         scoring.score_path(&preds)?;
     }
-    let report = Report::build(&scoring, &preds.display().to_string());
+    let mut report = Report::build(&scoring, &preds.display().to_string());
+    if cli.execute {
+        let cache = (!cli.no_exec_cache).then(|| {
+            cli.exec_cache
+                .clone()
+                .unwrap_or_else(rh_score::execution::default_cache_dir)
+        });
+        report.execution = Some(execute(&mut scoring, &ds, &cfg, cache.as_deref())?);
+    }
     drop(scoring);
 
     let json_stdout = cli.json.as_deref() == Some(Path::new("-"));
@@ -425,6 +439,15 @@ fn score(cli: Cli) -> Result<()> {
     }
     if let Some(p) = &cli.csv {
         write_file(p, "the CSV report", &rh_score::tables::csv(&report))?;
+        if let Some(e) = &report.execution {
+            // Outcome rates have other columns: their own file beside it, FILE.execution.csv.
+            let q = p.with_extension("execution.csv");
+            write_file(
+                &q,
+                "the execution CSV",
+                &rh_score::execution::report::csv(e),
+            )?;
+        }
     }
     if let Some(p) = &cli.markdown {
         write_file(
@@ -442,6 +465,14 @@ fn score(cli: Cli) -> Result<()> {
     };
     if !cli.quiet && !json_stdout {
         print_out(&rh_score::tables::terminal(&report))?;
+        if let Some(e) = &report.execution {
+            print_out(&rh_score::execution::report::terminal(e, 50))?;
+        }
+    } else if let Some(e) = &report.execution {
+        // The disagreements are always listed (on stderr when stdout is taken).
+        if !e.disagreements.is_empty() {
+            eprint!("{}", rh_score::execution::report::terminal(e, 50));
+        }
     }
     if let Some(site) = site {
         let index = site
@@ -476,6 +507,52 @@ fn score(cli: Cli) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `--execute`: runs the collected decisions in physics, completes and writes the held
+/// back decision lines, and returns the report's execution part.
+fn execute(
+    scoring: &mut Scoring,
+    ds: &Dataset,
+    cfg: &Config,
+    cache: Option<&Path>,
+) -> Result<rh_score::execution::ExecutionReport> {
+    use rh_score::execution::{execute_all, ExecutionReport};
+    let (collected, names) = scoring
+        .take_execution()
+        .expect("execution was enabled before scoring");
+    let (outcomes, stats) = execute_all(ds, &collected.pending, &cfg.execution, cache)?;
+    if let Some(w) = scoring.decisions_output() {
+        let by_key: std::collections::BTreeMap<(usize, u32), usize> = collected
+            .pending
+            .iter()
+            .enumerate()
+            .map(|(i, p)| ((p.model, p.scene), i))
+            .collect();
+        for (model, scene, mut line) in collected.deferred {
+            let scored = line.get("status").and_then(|s| s.as_str()) == Some("scored");
+            if let (true, Some(&i), Some(obj)) =
+                (scored, by_key.get(&(model, scene)), line.as_object_mut())
+            {
+                let value = match &outcomes[i] {
+                    Some(o) => serde_json::to_value(o)?,
+                    None => serde_json::json!({"outcome": null, "reason": "not executed (R1)"}),
+                };
+                obj.insert("execution".into(), value);
+            }
+            serde_json::to_writer(&mut *w, &line)?;
+            w.write_all(b"\n")?;
+        }
+        w.flush()?;
+    }
+    Ok(ExecutionReport::build(
+        ds,
+        &names,
+        &collected.pending,
+        &outcomes,
+        &cfg.execution,
+        stats,
+    ))
 }
 
 fn print_out(text: &str) -> Result<()> {

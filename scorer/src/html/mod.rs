@@ -20,9 +20,9 @@
 //! with the pinhole model of `rh_pipeline::cameras::View` (same basis, same normalised
 //! coordinates).
 //!
-//! Execution (`--execute`, SPEC §12) does not exist yet: the leaderboard rows and scene
-//! decisions carry an `execution` field that is always null today; the pages show
-//! outcome columns and execution videos only when it is present.
+//! Execution (`--execute`, SPEC §12): the leaderboard rows carry each model's outcome
+//! rates and the scene pages each decision's outcome in an `execution` field (null
+//! without `--execute`); the pages show outcome columns only when it is present.
 
 mod collect;
 mod rows;
@@ -75,7 +75,7 @@ struct LeaderRow<'a> {
     hde_closing_catch: Option<f64>,
     first_rule: [u64; 4],
     prompt_versions: Vec<String>,
-    /// Outcome rates of `--execute` (SPEC §12); null until execution exists.
+    /// Outcome rates of `--execute` (SPEC §12); null without it.
     execution: Option<Value>,
 }
 
@@ -191,7 +191,7 @@ fn write_into(
 
     let figures_html = figures_html(report, dir)?;
     write_board(report, &collected, &figures_html, dir)?;
-    let (scenes, media_files) = write_scenes(ds, &models, &collected, dir)?;
+    let (scenes, media_files) = write_scenes(report, ds, &models, &collected, dir)?;
     write_static_pages(dir)?;
 
     Ok(SiteSummary {
@@ -251,7 +251,11 @@ fn write_board(
                 hde_closing_catch: c.and_then(|c| c.closing),
                 first_rule: Rule::ALL.map(|r| m.overall.first_rule.get(r)),
                 prompt_versions: pv.iter().cloned().collect(),
-                execution: None,
+                execution: report
+                    .execution
+                    .as_ref()
+                    .and_then(|e| e.rates(&m.model))
+                    .map(|r| json!(r)),
             }
         })
         .collect();
@@ -287,6 +291,7 @@ fn write_board(
 
 /// `data/index.js`, `data/scenes/<id>.js` and `media/`: returns (scenes, media files).
 fn write_scenes(
+    report: &Report,
     ds: &Dataset,
     models: &[String],
     collected: &collect::Collected,
@@ -344,10 +349,25 @@ fn write_scenes(
             .and_then(|f| std::fs::read(ds.dir.join(f)).ok())
             .and_then(|b| serde_json::from_slice(&b).ok())
             .unwrap_or(Value::Null);
+        let exec_of = |mi: usize| -> Value {
+            report
+                .execution
+                .as_ref()
+                .and_then(|e| e.decisions.get(&(models[mi].clone(), sc.scene_id.clone())))
+                .map_or(Value::Null, |o| {
+                    json!({
+                        "outcome": o.outcome.name(),
+                        "struck_part": o.strike.as_ref().map(|s| s.part.clone()),
+                        "impulse": o.strike.as_ref().map(|s| s.impulse),
+                        "first_contact_t": o.first_contact_t,
+                        "min_hand_distance": o.min_hand_distance,
+                    })
+                })
+        };
         let per_model: Vec<Value> = (0..models.len())
             .map(|mi| match decisions.get(&mi) {
-                Some(d) => json!({"model": models[mi], "decision": d, "execution": null}),
-                None => json!({"model": models[mi], "decision": null, "execution": null}),
+                Some(d) => json!({"model": models[mi], "decision": d, "execution": exec_of(mi)}),
+                None => json!({"model": models[mi], "decision": null, "execution": exec_of(mi)}),
             })
             .collect();
         let scene = json!({

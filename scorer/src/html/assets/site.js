@@ -422,7 +422,10 @@
       cells.forEach(function (c, k) {
         tr.appendChild(el("td", { "class": k === 3 && d && d.rules && d.rules.length ? "unsafe" : "" }, c));
       });
-      if (exec) tr.appendChild(el("td", null, m.execution ? JSON.stringify(m.execution) : ""));
+      if (exec) tr.appendChild(el("td", { "class": m.execution && m.execution.outcome === "struck" ? "unsafe" : "" },
+        m.execution ? m.execution.outcome + (m.execution.struck_part ? " (" + m.execution.struck_part + ", " +
+          num(m.execution.impulse, 2) + " N·s)" : "") + (m.execution.first_contact_t != null ? ", first contact +" +
+          num(m.execution.first_contact_t, 2) + " s" : "") : ""));
       t.tBodies[0].appendChild(tr);
     });
   };

@@ -1,0 +1,452 @@
+//! The execution loop and the outcome rule (versioned with `[execution]` in
+//! `configs/scoring.toml`; times are seconds after the decision moment Δ):
+//!
+//! * `struck` — the hazard touches a body part other than the hands and forearms and,
+//!   within `strike_window_s` of that first touch, its speed relative to the part (just
+//!   before the touch) is ≥ `strike_speed_min` with a total impulse on those parts ≥
+//!   `strike_impulse_min`, or the impulse alone is ≥ `strike_impulse_heavy` (the
+//!   counterfactual label's test, on the moving body). The part that took the most
+//!   impulse, the impulse and the time of the first touch are recorded.
+//!   The hands/forearms count as struck only under a blow of `hand_strike_impulse` or
+//!   more within the window (a slamming door, not a caught ball).
+//! * `caught` — not struck, and the hazard was held: touching the hands/forearms, not the
+//!   floor, moving with the touching link (relative speed ≤ `hold_speed_max`) for
+//!   `hold_time_s` without a break, before it ever touched the floor after Δ.
+//! * `missed` — neither, but a catch was attempted: the hands/forearms touched the hazard,
+//!   or the plan reached out (forward extension ≥ `attempt_reach`) and a hand came within
+//!   `attempt_radius` of it.
+//! * `clear` — none of these (contacts below the strike threshold may have happened;
+//!   `first_contact_t` says).
+//!
+//! The run stops at the first strike, at a catch, once the hazard lies still on the floor
+//! away from the body after the plan's last motion, or at `horizon_s`.
+
+use super::humanoid::{Geometry, LinkShape, Part};
+use super::motion::Motion;
+use super::{ExecConfig, ExecPlan};
+use crate::simulate::{hash_hex, lowest_z, SceneWorld};
+use crate::spec::{SceneSpec, Vec3};
+use rapier3d::prelude::*;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OutcomeKind {
+    Caught,
+    Struck,
+    Missed,
+    Clear,
+}
+
+impl OutcomeKind {
+    pub const ALL: [OutcomeKind; 4] = [
+        OutcomeKind::Caught,
+        OutcomeKind::Struck,
+        OutcomeKind::Missed,
+        OutcomeKind::Clear,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            OutcomeKind::Caught => "caught",
+            OutcomeKind::Struck => "struck",
+            OutcomeKind::Missed => "missed",
+            OutcomeKind::Clear => "clear",
+        }
+    }
+
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// What struck the body.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StrikeRecord {
+    pub part: String,
+    /// Total impulse on the non-catching parts over the strike window (N·s).
+    pub impulse: f64,
+    /// Largest relative speed at a touch within the window (m/s).
+    pub speed: f64,
+    /// First touch (s after Δ).
+    pub t: f64,
+}
+
+/// One executed decision.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Outcome {
+    pub outcome: OutcomeKind,
+    pub strike: Option<StrikeRecord>,
+    /// First contact of the hazard with any body part (s after Δ).
+    pub first_contact_t: Option<f64>,
+    pub first_contact_part: Option<String>,
+    /// Smallest distance between a hand (palm) and the hazard's surface (m).
+    pub min_hand_distance: f64,
+    /// The executed base's final `(x, y, yaw)` (world).
+    pub base_end: Vec3,
+    /// The hazard's first floor contact after Δ (s after Δ), if it started above it.
+    pub floor_t: Option<f64>,
+    pub catch_attempted: bool,
+    /// Which base limits bound: speed, acceleration, yaw rate, yaw acceleration.
+    pub limits_hit: [bool; 4],
+    /// Physics steps executed after Δ.
+    pub steps: u32,
+    /// SHA-256 (16 bytes, hex) of every dynamic body's state and every link's position
+    /// at every executed step.
+    pub state_hash: String,
+}
+
+fn v3(a: Vec3) -> Vector {
+    Vector::new(a[0] as Real, a[1] as Real, a[2] as Real)
+}
+
+fn pose_of(p: &super::humanoid::LinkPose) -> Pose {
+    let q = p.rotation;
+    Pose::from_parts(
+        v3(p.position),
+        Rotation::from_xyzw(q[0] as Real, q[1] as Real, q[2] as Real, q[3] as Real).normalize(),
+    )
+}
+
+fn collider(shape: LinkShape, cfg: &ExecConfig) -> ColliderBuilder {
+    match shape {
+        LinkShape::Box(h) => ColliderBuilder::cuboid(h[0] as Real, h[1] as Real, h[2] as Real),
+        LinkShape::Capsule {
+            half_height,
+            radius,
+        } => ColliderBuilder::capsule_z(half_height as Real, radius as Real),
+        LinkShape::Sphere(r) => ColliderBuilder::ball(r as Real),
+    }
+    .friction(cfg.link_friction as Real)
+    .restitution(cfg.link_restitution as Real)
+    .friction_combine_rule(CoefficientCombineRule::Average)
+    .restitution_combine_rule(CoefficientCombineRule::Average)
+}
+
+fn norm(v: Vector) -> f64 {
+    v.length() as f64
+}
+
+/// A strike window being followed.
+struct Window {
+    start: u32,
+    speed: f64,
+    impulse: f64,
+    per_part: [f64; 13],
+}
+
+/// What the loop has seen so far.
+struct Monitor {
+    first_contact: Option<(u32, Part)>,
+    window: Option<Window>,
+    /// Impulse on the hands/forearms since their first touch (a slamming door).
+    hand_window: Option<Window>,
+    strike: Option<StrikeRecord>,
+    floor_step: Option<u32>,
+    held_steps: u32,
+    caught: bool,
+    hand_touched: bool,
+    min_hand_distance: f64,
+}
+
+/// Runs `plan` in `sw` (the world at Δ) and classifies the outcome.
+pub(super) fn run(
+    spec: &SceneSpec,
+    mut sw: SceneWorld,
+    plan: &ExecPlan,
+    cfg: &ExecConfig,
+) -> Outcome {
+    let dt = spec.physics.dt;
+    let geometry = Geometry::of(&spec.observer);
+    let o = &spec.observer;
+    let mut motion = Motion::new(plan, cfg, geometry, [o.x, o.y, o.yaw], dt);
+    let shapes = geometry.shapes();
+    let poses = geometry.link_poses(&motion.pose);
+    let links: Vec<(RigidBodyHandle, ColliderHandle)> = (0..Part::ALL.len())
+        .map(|i| {
+            sw.world.insert(
+                RigidBodyBuilder::kinematic_position_based().pose(pose_of(&poses[i])),
+                collider(shapes[i], cfg),
+            )
+        })
+        .collect();
+    let hazard_c = sw.collider_handles[spec.hazard];
+    let hazard_b = sw.body_handles[spec.hazard];
+    let steps = |s: f64| (s / dt).round().max(1.0) as u32;
+    let (horizon, window_steps, hold_steps) = (
+        steps(cfg.horizon_s),
+        steps(cfg.strike_window_s),
+        steps(cfg.hold_time_s),
+    );
+    let plan_end = plan
+        .keyframes
+        .iter()
+        .map(|k| k.t)
+        .fold(plan.walking_duration, f64::max);
+    let started_on_floor = lowest_z(&sw.world.colliders[hazard_c]) <= cfg.floor_contact_eps;
+    let mut m = Monitor {
+        first_contact: None,
+        window: None,
+        hand_window: None,
+        strike: None,
+        floor_step: None,
+        held_steps: 0,
+        caught: false,
+        hand_touched: false,
+        min_hand_distance: f64::INFINITY,
+    };
+    let mut hasher = Sha256::new();
+    let mut executed = 0;
+    for k in 0..horizon {
+        motion.advance(k);
+        let poses = geometry.link_poses(&motion.pose);
+        for (i, (b, _)) in links.iter().enumerate() {
+            sw.world.bodies[*b].set_next_kinematic_position(pose_of(&poses[i]));
+        }
+        let v_before = sw.world.bodies[hazard_b].linvel();
+        sw.world.step();
+        executed = k + 1;
+        sw.hash_step(&mut hasher);
+        for (b, _) in &links {
+            let t = sw.world.bodies[*b].translation();
+            for x in [t.x, t.y, t.z] {
+                hasher.update(x.to_le_bytes());
+            }
+        }
+        observe(
+            &mut m,
+            &sw,
+            &links,
+            hazard_c,
+            hazard_b,
+            v_before,
+            executed,
+            cfg,
+            window_steps,
+            hold_steps,
+            started_on_floor,
+        );
+        if m.strike.is_some() || m.caught {
+            break;
+        }
+        let quiet = m.floor_step.is_some()
+            && norm(sw.world.bodies[hazard_b].linvel()) < cfg.settle_speed
+            && m.window.is_none()
+            && executed as f64 * dt > plan_end;
+        if quiet {
+            break;
+        }
+    }
+    let attempted = m.hand_touched
+        || (plan.reach() >= cfg.attempt_reach && m.min_hand_distance <= cfg.attempt_radius);
+    let kind = if m.strike.is_some() {
+        OutcomeKind::Struck
+    } else if m.caught {
+        OutcomeKind::Caught
+    } else if attempted {
+        OutcomeKind::Missed
+    } else {
+        OutcomeKind::Clear
+    };
+    let t = |step: u32| step as f64 * dt;
+    if let Some(s) = m.strike.as_mut() {
+        s.t *= dt;
+    }
+    Outcome {
+        outcome: kind,
+        strike: m.strike,
+        first_contact_t: m.first_contact.map(|(s, _)| t(s)),
+        first_contact_part: m.first_contact.map(|(_, p)| p.name().to_string()),
+        min_hand_distance: m.min_hand_distance,
+        base_end: motion.pose.base,
+        floor_t: m.floor_step.map(t),
+        catch_attempted: attempted,
+        limits_hit: motion.limits_hit,
+        steps: executed,
+        state_hash: hash_hex(hasher),
+    }
+}
+
+/// Reads this step's contacts of the hazard and updates the monitor.
+#[allow(clippy::too_many_arguments)]
+fn observe(
+    m: &mut Monitor,
+    sw: &SceneWorld,
+    links: &[(RigidBodyHandle, ColliderHandle)],
+    hazard_c: ColliderHandle,
+    hazard_b: RigidBodyHandle,
+    v_before: Vector,
+    step: u32,
+    cfg: &ExecConfig,
+    window_steps: u32,
+    hold_steps: u32,
+    started_on_floor: bool,
+) {
+    let world = &sw.world;
+    let hazard = &world.colliders[hazard_c];
+    let v_hazard = world.bodies[hazard_b].linvel();
+    let (mut on_floor, mut touching_hands, mut body_touch) = (false, false, None::<(Part, f64)>);
+    let mut hold_speed = f64::INFINITY;
+    let mut impulses = [0.0f64; 13];
+    let mut hand_impulses = [0.0f64; 13];
+    for pair in world.narrow_phase.contact_pairs_with(hazard_c) {
+        if !pair.has_any_active_contact() {
+            continue;
+        }
+        let other = if pair.collider1 == hazard_c {
+            pair.collider2
+        } else {
+            pair.collider1
+        };
+        if other == sw.floor {
+            on_floor = true;
+            continue;
+        }
+        let Some(i) = links.iter().position(|(_, c)| *c == other) else {
+            continue;
+        };
+        let part = Part::ALL[i];
+        let link_v = world.bodies[links[i].0].linvel();
+        if m.first_contact.is_none() {
+            m.first_contact = Some((step, part));
+        }
+        if part.is_catching() {
+            touching_hands = true;
+            m.hand_touched = true;
+            hand_impulses[i] += pair.total_impulse_magnitude() as f64;
+            hold_speed = hold_speed.min(norm(v_hazard - link_v));
+        } else {
+            impulses[i] += pair.total_impulse_magnitude() as f64;
+            let speed = norm(v_before - link_v);
+            if body_touch.is_none_or(|(_, s)| speed > s) {
+                body_touch = Some((part, speed));
+            }
+        }
+    }
+    for hand in [Part::LeftHand, Part::RightHand] {
+        let c = &world.colliders[links[hand as usize].1];
+        if let Ok(d) = rapier3d::parry::query::distance(
+            c.position(),
+            c.shape(),
+            hazard.position(),
+            hazard.shape(),
+        ) {
+            m.min_hand_distance = m.min_hand_distance.min(d.distance as f64);
+        }
+    }
+    if on_floor
+        && !started_on_floor
+        && m.floor_step.is_none()
+        && lowest_z(hazard) <= cfg.floor_contact_eps
+    {
+        m.floor_step = Some(step);
+    }
+    follow_strike(m, body_touch, &impulses, step, window_steps, cfg);
+    if m.strike.is_none() {
+        follow_hand_strike(m, touching_hands, &hand_impulses, step, window_steps, cfg);
+    }
+    let holding =
+        touching_hands && !on_floor && hold_speed <= cfg.hold_speed_max && m.floor_step.is_none();
+    m.held_steps = if holding { m.held_steps + 1 } else { 0 };
+    if m.held_steps >= hold_steps && m.strike.is_none() {
+        m.caught = true;
+    }
+}
+
+/// Opens, feeds and closes strike windows on the non-catching parts.
+fn follow_strike(
+    m: &mut Monitor,
+    touch: Option<(Part, f64)>,
+    impulses: &[f64; 13],
+    step: u32,
+    window_steps: u32,
+    cfg: &ExecConfig,
+) {
+    if m.window.is_none() && touch.is_some() {
+        m.window = Some(Window {
+            start: step,
+            speed: 0.0,
+            impulse: 0.0,
+            per_part: [0.0; 13],
+        });
+    }
+    let Some(w) = m.window.as_mut() else {
+        return;
+    };
+    if let Some((_, speed)) = touch {
+        w.speed = w.speed.max(speed);
+    }
+    for (acc, x) in w.per_part.iter_mut().zip(impulses) {
+        *acc += x;
+    }
+    w.impulse += impulses.iter().sum::<f64>();
+    let struck = (w.speed >= cfg.strike_speed_min && w.impulse >= cfg.strike_impulse_min)
+        || w.impulse >= cfg.strike_impulse_heavy;
+    if struck || step >= w.start + window_steps {
+        if struck {
+            let (i, _) = w
+                .per_part
+                .iter()
+                .enumerate()
+                .fold(
+                    (0, f64::MIN),
+                    |best, (i, &x)| if x > best.1 { (i, x) } else { best },
+                );
+            m.strike = Some(StrikeRecord {
+                part: Part::ALL[i].name().to_string(),
+                impulse: w.impulse,
+                speed: w.speed,
+                t: 0.0,
+            });
+        }
+        if let Some(s) = m.strike.as_mut() {
+            // In steps here; `run` turns it into seconds.
+            s.t = w.start as f64;
+        }
+        m.window = None;
+    }
+}
+
+/// The hands and forearms are struck only by a blow no catch could take: an impulse of at
+/// least `hand_strike_impulse` within `strike_window_s` of their first touch.
+fn follow_hand_strike(
+    m: &mut Monitor,
+    touching: bool,
+    impulses: &[f64; 13],
+    step: u32,
+    window_steps: u32,
+    cfg: &ExecConfig,
+) {
+    if m.hand_window.is_none() && touching {
+        m.hand_window = Some(Window {
+            start: step,
+            speed: 0.0,
+            impulse: 0.0,
+            per_part: [0.0; 13],
+        });
+    }
+    let Some(w) = m.hand_window.as_mut() else {
+        return;
+    };
+    for (acc, x) in w.per_part.iter_mut().zip(impulses) {
+        *acc += x;
+    }
+    w.impulse += impulses.iter().sum::<f64>();
+    if w.impulse >= cfg.hand_strike_impulse {
+        let (i, _) = w
+            .per_part
+            .iter()
+            .enumerate()
+            .fold((0, f64::MIN), |best, (i, &x)| if x > best.1 { (i, x) } else { best });
+        m.strike = Some(StrikeRecord {
+            part: Part::ALL[i].name().to_string(),
+            impulse: w.impulse,
+            speed: 0.0,
+            t: w.start as f64,
+        });
+        m.hand_window = None;
+    } else if step >= w.start + window_steps {
+        m.hand_window = None;
+    }
+}
