@@ -429,6 +429,12 @@ fn object_look_mesh(catalog: &Catalog, id: &str, parts: &[crate::spec::PartSpec]
     Some(recipes::object_mesh(&look))
 }
 
+/// How far behind the wall plane the room's walls are drawn. Fixtures stand flush
+/// against a wall (a ladder's or a shelf's wall slab has its face on the plane), and two
+/// coplanar faces z-fight into a hatched pattern; set back by 1 cm, the fixture's face is
+/// drawn in front, and a 1 cm gap behind a flush face is invisible at any camera distance.
+const WALL_SETBACK: f32 = 0.01;
+
 /// The room's floor, four walls and ceiling, appended to `statics` (one piece each).
 fn room_shell(
     room: &crate::spec::RoomSpec,
@@ -447,7 +453,7 @@ fn room_shell(
     let mut floor = Mesh::new();
     floor.boxy(
         &Xf::at([0.0, 0.0, -0.02]),
-        [hx, hy, 0.02],
+        [hx + WALL_SETBACK, hy + WALL_SETBACK, 0.02],
         1,
         &solid(floor_c),
     );
@@ -462,13 +468,13 @@ fn room_shell(
         let mut m = Mesh::new();
         let (half_len, pos) = if axis == 0 {
             (
-                [0.02, hy + 0.04, ch / 2.0],
-                [sign as f32 * (hx + 0.02), 0.0, ch / 2.0],
+                [0.02, hy + 0.04 + WALL_SETBACK, ch / 2.0],
+                [sign as f32 * (hx + 0.02 + WALL_SETBACK), 0.0, ch / 2.0],
             )
         } else {
             (
-                [hx + 0.04, 0.02, ch / 2.0],
-                [0.0, sign as f32 * (hy + 0.02), ch / 2.0],
+                [hx + 0.04 + WALL_SETBACK, 0.02, ch / 2.0],
+                [0.0, sign as f32 * (hy + 0.02 + WALL_SETBACK), ch / 2.0],
             )
         };
         // Paint in world coordinates: the box is axis-aligned, so local z + centre.
@@ -488,7 +494,7 @@ fn room_shell(
     let mut ceil = Mesh::new();
     ceil.boxy(
         &Xf::at([0.0, 0.0, ch + 0.02]),
-        [hx, hy, 0.02],
+        [hx + WALL_SETBACK, hy + WALL_SETBACK, 0.02],
         1,
         &solid(hex("#f4f4f0")),
     );
