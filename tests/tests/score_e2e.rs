@@ -433,7 +433,13 @@ fn bad_inputs_exit_2_with_a_message() {
     // the missing spec file.
     let out = run(
         "rh-score",
-        &[p.to_str().unwrap(), "--dataset", d, "--execute", "--no-exec-cache"],
+        &[
+            p.to_str().unwrap(),
+            "--dataset",
+            d,
+            "--execute",
+            "--no-exec-cache",
+        ],
     );
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("specs/"));

@@ -438,7 +438,10 @@ fn follow_hand_strike(
             .per_part
             .iter()
             .enumerate()
-            .fold((0, f64::MIN), |best, (i, &x)| if x > best.1 { (i, x) } else { best });
+            .fold(
+                (0, f64::MIN),
+                |best, (i, &x)| if x > best.1 { (i, x) } else { best },
+            );
         m.strike = Some(StrikeRecord {
             part: Part::ALL[i].name().to_string(),
             impulse: w.impulse,
