@@ -211,6 +211,13 @@ pub fn record_batch(results: &[SceneResult], catalog: &Catalog) -> RecordBatch {
         .media
         .as_ref()
         .map(|m| m.full_event.clone())));
+    columns.extend(frame_and_trajectory_columns(results));
+    columns.extend(crate::media::measured_columns(results));
+    RecordBatch::try_new(Arc::new(schema()), columns).expect("columns match the schema")
+}
+
+/// The `observation_frame_steps` and `trajectory` columns (lists per scene row).
+fn frame_and_trajectory_columns(results: &[SceneResult]) -> [ArrayRef; 2] {
     let mut frame_steps = ListBuilder::new(UInt32Builder::new());
     for r in results {
         frame_steps
@@ -218,7 +225,6 @@ pub fn record_batch(results: &[SceneResult], catalog: &Catalog) -> RecordBatch {
             .append_slice(&r.spec.observation_frame_steps(r.steps));
         frame_steps.append(true);
     }
-    columns.push(Arc::new(frame_steps.finish()));
     let mut trajectories = ListBuilder::new(
         FixedSizeListBuilder::new(Float32Builder::new(), 4).with_field(Field::new(
             "item",
@@ -233,9 +239,10 @@ pub fn record_batch(results: &[SceneResult], catalog: &Catalog) -> RecordBatch {
         }
         trajectories.append(true);
     }
-    columns.push(Arc::new(trajectories.finish()));
-    columns.extend(crate::media::measured_columns(results));
-    RecordBatch::try_new(Arc::new(schema()), columns).expect("columns match the schema")
+    [
+        Arc::new(frame_steps.finish()),
+        Arc::new(trajectories.finish()),
+    ]
 }
 
 /// Every file a row refers to, relative to the dataset root: its spec, its videos
