@@ -75,3 +75,25 @@ mod tests {
         assert_eq!(Action::parse("jump"), None);
     }
 }
+
+/// The base pose `[x, y, yaw]` at time `t` of a walk from `start` (`[x, y, yaw]`) under the
+/// body-frame command `cmd` (`[vx, vy, yaw rate]`) held for `duration` s: the closed-form
+/// arc of action rule v1 (the straight line when `|yaw rate · t| < 1e-9`), `t` clamped to
+/// the walk. One definition for the scorer's rule and the executor's reference path.
+pub fn walk_pose(start: [f64; 3], cmd: [f64; 3], duration: f64, t: f64) -> [f64; 3] {
+    let t = t.clamp(0.0, duration.max(0.0));
+    let [x0, y0, th0] = start;
+    let [vx, vy, w] = cmd;
+    let th = th0 + w * t;
+    if (w * t).abs() < 1e-9 {
+        let (s, c) = th0.sin_cos();
+        return [x0 + (c * vx - s * vy) * t, y0 + (s * vx + c * vy) * t, th];
+    }
+    let (s0, c0) = th0.sin_cos();
+    let (s1, c1) = th.sin_cos();
+    [
+        x0 + (vx * (s1 - s0) + vy * (c1 - c0)) / w,
+        y0 + (-vx * (c1 - c0) + vy * (s1 - s0)) / w,
+        th,
+    ]
+}

@@ -28,25 +28,8 @@ pub struct BasePose {
 
 /// Base pose at time `t` for a walk starting at `start` (x, y, yaw).
 pub fn base_pose_at(start: [f64; 3], cmd: [f64; 3], duration: f64, t: f64) -> BasePose {
-    let t = t.clamp(0.0, duration.max(0.0));
-    let [x0, y0, th0] = start;
-    let [vx, vy, w] = cmd;
-    let th = th0 + w * t;
-    if (w * t).abs() < 1e-9 {
-        let (s, c) = th0.sin_cos();
-        return BasePose {
-            x: x0 + (c * vx - s * vy) * t,
-            y: y0 + (s * vx + c * vy) * t,
-            yaw: th,
-        };
-    }
-    let (s0, c0) = th0.sin_cos();
-    let (s1, c1) = th.sin_cos();
-    BasePose {
-        x: x0 + (vx * (s1 - s0) + vy * (c1 - c0)) / w,
-        y: y0 + (-vx * (c1 - c0) + vy * (s1 - s0)) / w,
-        yaw: th,
-    }
+    let [x, y, yaw] = rh_contract::action::walk_pose(start, cmd, duration, t);
+    BasePose { x, y, yaw }
 }
 
 /// World position of a body-frame point for a base pose.

@@ -87,3 +87,49 @@ pub fn files_under(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     }
     out
 }
+
+/// A configuration for small rendered test builds, written into `dir` (with the
+/// `labels.toml` and `scoring.toml` it names): the embedded defaults at a `width` ×
+/// `height` render size. With `scale_visibility`, the visibility rule's pixel sizes
+/// (`visible_size_px_min`, `frame_size_px`, pixels at the configured resolution) shrink
+/// with the height, so tiny builds keep the scenes a full-size build would.
+pub fn small_render_config(dir: &Path, width: u32, height: u32, scale_visibility: bool) -> PathBuf {
+    let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs");
+    for name in ["labels.toml", "scoring.toml"] {
+        std::fs::copy(configs.join(name), dir.join(name)).unwrap();
+    }
+    let default = std::fs::read_to_string(configs.join("default.toml")).unwrap();
+    let mut small = default
+        .replace("\nwidth = 1280\n", &format!("\nwidth = {width}\n"))
+        .replace("\nheight = 720\n", &format!("\nheight = {height}\n"))
+        .replace("\nfull_width = 640\n", &format!("\nfull_width = {width}\n"))
+        .replace(
+            "\nfull_height = 360\n",
+            &format!("\nfull_height = {height}\n"),
+        );
+    assert_ne!(
+        small, default,
+        "the [render] keys moved; update this helper"
+    );
+    if scale_visibility {
+        let scale = |px: f64| ((px * height as f64 / 720.0) as u32).max(1);
+        let scaled = small
+            .replace(
+                "\nvisible_size_px_min = 8\n",
+                &format!("\nvisible_size_px_min = {}\n", scale(8.0)),
+            )
+            .replace(
+                "\nframe_size_px = [24, 400]\n",
+                &format!("\nframe_size_px = [{}, {}]\n", scale(24.0), scale(400.0)),
+            );
+        assert!(
+            scaled.contains(&format!("\nvisible_size_px_min = {}\n", scale(8.0)))
+                && scaled.contains(&format!("\nframe_size_px = [{}, ", scale(24.0))),
+            "the [validators] pixel keys moved; update this helper"
+        );
+        small = scaled;
+    }
+    let path = dir.join("small.toml");
+    std::fs::write(&path, small).unwrap();
+    path
+}

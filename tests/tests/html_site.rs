@@ -18,20 +18,7 @@ const FAMILIES: &str = "object_drop,sliding_object,thrown_object";
 const BASELINES: [&str; 5] = ["oracle", "majority", "random", "always-catch", "freeze"];
 
 fn small_config(dir: &Path) -> PathBuf {
-    let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs");
-    for name in ["labels.toml", "scoring.toml"] {
-        std::fs::copy(configs.join(name), dir.join(name)).unwrap();
-    }
-    let default = std::fs::read_to_string(configs.join("default.toml")).unwrap();
-    let small = default
-        .replace("\nwidth = 1280\n", &format!("\nwidth = {W}\n"))
-        .replace("\nheight = 720\n", &format!("\nheight = {H}\n"))
-        .replace("\nfull_width = 640\n", &format!("\nfull_width = {W}\n"))
-        .replace("\nfull_height = 360\n", &format!("\nfull_height = {H}\n"));
-    assert_ne!(small, default, "the [render] keys moved; update this test");
-    let path = dir.join("small.toml");
-    std::fs::write(&path, small).unwrap();
-    path
+    rh_e2e::small_render_config(dir, W, H, false)
 }
 
 fn url(site: &Path, page: &str) -> String {

@@ -11,33 +11,8 @@ use std::path::{Path, PathBuf};
 const W: u32 = 160;
 const H: u32 = 96;
 
-/// A configuration directory: the embedded defaults with a small render size.
 fn small_config(dir: &Path) -> PathBuf {
-    let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs");
-    for name in ["labels.toml", "scoring.toml"] {
-        std::fs::copy(configs.join(name), dir.join(name)).unwrap();
-    }
-    let default = std::fs::read_to_string(configs.join("default.toml")).unwrap();
-    let small = default
-        .replace("\nwidth = 1280\n", &format!("\nwidth = {W}\n"))
-        .replace("\nheight = 720\n", &format!("\nheight = {H}\n"))
-        .replace("\nfull_width = 640\n", &format!("\nfull_width = {W}\n"))
-        .replace("\nfull_height = 360\n", &format!("\nfull_height = {H}\n"))
-        // The visibility rule's sizes are pixels at the configured resolution: scaled
-        // down with it (1280 × 720 → 160 × 96), so these small builds keep their scenes.
-        .replace("\nvisible_size_px_min = 8\n", "\nvisible_size_px_min = 1\n")
-        .replace(
-            "\nframe_size_px = [24, 400]\n",
-            "\nframe_size_px = [3, 53]\n",
-        );
-    assert_ne!(small, default, "the [render] keys moved; update this test");
-    assert!(
-        small.contains("visible_size_px_min = 1\n"),
-        "the [validators] keys moved"
-    );
-    let path = dir.join("small.toml");
-    std::fs::write(&path, small).unwrap();
-    path
+    rh_e2e::small_render_config(dir, W, H, true)
 }
 
 fn build(config: &Path, out: &Path, extra: &[&str]) -> std::process::Output {

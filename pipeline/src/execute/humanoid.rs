@@ -294,8 +294,10 @@ mod tests {
     #[test]
     fn ik_keeps_link_lengths_and_reaches_reachable_targets() {
         let g = geometry();
+        // The rest pose's hand (x = 0.10) is inside the torso's depth: kept in front of it.
+        assert_eq!(g.reachable(1.0, [0.1, 0.15, 0.0]), [0.15, 0.15, 0.0]);
         for target in [
-            [0.1, 0.15, 0.0],
+            [0.15, 0.15, 0.0],
             [0.45, 0.1, 0.1],
             [0.3, 0.4, 0.5],
             [2.0, 0.0, 0.3],

@@ -26,21 +26,7 @@ pub const REST_RIGHT: Vec3 = [0.10, -0.15, 0.0];
 /// Rule v1's base pose `(x, y, yaw)` at time `t` after the decision for a walk from
 /// `start` (closed-form arc; the straight limit when `|w t| < 1e-9`).
 pub fn reference_base(start: Vec3, cmd: Vec3, duration: f64, t: f64) -> Vec3 {
-    let t = t.clamp(0.0, duration.max(0.0));
-    let [x0, y0, th0] = start;
-    let [vx, vy, w] = cmd;
-    let th = th0 + w * t;
-    if (w * t).abs() < 1e-9 {
-        let (s, c) = th0.sin_cos();
-        return [x0 + (c * vx - s * vy) * t, y0 + (s * vx + c * vy) * t, th];
-    }
-    let (s0, c0) = th0.sin_cos();
-    let (s1, c1) = th.sin_cos();
-    [
-        x0 + (vx * (s1 - s0) + vy * (c1 - c0)) / w,
-        y0 + (-vx * (c1 - c0) + vy * (s1 - s0)) / w,
-        th,
-    ]
+    rh_contract::action::walk_pose(start, cmd, duration, t)
 }
 
 /// The body's state while executing one plan.
