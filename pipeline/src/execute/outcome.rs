@@ -136,6 +136,29 @@ struct Window {
     per_part: [f64; 13],
 }
 
+impl Window {
+    /// Adds one step's contact impulses (per body part, in [`Part::ALL`] order).
+    fn add(&mut self, impulses: &[f64; 13]) {
+        for (acc, x) in self.per_part.iter_mut().zip(impulses) {
+            *acc += x;
+        }
+        self.impulse += impulses.iter().sum::<f64>();
+    }
+
+    /// The part that took the largest impulse in the window (the first on a tie).
+    fn heaviest_part(&self) -> String {
+        let (i, _) = self
+            .per_part
+            .iter()
+            .enumerate()
+            .fold(
+                (0, f64::MIN),
+                |best, (i, &x)| if x > best.1 { (i, x) } else { best },
+            );
+        Part::ALL[i].name().to_string()
+    }
+}
+
 /// What the loop has seen so far.
 struct Monitor {
     first_contact: Option<(u32, Part)>,
@@ -377,24 +400,13 @@ fn follow_strike(
     if let Some((_, speed)) = touch {
         w.speed = w.speed.max(speed);
     }
-    for (acc, x) in w.per_part.iter_mut().zip(impulses) {
-        *acc += x;
-    }
-    w.impulse += impulses.iter().sum::<f64>();
+    w.add(impulses);
     let struck = (w.speed >= cfg.strike_speed_min && w.impulse >= cfg.strike_impulse_min)
         || w.impulse >= cfg.strike_impulse_heavy;
     if struck || step >= w.start + window_steps {
         if struck {
-            let (i, _) = w
-                .per_part
-                .iter()
-                .enumerate()
-                .fold(
-                    (0, f64::MIN),
-                    |best, (i, &x)| if x > best.1 { (i, x) } else { best },
-                );
             m.strike = Some(StrikeRecord {
-                part: Part::ALL[i].name().to_string(),
+                part: w.heaviest_part(),
                 impulse: w.impulse,
                 speed: w.speed,
                 t: 0.0,
@@ -429,21 +441,10 @@ fn follow_hand_strike(
     let Some(w) = m.hand_window.as_mut() else {
         return;
     };
-    for (acc, x) in w.per_part.iter_mut().zip(impulses) {
-        *acc += x;
-    }
-    w.impulse += impulses.iter().sum::<f64>();
+    w.add(impulses);
     if w.impulse >= cfg.hand_strike_impulse {
-        let (i, _) = w
-            .per_part
-            .iter()
-            .enumerate()
-            .fold(
-                (0, f64::MIN),
-                |best, (i, &x)| if x > best.1 { (i, x) } else { best },
-            );
         m.strike = Some(StrikeRecord {
-            part: Part::ALL[i].name().to_string(),
+            part: w.heaviest_part(),
             impulse: w.impulse,
             speed: 0.0,
             t: w.start as f64,
