@@ -103,3 +103,28 @@ fn standing_still_in_a_throw_gets_struck_and_a_dodge_clears() {
     }
     assert!(checked >= 2, "only {checked} danger_present throws");
 }
+
+#[test]
+fn recording_the_steps_leaves_outcome_and_hash_unchanged() {
+    let cfg = ExecConfig::embedded_default();
+    for family in ["thrown_object", "rolling_ball"] {
+        let r = &scenes(family, 0)[0];
+        let rep = replay(&r.spec);
+        let sim = simulate(&r.spec, SimOptions::default());
+        for plan in plans() {
+            let plain = rep.execute(&plan, &cfg);
+            let (recorded, frames) = rep.execute_recorded(&plan, &cfg);
+            assert_eq!(plain, recorded, "{family}");
+            // Frame 0 is the world at Δ, then one frame per executed step.
+            assert_eq!(frames.len() as u32, plain.steps + 1, "{family}");
+            let d = decision_step(&r.spec);
+            for (slot, b) in frames[0].bodies.iter().enumerate() {
+                assert_eq!(b, sim.state(d, slot), "{family} slot {slot}");
+            }
+            let last = frames.last().unwrap();
+            assert_eq!(last.base, plain.base_end, "{family}");
+            // The pelvis link sits over the base.
+            assert!((last.links[0].position[0] - last.base[0]).abs() < 1e-9);
+        }
+    }
+}

@@ -21,6 +21,55 @@ pub struct Config {
     /// the embedded default's when a config file has none.
     #[serde(default = "rh_pipeline::execute::ExecConfig::embedded_default")]
     pub execution: rh_pipeline::execute::ExecConfig,
+    /// `[execution_video]`: how `--execute-videos` draws the executions (the embedded
+    /// default's when a config file has none).
+    #[serde(default = "ExecVideoConfig::embedded_default")]
+    pub execution_video: ExecVideoConfig,
+}
+
+/// `[execution_video]` of `configs/scoring.toml` (`--execute-videos`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExecVideoConfig {
+    pub width: u32,
+    pub height: u32,
+    /// 0: the dataset's fps.
+    pub fps: u32,
+    pub include_observation: bool,
+    pub tile_columns: u32,
+    pub preset: String,
+    pub crf: u32,
+}
+
+impl ExecVideoConfig {
+    /// The `[execution_video]` table of the embedded `configs/scoring.toml`.
+    pub fn embedded_default() -> ExecVideoConfig {
+        #[derive(Deserialize)]
+        struct File {
+            execution_video: ExecVideoConfig,
+        }
+        let file: File =
+            toml::from_str(DEFAULT_CONFIG_TOML).expect("the embedded scoring.toml parses");
+        file.execution_video
+    }
+
+    fn validate(&self) -> Result<()> {
+        let v = self;
+        if v.width < 16 || v.height < 16 || v.width % 2 == 1 || v.height % 2 == 1 {
+            bail!(
+                "config fields execution_video.width and .height must be even numbers >= 16, got {} x {}",
+                v.width,
+                v.height
+            );
+        }
+        if v.width > 3840 || v.height > 2160 || v.fps > 240 {
+            bail!("config fields execution_video.width/height/fps are at most 3840/2160/240");
+        }
+        if v.tile_columns == 0 || v.crf > 51 || v.preset.is_empty() {
+            bail!("config fields execution_video.tile_columns must be >= 1, crf <= 51, preset not empty");
+        }
+        Ok(())
+    }
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -117,6 +166,7 @@ impl Config {
         if let Err(e) = self.execution.validate() {
             bail!("config field {e}");
         }
+        self.execution_video.validate()?;
         if self.sanity.max_line_bytes < 1024 {
             bail!("config field sanity.max_line_bytes must be at least 1024");
         }

@@ -20,8 +20,9 @@ pub mod humanoid;
 pub mod motion;
 pub mod outcome;
 
-use crate::simulate::{build_world, hash_hex, simulate, SceneWorld, SimOptions};
-use crate::spec::SceneSpec;
+use crate::simulate::{build_world, hash_hex, simulate, BodyState, SceneWorld, SimOptions};
+use crate::spec::{SceneSpec, Vec3};
+use humanoid::{BodyPose, LinkPose};
 use rapier3d::prelude::*;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -73,6 +74,36 @@ impl ExecPlan {
             .iter()
             .map(|k| (k.left[0] - motion::REST_LEFT[0]).max(k.right[0] - motion::REST_RIGHT[0]))
             .fold(0.0, f64::max)
+    }
+}
+
+/// One executed physics step as recorded by [`Replay::execute_recorded`] (for videos):
+/// frame `k` is the state after `k` steps from Δ (frame 0: the world at Δ, the humanoid
+/// in its starting pose).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExecFrame {
+    /// Every dynamic body's state, in the scene's dynamic-body order (the `Simulation`
+    /// slots of the same spec).
+    pub bodies: Vec<BodyState>,
+    /// The humanoid's links, in [`humanoid::Part::ALL`] order.
+    pub links: [LinkPose; 13],
+    /// The base's `(x, y, yaw)` and the pelvis drop (m).
+    pub base: Vec3,
+    pub drop: f64,
+}
+
+impl ExecFrame {
+    fn of(sw: &SceneWorld, pose: &BodyPose, links: &[LinkPose; 13]) -> ExecFrame {
+        ExecFrame {
+            bodies: sw
+                .dynamic_bodies
+                .iter()
+                .map(|&i| sw.body_state(i))
+                .collect(),
+            links: *links,
+            base: pose.base,
+            drop: pose.drop,
+        }
     }
 }
 
@@ -281,7 +312,15 @@ impl Replay {
 
     /// Executes `plan` from Δ and says what happened. Pure in (replay, plan, config).
     pub fn execute(&self, plan: &ExecPlan, cfg: &ExecConfig) -> Outcome {
-        outcome::run(&self.spec, self.fork(), plan, cfg)
+        outcome::run(&self.spec, self.fork(), plan, cfg, None)
+    }
+
+    /// [`Replay::execute`] that also records every step ([`ExecFrame`]) for the videos;
+    /// the outcome (and its `state_hash`) is the same bits as without recording.
+    pub fn execute_recorded(&self, plan: &ExecPlan, cfg: &ExecConfig) -> (Outcome, Vec<ExecFrame>) {
+        let mut frames = Vec::new();
+        let outcome = outcome::run(&self.spec, self.fork(), plan, cfg, Some(&mut frames));
+        (outcome, frames)
     }
 }
 

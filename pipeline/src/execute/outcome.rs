@@ -23,7 +23,7 @@
 
 use super::humanoid::{Geometry, LinkShape, Part};
 use super::motion::Motion;
-use super::{ExecConfig, ExecPlan};
+use super::{ExecConfig, ExecFrame, ExecPlan};
 use crate::simulate::{hash_hex, lowest_z, SceneWorld};
 use crate::spec::{SceneSpec, Vec3};
 use rapier3d::prelude::*;
@@ -173,12 +173,14 @@ struct Monitor {
     min_hand_distance: f64,
 }
 
-/// Runs `plan` in `sw` (the world at Δ) and classifies the outcome.
+/// Runs `plan` in `sw` (the world at Δ) and classifies the outcome. With `record`, every
+/// step's state is pushed onto it as well (a side output: it only reads the world).
 pub(super) fn run(
     spec: &SceneSpec,
     mut sw: SceneWorld,
     plan: &ExecPlan,
     cfg: &ExecConfig,
+    mut record: Option<&mut Vec<ExecFrame>>,
 ) -> Outcome {
     let dt = spec.physics.dt;
     let geometry = Geometry::of(&spec.observer);
@@ -221,6 +223,9 @@ pub(super) fn run(
     };
     let mut hasher = Sha256::new();
     let mut executed = 0;
+    if let Some(r) = record.as_deref_mut() {
+        r.push(ExecFrame::of(&sw, &motion.pose, &poses));
+    }
     for k in 0..horizon {
         motion.advance(k);
         let poses = geometry.link_poses(&motion.pose);
@@ -231,6 +236,9 @@ pub(super) fn run(
         sw.world.step();
         executed = k + 1;
         sw.hash_step(&mut hasher);
+        if let Some(r) = record.as_deref_mut() {
+            r.push(ExecFrame::of(&sw, &motion.pose, &poses));
+        }
         for (b, _) in &links {
             let t = sw.world.bodies[*b].translation();
             for x in [t.x, t.y, t.z] {

@@ -54,9 +54,22 @@ pub fn full_event_camera(
         k += stride;
     }
     pts.push(sim.hazard_position(sim.steps()));
+    outside_camera(spec, sim.hazard_position(0), &pts, width, height)
+}
+
+/// The outside camera for a set of points to hold in view (`full_event_camera`'s
+/// placement): beside the line from the observer to `start`, raised, aimed at the
+/// points' centre, with a field of view that holds them all.
+pub(super) fn outside_camera(
+    spec: &SceneSpec,
+    start: Vec3,
+    pts: &[Vec3],
+    width: u32,
+    height: u32,
+) -> CameraSpec {
+    let o = &spec.observer;
     let n = pts.len() as f64;
     let c = scale(pts.iter().fold([0.0; 3], |a, p| add(a, *p)), 1.0 / n);
-    let start = sim.hazard_position(0);
     let mut d = [start[0] - o.x, start[1] - o.y, 0.0];
     if norm(d) < 1e-3 {
         d = [o.yaw.cos(), o.yaw.sin(), 0.0];
@@ -84,7 +97,7 @@ pub fn full_event_camera(
         let (r, u, f) = cameras::draw_basis(&cam);
         let mut need = 0.0f64;
         let mut behind = false;
-        for p in &pts {
+        for p in pts {
             let v = sub(*p, position);
             let z = dot(v, f);
             if z < 0.3 {

@@ -11,7 +11,7 @@ use super::recipes;
 use super::regions::{bounds, rects_meet, screen_rect, shadow_regions};
 use super::Shading;
 use crate::cameras::View;
-use crate::simulate::Simulation;
+use crate::simulate::{BodyState, Simulation};
 use crate::spec::vec3::{add, norm, sub};
 use crate::spec::{BodyKind, CameraSpec, JointKind, SceneSpec, Vec3};
 use rh_catalog::Catalog;
@@ -196,15 +196,23 @@ impl SceneGeometry {
         }
     }
 
-    fn pose(&self, sim: &Simulation, step: u32, slot: usize) -> Xf {
-        let s = sim.state(step, slot);
-        Xf::from_quat(s.rotation.map(f64::from), s.position.map(f64::from))
+    /// The moving bodies (and ropes) at one step of `sim`.
+    pub(super) fn dynamic_at(&self, sim: &Simulation, step: u32, mask: bool) -> Vec<Vertex> {
+        let n = sim.dynamic_bodies.len();
+        let at = step as usize * n;
+        self.dynamic_from(&sim.states[at..at + n], mask)
     }
 
-    pub(super) fn dynamic_at(&self, sim: &Simulation, step: u32, mask: bool) -> Vec<Vertex> {
+    /// The moving bodies (and ropes) with the given states (one per dynamic body, in the
+    /// `Simulation` slot order): a simulation step or an executed one (`execute`).
+    pub(super) fn dynamic_from(&self, states: &[BodyState], mask: bool) -> Vec<Vertex> {
+        let pose = |slot: usize| {
+            let s = &states[slot];
+            Xf::from_quat(s.rotation.map(f64::from), s.position.map(f64::from))
+        };
         let mut out = Vec::with_capacity(self.max_dynamic);
         for d in &self.dynamic {
-            let xf = self.pose(sim, step, d.slot);
+            let xf = pose(d.slot);
             let from = out.len();
             d.mesh.transformed_into(&xf, &mut out);
             if mask && d.hazard {
@@ -216,10 +224,10 @@ impl SceneGeometry {
         let mut m = Mesh::new();
         for r in &self.ropes {
             let a = match r.a {
-                (Some(slot), p) => self.pose(sim, step, slot).apply(p.map(|v| v as f32)),
+                (Some(slot), p) => pose(slot).apply(p.map(|v| v as f32)),
                 (None, p) => p.map(|v| v as f32),
             };
-            let b = self.pose(sim, step, r.b.0).apply(r.b.1.map(|v| v as f32));
+            let b = pose(r.b.0).apply(r.b.1.map(|v| v as f32));
             let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
             if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() > 0.03 {
                 m.rod(&Xf::ID, a, b, 0.008, 6, &solid(hex("#3a3a3a")));
@@ -227,6 +235,12 @@ impl SceneGeometry {
         }
         out.extend_from_slice(&m.verts);
         out
+    }
+
+    /// Leaves the standing observer out of every view and the shadow casters (the
+    /// execution videos draw the executing humanoid as moving geometry instead).
+    pub(super) fn hide_observer(&mut self) {
+        self.observer = self.observer.start..self.observer.start;
     }
 
     /// Static vertex ranges a camera sees: walls it stands behind are cut away, the

@@ -34,10 +34,12 @@
 //! | `measure` | the instance-id pass at the observation frames: hazard visibility, masks, depth |
 //! | `gpu` | the wgpu device, pipelines, static cache and overlay drawing |
 //! | `encode` | H.264 encoding through FFmpeg |
+//! | `execution` | execution videos: outside and ego views of executed plans, tiled ([`Renderer::render_executions`]) |
 //! | `sheet` | the contact sheet (`rh-pipeline sheet`) |
 
 mod camera;
 pub mod encode;
+mod execution;
 mod font;
 mod geometry;
 pub mod gpu;
@@ -55,6 +57,7 @@ use encode::EncodeSettings;
 use std::collections::BTreeMap;
 
 pub use camera::{full_event_camera, view_proj};
+pub use execution::{ExecTrack, ExecVideoOptions, ExecVideos, TiledVideo};
 pub use measure::Observed;
 pub use renderer::{render_stage, with_thread_renderer, Renderer};
 pub use rh_contract::layout::{frame_file_name, frame_path};

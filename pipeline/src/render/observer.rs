@@ -1,6 +1,7 @@
 //! The observer's mesh: a humanoid with Unitree-G1 proportions.
 
 use super::mesh::*;
+use crate::execute::humanoid::{LinkShape, Part};
 
 /// The observer: a humanoid with Unitree-G1 proportions (height 1.32 m, pelvis 0.79 m,
 /// shoulders 1.10 m), in its body frame (x forward, y left, z up, origin on the floor).
@@ -97,4 +98,34 @@ pub(super) fn observer_mesh(height: f64, pelvis: f64, shoulder: f64) -> (Mesh, M
         &solid(mat(hex("#101418"), MAT_GLOSSY)),
     );
     (m, head)
+}
+
+/// The executing humanoid (`execute::humanoid`): one mesh per link, in
+/// `humanoid::Part::ALL` order, each in its link's frame (capsules along z) with the
+/// shape the physics uses; coloured like the observer, the palms in its accent colour.
+pub(super) fn link_meshes(shapes: &[LinkShape; 13]) -> Vec<Mesh> {
+    let shell = hex("#c9cdd2");
+    let dark = hex("#2b2f33");
+    let accent = hex("#ff6f00");
+    shapes
+        .iter()
+        .zip(Part::ALL)
+        .map(|(shape, part)| {
+            let c = match part {
+                Part::Pelvis | Part::LeftShank | Part::RightShank => dark,
+                Part::LeftHand | Part::RightHand => accent,
+                _ => shell,
+            };
+            let mut m = Mesh::new();
+            match *shape {
+                LinkShape::Box(h) => m.boxy(&Xf::ID, h.map(|v| v as f32), 1, &solid(c)),
+                LinkShape::Capsule {
+                    half_height,
+                    radius,
+                } => m.capsule(&Xf::ID, radius as f32, half_height as f32, 12, &solid(c)),
+                LinkShape::Sphere(r) => m.sphere(&Xf::ID, r as f32, 16, &solid(c)),
+            }
+            m
+        })
+        .collect()
 }

@@ -84,6 +84,27 @@ struct Cli {
     #[arg(long, requires = "execute")]
     no_exec_cache: bool,
 
+    /// Draw every executed decision into this directory: DIR/<scene_id>/<model>__outside.mp4
+    /// and __ego.mp4 (H.264), one scene's executions tiled side by side
+    /// (DIR/<scene_id>/tiled.mp4) and DIR/index.json. Needs a build with the `videos`
+    /// feature (the default) and a GPU or lavapipe.
+    #[arg(long, value_name = "DIR", requires = "execute")]
+    execute_videos: Option<PathBuf>,
+
+    /// Only these scenes get execution videos (comma-separated scene ids; default: all).
+    #[arg(
+        long,
+        value_name = "ID,...",
+        value_delimiter = ',',
+        requires = "execute_videos"
+    )]
+    video_scenes: Option<Vec<String>>,
+
+    /// The scene whose executions are tiled (default: the one with the most executed
+    /// decisions, the first on a tie).
+    #[arg(long, value_name = "ID", requires = "execute_videos")]
+    tiled_scene: Option<String>,
+
     /// Do not print the terminal report.
     #[arg(long, short)]
     quiet: bool,
@@ -402,6 +423,12 @@ fn score(cli: Cli) -> Result<()> {
         )
         .into());
     }
+    if cli.execute_videos.is_some() && !cfg!(feature = "videos") {
+        return Err(InputError(
+            "--execute-videos: this rh-score was built without the `videos` feature (no renderer); build it with default features (cargo build --release -p rh-score)".into(),
+        )
+        .into());
+    }
     let ds = Dataset::load(&dataset_dir(cli.dataset)?)?;
     let mut scoring = Scoring::new(&ds, &cfg);
     if let Some(p) = &cli.decisions {
@@ -424,7 +451,13 @@ fn score(cli: Cli) -> Result<()> {
                 .clone()
                 .unwrap_or_else(rh_score::execution::default_cache_dir)
         });
-        report.execution = Some(execute(&mut scoring, &ds, &cfg, cache.as_deref())?);
+        let videos = cli.execute_videos.as_deref().map(|dir| Videos {
+            dir,
+            scenes: cli.video_scenes.as_deref(),
+            tiled_scene: cli.tiled_scene.as_deref(),
+            progress: !cli.quiet,
+        });
+        report.execution = Some(execute(&mut scoring, &ds, &cfg, cache.as_deref(), videos)?);
     }
     drop(scoring);
 
@@ -511,17 +544,29 @@ fn score(cli: Cli) -> Result<()> {
 
 /// `--execute`: runs the collected decisions in physics, completes and writes the held
 /// back decision lines, and returns the report's execution part.
+/// `--execute-videos` and its options.
+struct Videos<'a> {
+    dir: &'a Path,
+    scenes: Option<&'a [String]>,
+    tiled_scene: Option<&'a str>,
+    progress: bool,
+}
+
 fn execute(
     scoring: &mut Scoring,
     ds: &Dataset,
     cfg: &Config,
     cache: Option<&Path>,
+    videos: Option<Videos>,
 ) -> Result<rh_score::execution::ExecutionReport> {
     use rh_score::execution::{execute_all, ExecutionReport};
     let (collected, names) = scoring
         .take_execution()
         .expect("execution was enabled before scoring");
     let (outcomes, stats) = execute_all(ds, &collected.pending, &cfg.execution, cache)?;
+    if let Some(v) = videos {
+        write_videos(ds, &collected.pending, &outcomes, &names, cfg, v)?;
+    }
     if let Some(w) = scoring.decisions_output() {
         let by_key: std::collections::BTreeMap<(usize, u32), usize> = collected
             .pending
@@ -553,6 +598,57 @@ fn execute(
         &cfg.execution,
         stats,
     ))
+}
+
+/// Draws the execution videos (`--execute-videos`) and says what was written.
+#[cfg(feature = "videos")]
+fn write_videos(
+    ds: &Dataset,
+    pending: &[rh_score::execution::Pending],
+    outcomes: &[Option<rh_pipeline::execute::Outcome>],
+    names: &[String],
+    cfg: &Config,
+    v: Videos,
+) -> Result<()> {
+    use rh_score::execution::videos::{write_videos, VideoRequest};
+    let req = VideoRequest {
+        dir: v.dir,
+        scenes: v.scenes,
+        tiled_scene: v.tiled_scene,
+        progress: v.progress,
+    };
+    let started = std::time::Instant::now();
+    let index = write_videos(
+        ds,
+        pending,
+        outcomes,
+        names,
+        &cfg.execution,
+        &cfg.execution_video,
+        &req,
+    )?;
+    let decisions: usize = index.scenes.iter().map(|s| s.decisions.len()).sum();
+    let secs = started.elapsed().as_secs_f64();
+    eprintln!(
+        "rh-score: execution videos of {decisions} decisions in {} scenes ({:.2} s per decision) in {}; see {}",
+        index.scenes.len(),
+        secs / decisions.max(1) as f64,
+        v.dir.display(),
+        v.dir.join("index.json").display()
+    );
+    Ok(())
+}
+
+#[cfg(not(feature = "videos"))]
+fn write_videos(
+    _: &Dataset,
+    _: &[rh_score::execution::Pending],
+    _: &[Option<rh_pipeline::execute::Outcome>],
+    _: &[String],
+    _: &Config,
+    _: Videos,
+) -> Result<()> {
+    unreachable!("--execute-videos is refused before scoring in a build without `videos`")
 }
 
 fn print_out(text: &str) -> Result<()> {

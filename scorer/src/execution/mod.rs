@@ -12,13 +12,15 @@
 //!   so rescoring the same predictions executes nothing again.
 
 pub mod report;
+#[cfg(feature = "videos")]
+pub mod videos;
 
 use crate::dataset::{read_replay_keys, Dataset, ReplayKey};
 use crate::plan::Plan;
 use crate::types::{Action, InputError};
 use anyhow::Result;
 use rayon::prelude::*;
-use rh_pipeline::execute::{replay, ExecConfig, ExecKeyframe, ExecPlan, Outcome};
+use rh_pipeline::execute::{replay, ExecConfig, ExecKeyframe, ExecPlan, Outcome, Replay};
 use rh_pipeline::spec::SceneSpec;
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
@@ -152,25 +154,7 @@ pub fn execute_all(
         .map(|(scene, decisions)| {
             let sc = &ds.scenes[*scene as usize];
             let key = replay_key(&keys, &sc.scene_id)?;
-            let spec = load_spec(&ds.dir, &key.spec_file)?;
-            let r = replay(&spec);
-            let full = match (&key.decision_state_hash, &key.state_hash) {
-                (Some(h), _) => {
-                    r.check(h).map_err(|e| InputError(e.to_string()))?;
-                    false
-                }
-                (None, Some(h)) => {
-                    r.check_full(h).map_err(|e| InputError(e.to_string()))?;
-                    true
-                }
-                (None, None) => {
-                    return Err(InputError(format!(
-                        "scene {}: the dataset has neither decision_state_hash nor state_hash, so its replay cannot be checked; refusing to execute",
-                        sc.scene_id
-                    ))
-                    .into())
-                }
-            };
+            let (r, full) = checked_replay(&ds.dir, key, &sc.scene_id)?;
             let out = decisions
                 .par_iter()
                 .map(|(i, ck)| {
@@ -200,7 +184,36 @@ pub fn execute_all(
     Ok((outcomes, stats))
 }
 
-fn replay_key<'a>(
+/// Replays a scene from its spec to Δ and checks it against the dataset's
+/// `decision_state_hash` (older datasets: a full replay against `state_hash`); true when
+/// the full replay was the check.
+pub(crate) fn checked_replay(
+    dir: &Path,
+    key: &ReplayKey,
+    scene_id: &str,
+) -> Result<(Replay, bool)> {
+    let spec = load_spec(dir, &key.spec_file)?;
+    let r = replay(&spec);
+    let full = match (&key.decision_state_hash, &key.state_hash) {
+        (Some(h), _) => {
+            r.check(h).map_err(|e| InputError(e.to_string()))?;
+            false
+        }
+        (None, Some(h)) => {
+            r.check_full(h).map_err(|e| InputError(e.to_string()))?;
+            true
+        }
+        (None, None) => {
+            return Err(InputError(format!(
+                "scene {scene_id}: the dataset has neither decision_state_hash nor state_hash, so its replay cannot be checked; refusing to execute"
+            ))
+            .into())
+        }
+    };
+    Ok((r, full))
+}
+
+pub(crate) fn replay_key<'a>(
     keys: &'a crate::types::FastMap<String, ReplayKey>,
     id: &str,
 ) -> Result<&'a ReplayKey> {
