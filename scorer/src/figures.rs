@@ -2,7 +2,9 @@
 //! `disposition` (SAA on CATCH vs DODGE scenes, one point per model, dashed diagonal),
 //! `freeze_by_band` (share of NO_ACTION per speed band, speed-sweeping families),
 //! `per_family` (SAA per family and model), `safety_rules` (first-rule breakdown, legend
-//! below). Percentage axes are labelled with whole numbers.
+//! below), and with `--execute` `outcomes` (caught / struck / missed / clear / not
+//! executed per model, and per model and ground-truth action, stacked). Percentage axes
+//! are labelled with whole numbers.
 //!
 //! Text is rendered with `ab_glyph` from a font embedded in the binary (Hack, via the
 //! `epaint_default_fonts` crate), so no system fonts or fontconfig are needed.
@@ -332,6 +334,91 @@ fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -
     Ok(())
 }
 
+/// Outcome segments of the `outcomes` figure: name, colour.
+const OUTCOME_SEGMENTS: [(&str, RGBColor); 5] = [
+    ("caught", RGBColor(44, 160, 44)),
+    ("struck", RGBColor(214, 39, 40)),
+    ("missed", RGBColor(255, 127, 14)),
+    ("clear", RGBColor(120, 144, 156)),
+    ("not executed (R1)", RGBColor(215, 215, 215)),
+];
+
+/// The `outcomes` figure's rows: per model its decisions, then per ground-truth action.
+fn outcome_rows(x: &crate::execution::ExecutionReport) -> Vec<(String, [u64; 5])> {
+    use crate::execution::report::Counts;
+    let seg = |c: &Counts| [c.caught, c.struck, c.missed, c.clear, c.not_executed];
+    let mut rows = Vec::new();
+    for m in &x.models {
+        rows.push((format!("{} (all)", m.model), seg(&m.all)));
+        for (gt, c) in &m.by_gt_action {
+            rows.push((format!("{}  gt {gt}", m.model), seg(c)));
+        }
+    }
+    rows
+}
+
+/// Execution outcomes (`--execute`): stacked bars of caught / struck / missed / clear /
+/// not executed, as shares of each row's decisions.
+fn outcomes<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> DrawResult {
+    root.fill(&WHITE).map_err(e)?;
+    let rows = r.execution.as_ref().map(outcome_rows).unwrap_or_default();
+    let n = rows.len().max(1);
+    let names: Vec<String> = rows.iter().map(|(name, _)| name.clone()).collect();
+    let longest = names.iter().map(|s| s.chars().count()).max().unwrap_or(0);
+    let (_, h) = root.dim_in_pixel();
+    let (plot, legend_area) = root.split_vertically(h as i32 - 40);
+    let mut chart = ChartBuilder::on(&plot)
+        .caption(
+            "Execution outcomes (% of decisions; per model and ground-truth action)",
+            (FONT, 20),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size((20 + longest * 7).clamp(140, 420) as u32)
+        .build_cartesian_2d(0f64..100f64, -0.5f64..(n as f64 - 0.5))
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .y_labels(n + 1)
+        .y_label_formatter(&|y| category_label(&names, *y))
+        .disable_y_mesh()
+        .x_desc("decisions (%)")
+        .x_label_formatter(&percent_label)
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 14))
+        .draw()
+        .map_err(e)?;
+    for (si, (_, c)) in OUTCOME_SEGMENTS.iter().enumerate() {
+        let bars: Vec<_> = rows
+            .iter()
+            .enumerate()
+            .filter_map(|(i, (_, counts))| {
+                let total: u64 = counts.iter().sum();
+                if total == 0 || counts[si] == 0 {
+                    return None;
+                }
+                let before: u64 = counts[..si].iter().sum();
+                let x0 = 100.0 * before as f64 / total as f64;
+                let x1 = x0 + 100.0 * counts[si] as f64 / total as f64;
+                let y = (n - 1 - i) as f64;
+                Some(Rectangle::new([(x0, y - 0.35), (x1, y + 0.35)], c.filled()))
+            })
+            .collect();
+        chart.draw_series(bars).map_err(e)?;
+    }
+    for (i, (label, c)) in OUTCOME_SEGMENTS.iter().enumerate() {
+        let x = 20 + 150 * i as i32;
+        legend_area
+            .draw(&Rectangle::new([(x, 10), (x + 14, 22)], c.filled()))
+            .map_err(e)?;
+        legend_area
+            .draw(&Text::new(label.to_string(), (x + 20, 9), (FONT, 12)))
+            .map_err(e)?;
+    }
+    root.present().map_err(e)?;
+    Ok(())
+}
+
 /// Height of the legend strip under the safety-rule chart (two rows of two).
 const LEGEND_BELOW: i32 = 60;
 
@@ -372,6 +459,10 @@ pub fn write_figures(r: &Report, dir: &Path) -> Result<Vec<std::path::PathBuf>> 
     both!(dir, "freeze_by_band", (900, 500), freeze_by_band, r, out);
     both!(dir, "per_family", (1080, fam_h), per_family, r, out);
     both!(dir, "safety_rules", (1000, safety_h), safety_rules, r, out);
+    if let Some(x) = &r.execution {
+        let outcomes_h = (140 + 26 * outcome_rows(x).len() as u32).clamp(300, 2400);
+        both!(dir, "outcomes", (1000, outcomes_h), outcomes, r, out);
+    }
     Ok(out)
 }
 
