@@ -545,6 +545,7 @@ fn score(cli: Cli) -> Result<()> {
 /// `--execute`: runs the collected decisions in physics, completes and writes the held
 /// back decision lines, and returns the report's execution part.
 /// `--execute-videos` and its options.
+#[cfg_attr(not(feature = "videos"), allow(dead_code))]
 struct Videos<'a> {
     dir: &'a Path,
     scenes: Option<&'a [String]>,
