@@ -165,8 +165,11 @@ pub fn write_videos(
     let keys = read_replay_keys(&ds.dir)?;
     let catalog =
         rh_catalog::Catalog::embedded().map_err(|e| anyhow!("the embedded catalog: {e}"))?;
-    let mut renderer = Renderer::new(RenderOptions::default())
-        .map_err(|e| anyhow!("--execute-videos cannot render here: {e}"))?;
+    let mut renderer = Renderer::new(RenderOptions::default()).map_err(|e| {
+        InputError(format!(
+            "--execute-videos cannot render on this machine: {e} (needs Vulkan — a GPU or Mesa's lavapipe — and FFmpeg with libx264; scripts/setup.sh installs them)"
+        ))
+    })?;
     let opts = ExecVideoOptions {
         width: vcfg.width,
         height: vcfg.height,
