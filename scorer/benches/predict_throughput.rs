@@ -3,6 +3,8 @@
 //! CPU time of building the prompts (PNG decode, scaling, JPEG, base64) per decision,
 //! reported separately, the server's CPU per request, and the peak RSS of each run at
 //! three sizes (flat = memory does not grow with the number of scenes).
+//! Before the runs: the thread CPU per frame of each encoding stage (PNG decode, scaling,
+//! JPEG), mean of 100 frames.
 //!
 //! `cargo bench -p rh-score --bench predict_throughput [-- [SCENES ...] [--frames DIR]]`
 //! (default sizes 120 480 1200). Dataset: the fixture generator's scenes, each with five
