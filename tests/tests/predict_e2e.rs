@@ -225,18 +225,48 @@ fn once_each(ls: &[Value], n: usize) {
     assert_eq!(ls.len(), n);
 }
 
-#[test]
-fn answers_resume_cache_report_and_no_key_anywhere() {
+/// One `predict` run in a fresh directory against a fresh test server (scripted replies
+/// `script`, then `then`), checked to have written every scene exactly once.
+struct FirstRun {
+    dir: tempfile::TempDir,
+    srv: Server,
+    out: PathBuf,
+    summary: Value,
+    n: usize,
+    lines: Vec<Value>,
+}
+
+fn first_run(script: &str, then: &str, args: &[&str]) -> FirstRun {
     let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    let srv = Server::start(d, "refusal", "cycle", &[]);
-    let out = d.join("preds.jsonl");
-    let price = ["--price-in", "10", "--price-out", "100"];
-    let s = ok_json(&predict(d, &srv.url(), &out, &price));
-    let n = s["scenes"].as_u64().unwrap() as usize;
-    assert!(n >= 2, "the build has valid scenes: {s}");
+    let srv = Server::start(dir.path(), script, then, &[]);
+    let out = dir.path().join("preds.jsonl");
+    let summary = ok_json(&predict(dir.path(), &srv.url(), &out, args));
+    let n = summary["scenes"].as_u64().unwrap() as usize;
     let ls = lines(&out);
     once_each(&ls, n);
+    FirstRun {
+        dir,
+        srv,
+        out,
+        summary,
+        n,
+        lines: ls,
+    }
+}
+
+#[test]
+fn answers_resume_cache_report_and_no_key_anywhere() {
+    let price = ["--price-in", "10", "--price-out", "100"];
+    let FirstRun {
+        dir,
+        srv,
+        out,
+        summary: s,
+        n,
+        lines: ls,
+    } = first_run("refusal", "cycle", &price);
+    let d = dir.path();
+    assert!(n >= 2, "the build has valid scenes: {s}");
     assert_eq!(srv.requests().len(), n);
     for r in srv.requests() {
         assert_eq!(r["images"], 5, "five ego frames per request");
@@ -304,24 +334,19 @@ fn answers_resume_cache_report_and_no_key_anywhere() {
 
 #[test]
 fn transient_failures_are_retried_and_retry_after_is_honoured() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    let srv = Server::start(
-        d,
+    let FirstRun {
+        dir,
+        srv,
+        summary: s,
+        n,
+        lines: ls,
+        ..
+    } = first_run(
         "429ra=1;429;500;502;503;malformed;empty;drop;hang",
         "bare",
-        &[],
-    );
-    let out = d.join("preds.jsonl");
-    let s = ok_json(&predict(
-        d,
-        &srv.url(),
-        &out,
         &["--concurrency", "1", "--timeout", "1", "--no-cache"],
-    ));
-    let n = s["scenes"].as_u64().unwrap() as usize;
-    let ls = lines(&out);
-    once_each(&ls, n);
+    );
+    let d = dir.path();
     assert!(
         ls.iter()
             .all(|l| l["error"].is_null() && l["plan"].is_object()),
@@ -345,16 +370,17 @@ fn transient_failures_are_retried_and_retry_after_is_honoured() {
 
 #[test]
 fn lost_decisions_retry_errors_and_fatal_errors() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    let srv = Server::start(d, "500;503", "bare", &[]);
-    let out = d.join("preds.jsonl");
     let args = ["--concurrency", "1", "--max-retries", "1"];
-    let s = ok_json(&predict(d, &srv.url(), &out, &args));
-    let n = s["scenes"].as_u64().unwrap() as usize;
+    let FirstRun {
+        dir,
+        srv,
+        out,
+        summary: s,
+        n,
+        lines: ls,
+    } = first_run("500;503", "bare", &args);
+    let d = dir.path();
     assert_eq!(s["lost"], 1);
-    let ls = lines(&out);
-    once_each(&ls, n);
     let lost: Vec<&Value> = ls.iter().filter(|l| !l["error"].is_null()).collect();
     assert_eq!(lost.len(), 1);
     assert!(

@@ -335,6 +335,14 @@ mod tests {
             .collect()
     }
 
+    /// [`test_frame`] as `frame.png` in a new temporary directory.
+    fn test_frame_in_tempdir() -> (tempfile::TempDir, std::path::PathBuf) {
+        let d = tempfile::tempdir().unwrap();
+        let f = d.path().join("frame.png");
+        test_frame(&f);
+        (d, f)
+    }
+
     /// A 1280×720 frame with edges, gradients and flat areas, written as the pipeline
     /// writes frames (RGB, fast deflate, Sub filter).
     fn test_frame(path: &Path) {
@@ -385,9 +393,7 @@ mod tests {
     /// features), the thread or the run, or `prompt_hash` and every cache key would.
     #[test]
     fn frame_bytes_are_pinned_and_thread_independent() {
-        let d = tempfile::tempdir().unwrap();
-        let f = d.path().join("frame.png");
-        test_frame(&f);
+        let (_d, f) = test_frame_in_tempdir();
         let jpeg = encode_frame(&f, 768, 85, SUB).unwrap();
         let back = image::load_from_memory(&jpeg).unwrap();
         assert_eq!((back.width(), back.height()), (768, 432));
@@ -410,13 +416,12 @@ mod tests {
     }
 
     /// libjpeg-turbo's SIMD paths (AVX2 and SSE2 on x86-64) write the bytes of its plain C
-    /// path: the same frame encoded in child processes with `JSIMD_FORCENONE=1` (C only)
-    /// and `JSIMD_FORCESSE2=1` gives this process's bytes (its best SIMD).
+    /// path: the same frame encoded in child processes with `JSIMD_FORCENONE=1` (C only),
+    /// `JSIMD_FORCESSE2=1`, `JSIMD_FORCEAVX2=1` and `JSIMD_NOHUFFENC=1` (C Huffman coder)
+    /// gives this process's bytes (its best SIMD).
     #[test]
     fn jpeg_bytes_do_not_depend_on_simd() {
-        let d = tempfile::tempdir().unwrap();
-        let f = d.path().join("frame.png");
-        test_frame(&f);
+        let (d, f) = test_frame_in_tempdir();
         let here = encode_frame(&f, 768, 85, SUB).unwrap();
         for (i, force) in [
             "JSIMD_FORCENONE",
@@ -450,9 +455,7 @@ mod tests {
     #[test]
     fn scaling_does_not_depend_on_simd() {
         use fast_image_resize as fr;
-        let d = tempfile::tempdir().unwrap();
-        let f = d.path().join("frame.png");
-        test_frame(&f);
+        let (_d, f) = test_frame_in_tempdir();
         let mut sc = Scratch::default();
         let (w, h) = decode_png(&f, &mut sc).unwrap();
         let size = scale_down(&mut sc, (w, h), 768).unwrap();
