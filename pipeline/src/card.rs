@@ -308,15 +308,15 @@ pub fn render(input: &CardInput) -> String {
              scene's last step; the PNG at time t is video frame `round(t · fps)` before \
              compression.\n\n**The full-event video** (`videos/full/<id>.mp4`, for people, never \
              model input) shows what the labels mean: the counterfactual run of the label \
-             rule, in which the standing observer is a static collider (a capsule of radius \
-             `observer.torso_radius` and the observer's height), run to the end of the event \
-             (the run the labels use stops after the strike window). A hazard that would \
+             rule, in which the standing observer is a body of fixed colliders (the \
+             humanoid's thirteen links at rest, the body `rh-score --execute` moves), run to \
+             the end of the event (the run the labels use stops after a strike's window). A hazard that would \
              strike the observer stops at its body there, instead of passing through it as \
              in the plain run, where the observer is drawn but is no body. Where nothing \
              comes near the observer the two runs are the same. The camera videos and \
              frames show the plain run: they end at Δ, before anything reaches the observer \
-             in a valid scene. The drawn robot's arms reach a few centimetres past the \
-             capsule. Full-event frame `j` shows step `round(j / full_fps / dt)` of that run."
+             in a valid scene. The drawn robot is a decorative mesh close to, not exactly, \
+             those links. Full-event frame `j` shows step `round(j / full_fps / dt)` of that run."
                 .into()
         } else {
             "This build has no rendered videos: the `*_file_name` columns are null and there is \
