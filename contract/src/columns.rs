@@ -328,13 +328,13 @@ pub const COLUMNS: &[Column] = &[
         col::STRIKE_SPEED,
         Float64,
         true,
-        "Counterfactual (observer standing still): speed of the hazard's contact point relative to the body (m/s); null if it never touches the body",
+        "Counterfactual (observer standing still, label rule v3: the humanoid's rest-pose links): largest speed of the hazard's contact point relative to the body over the strike window — the strike's, else the first touch's (m/s); null if it never touches the body",
     ),
     c(
         col::STRIKE_IMPULSE,
         Float64,
         true,
-        "Counterfactual: impulse the standing body receives within the strike window (N·s); null if never touched",
+        "Counterfactual: impulse the standing body receives within the strike window — the strike's, else the first touch's (N·s); null if never touched",
     ),
     c(
         col::OBJECT_START,

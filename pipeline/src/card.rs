@@ -308,15 +308,15 @@ pub fn render(input: &CardInput) -> String {
              scene's last step; the PNG at time t is video frame `round(t · fps)` before \
              compression.\n\n**The full-event video** (`videos/full/<id>.mp4`, for people, never \
              model input) shows what the labels mean: the counterfactual run of the label \
-             rule, in which the standing observer is a static collider (a capsule of radius \
-             `observer.torso_radius` and the observer's height), run to the end of the event \
-             (the run the labels use stops after the strike window). A hazard that would \
+             rule, in which the standing observer is a body of fixed colliders (the \
+             humanoid's thirteen links at rest, the body `rh-score --execute` moves), run to \
+             the end of the event (the run the labels use stops after a strike's window). A hazard that would \
              strike the observer stops at its body there, instead of passing through it as \
              in the plain run, where the observer is drawn but is no body. Where nothing \
              comes near the observer the two runs are the same. The camera videos and \
              frames show the plain run: they end at Δ, before anything reaches the observer \
-             in a valid scene. The drawn robot's arms reach a few centimetres past the \
-             capsule. Full-event frame `j` shows step `round(j / full_fps / dt)` of that run."
+             in a valid scene. The drawn robot is a decorative mesh close to, not exactly, \
+             those links. Full-event frame `j` shows step `round(j / full_fps / dt)` of that run."
                 .into()
         } else {
             "This build has no rendered videos: the `*_file_name` columns are null and there is \
@@ -526,12 +526,21 @@ the floor (a toppling wardrobe, a ladder), the moment the top corners of its bou
 first come within {eps} m of the floor, interpolated within the step.
 * **dangerous**: the object is sharp, hot, or large and fragile (catalog hazard flags of its \
 true physics), or its mass is ≥ {heavy} kg, or its impact momentum is ≥ {momentum} kg·m/s.
-* **danger_present**: in a counterfactual simulation with the observer's body (a capsule of \
-radius {torso} m, floor to {height} m) as a static collider, the hazard's point of contact \
-moves at ≥ {strike} m/s relative to the body (`strike_speed`: `v + ω × r` of the hazard just \
-before contact) and the body receives an impulse ≥ {impulse} N·s within {window_strike} s of \
-the first contact (`strike_impulse`) — or, at any speed, an impulse ≥ {heavy_push} N·s (a heavy \
-door or wardrobe pressing into the body).
+* **danger_present** (rule v3): in a counterfactual simulation with the observer's body as \
+fixed colliders — the articulated humanoid the executor moves (`rh-score --execute`), \
+standing at its pose with the palms at rest: pelvis, torso, head, upper arms, forearms, \
+palms, thighs and shanks (capsules and boxes, SPEC §2 proportions, {height} m tall; the legs \
+are two capsules 0.18 m apart, so a small ball can pass between them) — the hazard touches \
+a link and, within {window_strike} s of that touch, its point of contact moves at ≥ {strike} m/s \
+relative to the body (`strike_speed`: `v + ω × r` of the hazard just before contact) and the \
+links receive an impulse ≥ {impulse} N·s (`strike_impulse`) — or, at any speed, an impulse ≥ \
+{heavy_push} N·s (a heavy door or wardrobe pressing into the body). A touch that fails the \
+test closes after the window and a later touch is judged afresh (a pendulum that grazes the \
+body and comes back hard). The forearms and palms count like any other part (the body stands \
+with its hands at rest; only a plan that reaches out catches with them). Rule v2 used one \
+vertical capsule of radius {torso} m from the floor to the head instead, and judged only the \
+first touch; the executor's `freeze` plan disagreed with it on slow rollers passing beside or \
+between the legs and on blows to the forearms.
 * **reachable**: the hazard passes within {reach} m of the torso axis at or after Δ, or \
 danger is present.
 * **gt_action**: `NO_ACTION` when not reachable; else `DODGE` when dangerous, or the impact \

@@ -454,7 +454,7 @@ mod tests {
     fn embedded_config_is_valid() {
         let c = Config::embedded().unwrap();
         assert!((c.physics.dt - 1.0 / 240.0).abs() < 1e-15);
-        assert_eq!(c.labels.rule_version, "v2");
+        assert_eq!(c.labels.rule_version, "v3");
         for f in &c.build.families {
             assert!(
                 c.speed_bands(f).is_some(),

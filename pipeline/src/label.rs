@@ -1,11 +1,14 @@
 //! Stage 5 — label: ground truth from simulator state, never from appearance (SPEC §6).
 //!
 //! `label(&spec, &sim, &counterfactual)` reads the hazard's trajectory from the plain
-//! simulation and the strike from the counterfactual one (the observer standing still as
-//! a static collider), and applies the thresholds stored in the spec.
+//! simulation and the strike from the counterfactual one (the observer standing still:
+//! the humanoid's rest-pose links as fixed colliders, `simulate::observer_links`), and
+//! applies the thresholds stored in the spec (the strike test is `crate::strike`'s, the
+//! executor's too).
 
 use crate::simulate::{Simulation, Strike};
 use crate::spec::{SceneSpec, Vec3};
+use crate::strike::StrikeRule;
 use serde::{Deserialize, Serialize};
 
 /// The action primitives (the data contract's).
@@ -234,7 +237,7 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labe
     let impact_speed = impact.map(|(k, _)| length(sim.hazard_velocity(k)));
 
     let reach = approach(spec, sim, 0, cfg.reach_radius).map(|(k, _)| at(k));
-    let strike_time = strike.map(|s| at(s.step));
+    let strike_time = strike.map(|s| at(s.first_touch));
     let time_to_reach = match (reach, strike_time) {
         (Some(a), Some(b)) => Some(a.min(b)),
         (a, b) => a.or(b),
@@ -264,10 +267,9 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labe
     }
     let dangerous = !danger_reasons.is_empty();
 
-    let danger_present = strike.is_some_and(|s| {
-        (s.speed >= cfg.strike_speed_min && s.impulse >= cfg.strike_impulse_min)
-            || s.impulse >= cfg.strike_impulse_heavy
-    });
+    // The one strike test (`crate::strike`), the executor's too.
+    let rule = StrikeRule::of_labels(cfg, sim.dt);
+    let danger_present = strike.is_some_and(|s| rule.is_strike(s.speed, s.impulse));
     let reachable = closest_approach <= cfg.reach_radius || danger_present;
 
     let speed = impact_speed.unwrap_or(max_speed);
@@ -506,8 +508,10 @@ mod tests {
         let strike = |speed, impulse| {
             Some(Strike {
                 step: 300,
+                first_touch: 300,
                 speed,
                 impulse,
+                part: crate::execute::humanoid::Part::Torso,
             })
         };
         let hard = label(&s, &sim, strike(3.0, 1.0));

@@ -39,6 +39,7 @@ pub mod scene;
 pub mod seeds;
 pub mod simulate;
 pub mod spec;
+pub mod strike;
 pub mod validate;
 pub mod verify;
 pub mod visibility;

@@ -126,12 +126,11 @@ pub fn label_scene(spec: SceneSpec, sim: Simulation, config: &Config) -> SceneRe
     }
 }
 
-/// The counterfactual run of SPEC §6: the observer's body as a static collider, the
-/// strike followed for `labels.strike_window_s`.
-pub fn counterfactual_options(spec: &SceneSpec) -> SimOptions {
+/// The counterfactual run of SPEC §6: the observer's body (the humanoid standing at
+/// rest, `simulate::observer_links`) as fixed colliders, followed by the strike test.
+pub fn counterfactual_options(_spec: &SceneSpec) -> SimOptions {
     SimOptions {
         observer_collider: true,
-        strike_window_steps: (spec.labels.strike_window_s / spec.physics.dt).round() as u32,
         run_past_strike: false,
     }
 }
@@ -165,11 +164,18 @@ const OBSERVER_CLEARANCE: f64 = 0.1;
 /// it cannot strike and need not be simulated.
 pub fn may_touch_observer(spec: &SceneSpec, sim: &Simulation) -> bool {
     let o = &spec.observer;
-    sim.dynamic_bodies.iter().enumerate().any(|(slot, &body)| {
-        let reach = spec.bodies[body].bounding_radius() + o.torso_radius + OBSERVER_CLEARANCE;
-        (0..=sim.steps())
-            .any(|k| o.torso_axis_distance(sim.state(k, slot).position.map(f64::from)) <= reach)
-    })
+    // The standing body's links reach this far from its axis (arms, hands).
+    let body = crate::execute::humanoid::Geometry::of(o).rest_extent();
+    sim.dynamic_bodies
+        .iter()
+        .enumerate()
+        .any(|(slot, &body_index)| {
+            let reach = spec.bodies[body_index].bounding_radius()
+                + body.max(o.torso_radius)
+                + OBSERVER_CLEARANCE;
+            (0..=sim.steps())
+                .any(|k| o.torso_axis_distance(sim.state(k, slot).position.map(f64::from)) <= reach)
+        })
 }
 
 fn hazard_trajectory(spec: &SceneSpec, sim: &Simulation) -> Vec<[f32; 4]> {

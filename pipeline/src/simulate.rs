@@ -6,7 +6,9 @@
 //! state. The same spec gives the same hash in any process, thread count or shard: a
 //! scene is simulated single-threaded, and nothing here reads a clock or a hash map.
 
+use crate::execute::humanoid::{Geometry, LinkShape, Part, BODY_FRICTION, BODY_RESTITUTION};
 use crate::spec::{BodyKind, JointKind, ObserverSpec, PartSpec, SceneSpec, ShapeSpec};
+use crate::strike::{contact_point_speed, StrikeMonitor, StrikeRule};
 use rapier3d::prelude::*;
 use sha2::{Digest, Sha256};
 
@@ -18,11 +20,11 @@ pub const TOUCH_OBSERVER: u8 = 8;
 
 #[derive(Debug, Clone, Copy, Default)]
 pub struct SimOptions {
-    /// Adds the observer's body as a static collider (the counterfactual of SPEC §6);
-    /// the run then stops `strike_window_steps` after the hazard first touches it.
+    /// Adds the observer's body — the humanoid's thirteen links standing at rest
+    /// ([`observer_links`]) — as fixed colliders (the counterfactual of SPEC §6); the run
+    /// then follows the strike test (`crate::strike`, thresholds from `spec.labels`) and
+    /// stops at the end of a strike's window.
     pub observer_collider: bool,
-    /// How long a strike is followed to add up the impulse it delivers (steps).
-    pub strike_window_steps: u32,
     /// Keeps simulating after the strike window (until the scene settles or the
     /// horizon) instead of stopping there: the full-event video's run. The strike's
     /// numbers still cover only the window, so they equal the stopping run's.
@@ -38,18 +40,22 @@ pub struct BodyState {
     pub angvel: [f32; 3],
 }
 
-/// The hazard struck the standing observer (counterfactual run).
+/// The hazard touched the standing observer (counterfactual run): the strike window
+/// (`crate::strike`) if the strike test passed, else the first touch's window.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Strike {
-    /// First step with an active hazard–observer contact.
+    /// First step of the window (the touch that opened it).
     pub step: u32,
-    /// Largest speed, relative to the (static) observer, of the hazard's point of contact
-    /// just before a contact step, over the strike window (m/s): `v + ω × (p − c)` with
-    /// the body's velocities of the previous step and `p` the hazard's point nearest the
-    /// observer's body.
+    /// First step with an active hazard–body contact at all (≤ `step`).
+    pub first_touch: u32,
+    /// Largest speed, relative to the (static) body, of the hazard's point of contact
+    /// just before a contact step, over the window (m/s): `v + ω × (p − c)` with the
+    /// hazard's velocities of the previous step ([`contact_point_speed`]).
     pub speed: f64,
-    /// Total normal impulse the observer's body received over the strike window (N·s).
+    /// Total normal impulse the body's links received over the window (N·s).
     pub impulse: f64,
+    /// The link that took the most of it.
+    pub part: Part,
 }
 
 #[derive(Debug, Clone)]
@@ -248,10 +254,12 @@ impl Obstacles {
     }
 }
 
-/// The observer's body as a collider (the counterfactual of SPEC §6; the one definition
-/// of its geometry): a vertical capsule of the torso radius from the floor to the top of
-/// the head, as (centre, half height of the segment, radius); `inflate` widens the radius
-/// (line-of-sight queries use it to cover the drawn limbs).
+/// The observer's *sight envelope* for line-of-sight queries (the visibility validator):
+/// a vertical capsule of the torso radius from the floor to the top of the head, as
+/// (centre, half height of the segment, radius), `inflate` widening the radius to cover
+/// the drawn mesh's limbs. It answers "could the drawn observer hide the hazard from a
+/// camera", not "does the hazard hit the body": the body that is struck is
+/// [`observer_links`] (the humanoid of `execute::humanoid`).
 fn observer_capsule(o: &ObserverSpec, inflate: f64) -> (Vector, Real, Real) {
     let radius = o.torso_radius as Real;
     let half = ((o.height as Real) / 2.0 - radius).max(0.0);
@@ -271,42 +279,6 @@ pub(crate) fn lowest_z(collider: &Collider) -> f64 {
             .fold(Real::MAX, Real::min) as f64,
         None => collider.compute_aabb().mins.z as f64,
     }
-}
-
-/// Speed of the hazard's point nearest the observer's body, relative to that (static)
-/// body, with the hazard's velocities of the step before `step` (before the contact
-/// impulse) and its pose at `step`.
-fn contact_point_speed(
-    sim: &Simulation,
-    step: u32,
-    world: &PhysicsWorld,
-    hazard: ColliderHandle,
-    observer: ColliderHandle,
-) -> f64 {
-    let (h, o) = (&world.colliders[hazard], &world.colliders[observer]);
-    let com = sim.hazard_com(step);
-    // The contact query gives the hazard's deepest (or nearest) point even when the
-    // shapes overlap; should it find none, the centre of mass stands in.
-    let point = match rapier3d::parry::query::contact(
-        h.position(),
-        h.shape(),
-        o.position(),
-        o.shape(),
-        0.1,
-    ) {
-        Ok(Some(c)) => [c.point1.x as f64, c.point1.y as f64, c.point1.z as f64],
-        _ => com,
-    };
-    let state = sim.hazard_state(step - 1);
-    let v = state.linvel.map(f64::from);
-    let w = state.angvel.map(f64::from);
-    let r = [point[0] - com[0], point[1] - com[1], point[2] - com[2]];
-    let u = [
-        v[0] + w[1] * r[2] - w[2] * r[1],
-        v[1] + w[2] * r[0] - w[0] * r[2],
-        v[2] + w[0] * r[1] - w[1] * r[0],
-    ];
-    (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt()
 }
 
 const FLOOR_HALF_EXTENT: Real = 50.0;
@@ -406,15 +378,15 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         dynamic_bodies,
     } = build_world(spec);
 
-    let observer_collider = options.observer_collider.then(|| {
-        let (centre, half, radius) = observer_capsule(&spec.observer, 0.0);
-        world
-            .insert(
-                RigidBodyBuilder::fixed().translation(centre),
-                ColliderBuilder::capsule_z(half, radius),
-            )
-            .1
-    });
+    let observer: Vec<ColliderHandle> = if options.observer_collider {
+        insert_observer(&mut world, &spec.observer)
+    } else {
+        Vec::new()
+    };
+    let mut strikes = StrikeMonitor::new(
+        StrikeRule::of_labels(&spec.labels, spec.physics.dt),
+        observer.len(),
+    );
 
     let hazard_slot = dynamic_bodies
         .iter()
@@ -467,23 +439,16 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         sim.hazard_com
             .push([com.x as f64, com.y as f64, com.z as f64]);
 
-        let flags = hazard_contact_flags(
-            &world,
-            hazard_collider,
-            floor,
-            source_collider,
-            observer_collider,
-        );
+        let flags =
+            hazard_contact_flags(&world, hazard_collider, floor, source_collider, &observer);
         sim.hazard_contacts.push(flags);
 
         if step == 0 {
             continue;
         }
-        if let Some(observer) = observer_collider {
-            let window = options.strike_window_steps;
-            let window_over =
-                track_strike(&mut sim, step, &world, hazard_collider, observer, window);
-            if window_over && !options.run_past_strike {
+        if !observer.is_empty() {
+            follow_strike(&mut strikes, &sim, step, &world, hazard_collider, &observer);
+            if strikes.strike_over(step) && !options.run_past_strike {
                 break;
             }
         }
@@ -498,7 +463,62 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         }
     }
     sim.state_hash = hash_hex(hasher);
+    sim.strike = strikes.report().map(|w| Strike {
+        step: w.start,
+        first_touch: strikes.first_touch().unwrap_or(w.start),
+        speed: w.speed,
+        impulse: w.impulse,
+        part: Part::ALL[w.heaviest_part()],
+    });
     sim
+}
+
+/// The observer's body as the counterfactual of SPEC §6 strikes it: the humanoid
+/// (`execute::humanoid`, SPEC §2 proportions) standing at its pose with no knee bend and
+/// the palms at rest — exactly the executor's body under the `freeze` plan — as world
+/// poses and shapes of its thirteen links, in [`Part::ALL`] order. The one definition of
+/// the body that can be struck: the label's counterfactual run, the executor and
+/// [`observer_penetration`] all use it.
+pub fn observer_links(o: &ObserverSpec) -> Vec<(Pose, SharedShape)> {
+    let geometry = Geometry::of(o);
+    let poses = geometry.link_poses(&geometry.rest_pose([o.x, o.y, o.yaw]));
+    poses
+        .iter()
+        .zip(geometry.shapes())
+        .map(|(p, shape)| {
+            let q = p.rotation;
+            let pose = Pose::from_parts(v3(p.position), rot(q));
+            let shape = match shape {
+                LinkShape::Box(h) => SharedShape::cuboid(h[0] as Real, h[1] as Real, h[2] as Real),
+                LinkShape::Capsule {
+                    half_height,
+                    radius,
+                } => SharedShape::capsule_z(half_height as Real, radius as Real),
+                LinkShape::Sphere(r) => SharedShape::ball(r as Real),
+            };
+            (pose, shape)
+        })
+        .collect()
+}
+
+/// Inserts [`observer_links`] as fixed bodies (one per link, the body's surface
+/// `BODY_FRICTION` / `BODY_RESTITUTION`); returns their colliders in [`Part::ALL`] order.
+fn insert_observer(world: &mut PhysicsWorld, o: &ObserverSpec) -> Vec<ColliderHandle> {
+    observer_links(o)
+        .into_iter()
+        .map(|(pose, shape)| {
+            world
+                .insert(
+                    RigidBodyBuilder::fixed().pose(pose),
+                    ColliderBuilder::new(shape)
+                        .friction(BODY_FRICTION as Real)
+                        .restitution(BODY_RESTITUTION as Real)
+                        .friction_combine_rule(CoefficientCombineRule::Average)
+                        .restitution_combine_rule(CoefficientCombineRule::Average),
+                )
+                .1
+        })
+        .collect()
 }
 
 fn state_of(rb: &RigidBody) -> BodyState {
@@ -604,37 +624,39 @@ fn initial_penetration(world: &PhysicsWorld) -> f64 {
     initial_penetration
 }
 
-/// The hazard's active contacts this step, as `TOUCH_*` flags.
-/// Follows a strike of the standing observer (counterfactual run) at `step`: opens it at
-/// the first contact, keeps the largest contact-point speed and adds up the impulse.
-/// Returns true once the strike window is over (the run can stop).
-fn track_strike(
-    sim: &mut Simulation,
+/// Feeds the strike test (counterfactual run) with this step's touches of the standing
+/// body: the largest relative contact-point speed over the touched links and each link's
+/// impulse.
+fn follow_strike(
+    strikes: &mut StrikeMonitor,
+    sim: &Simulation,
     step: u32,
     world: &PhysicsWorld,
     hazard: ColliderHandle,
-    observer: ColliderHandle,
-    window_steps: u32,
-) -> bool {
-    if sim.strike.is_some_and(|s| step > s.step + window_steps) {
-        return true;
-    }
-    if sim.hazard_contacts[step as usize] & TOUCH_OBSERVER != 0 {
-        let speed = contact_point_speed(sim, step, world, hazard, observer);
-        let strike = sim.strike.get_or_insert(Strike {
-            step,
-            speed: 0.0,
-            impulse: 0.0,
-        });
-        strike.speed = strike.speed.max(speed);
-    }
-    match sim.strike.as_mut() {
-        Some(strike) => {
-            strike.impulse += contact_impulse(world, hazard, observer);
-            step >= strike.step + window_steps
-        }
-        None => false,
-    }
+    observer: &[ColliderHandle],
+) {
+    let before = sim.hazard_state(step - 1);
+    let (linvel, angvel) = (
+        Vector::from(before.linvel.map(|x| x as Real)),
+        Vector::from(before.angvel.map(|x| x as Real)),
+    );
+    let mut touch = None::<f64>;
+    let impulses: Vec<f64> = observer
+        .iter()
+        .map(|&link| {
+            let impulse = contact_impulse(world, hazard, link);
+            let touching = world
+                .narrow_phase
+                .contact_pair(hazard, link)
+                .is_some_and(|pair| pair.has_any_active_contact());
+            if touching {
+                let speed = contact_point_speed(world, hazard, linvel, angvel, link);
+                touch = Some(touch.map_or(speed, |t| t.max(speed)));
+            }
+            impulse
+        })
+        .collect();
+    strikes.step(step, touch, &impulses);
 }
 
 /// Total normal impulse between two colliders in the last step (N·s).
@@ -646,12 +668,13 @@ pub(crate) fn contact_impulse(world: &PhysicsWorld, a: ColliderHandle, b: Collid
         .map_or(0.0, |pair| pair.total_impulse_magnitude() as f64)
 }
 
+/// The hazard's active contacts this step, as `TOUCH_*` flags.
 fn hazard_contact_flags(
     world: &PhysicsWorld,
     hazard_collider: ColliderHandle,
     floor: ColliderHandle,
     source_collider: Option<ColliderHandle>,
-    observer_collider: Option<ColliderHandle>,
+    observer: &[ColliderHandle],
 ) -> u8 {
     let mut flags = 0u8;
     for pair in world.narrow_phase.contact_pairs_with(hazard_collider) {
@@ -667,7 +690,7 @@ fn hazard_contact_flags(
             TOUCH_FLOOR
         } else if Some(other) == source_collider {
             TOUCH_SOURCE
-        } else if Some(other) == observer_collider {
+        } else if observer.contains(&other) {
             TOUCH_OBSERVER
         } else {
             TOUCH_OTHER
@@ -677,15 +700,13 @@ fn hazard_contact_flags(
 }
 
 /// The deepest any dynamic body of `sim` sinks into the standing observer's body — the
-/// static capsule of the counterfactual run (`simulate` with `observer_collider`) —
-/// over the whole run (m; 0 when nothing touches it). In the plain run the observer is
-/// no body and a hazard may pass through it; in the counterfactual run it stays out up
-/// to the solver's contact tolerance (millimetres).
+/// fixed links of the counterfactual run ([`observer_links`]) — over the whole run (m; 0
+/// when nothing touches it). In the plain run the observer is no body and a hazard may
+/// pass through it; in the counterfactual run it stays out up to the solver's contact
+/// tolerance (millimetres).
 pub fn observer_penetration(spec: &SceneSpec, sim: &Simulation) -> f64 {
-    // The same capsule, at the same place, as the counterfactual's static collider.
-    let (centre, half, radius) = observer_capsule(&spec.observer, 0.0);
-    let capsule = SharedShape::capsule_z(half, radius);
-    let capsule_pose = Pose::from_translation(centre);
+    // The same links, at the same places, as the counterfactual's fixed colliders.
+    let links = observer_links(&spec.observer);
     let parts: Vec<Vec<(Pose, SharedShape)>> = sim
         .dynamic_bodies
         .iter()
@@ -701,15 +722,17 @@ pub fn observer_penetration(spec: &SceneSpec, sim: &Simulation) -> f64 {
             );
             for (part_pose, shape) in body_parts {
                 let pose = body_pose * *part_pose;
-                let contact = rapier3d::parry::query::contact(
-                    &capsule_pose,
-                    capsule.as_ref(),
-                    &pose,
-                    shape.as_ref(),
-                    0.0,
-                );
-                if let Ok(Some(c)) = contact {
-                    deepest = deepest.max(-(c.dist as f64));
+                for (link_pose, link) in &links {
+                    let contact = rapier3d::parry::query::contact(
+                        link_pose,
+                        link.as_ref(),
+                        &pose,
+                        shape.as_ref(),
+                        0.0,
+                    );
+                    if let Ok(Some(c)) = contact {
+                        deepest = deepest.max(-(c.dist as f64));
+                    }
                 }
             }
         }

@@ -1,14 +1,19 @@
 //! The executor (SPEC §12) at the library level: the replay to Δ is the build's
 //! simulation bit for bit, forks are independent of order and thread count, and the
-//! humanoid standing still is struck by a ball thrown at it.
+//! humanoid standing still is struck by a ball thrown at it, and by a slab flung at its
+//! resting forearm exactly as the label's standing body is (one body, one strike test).
 
 use rh_catalog::Catalog;
 use rh_pipeline::config::Config;
+use rh_pipeline::execute::humanoid::{Geometry, Part};
 use rh_pipeline::execute::{replay, ExecConfig, ExecKeyframe, ExecPlan, OutcomeKind};
 use rh_pipeline::label::decision_step;
+use rh_pipeline::randomize::{randomize, SceneKey};
+use rh_pipeline::scene::counterfactual_options;
 use rh_pipeline::scene::{produce_group, SceneResult};
 use rh_pipeline::selection::plan_group;
 use rh_pipeline::simulate::{simulate, SimOptions};
+use rh_pipeline::spec::{Selection, ShapeSpec};
 
 fn scenes(family: &str, group: u64) -> Vec<SceneResult> {
     let catalog = Catalog::embedded().unwrap();
@@ -127,4 +132,57 @@ fn recording_the_steps_leaves_outcome_and_hash_unchanged() {
             assert!((last.links[0].position[0] - last.base[0]).abs() < 1e-9);
         }
     }
+}
+
+#[test]
+fn a_slab_flung_at_the_resting_forearm_strikes_label_and_freeze_alike() {
+    // A 1.5 kg slab flies sideways (no gravity) at 3 m/s into the left forearm of the
+    // body standing at rest, arriving 0.35 s after the decision moment. Rule v3: the
+    // forearm is part of the standing body, so it is a strike (≈ 4.5 N·s, under the
+    // 6 N·s a *reaching* hand would need); the executor's freeze plan is the same body
+    // and the same test, so it is struck on the same part.
+    let catalog = Catalog::embedded().unwrap();
+    let config = Config::embedded().unwrap();
+    let selection = Selection {
+        family: "thrown_object".into(),
+        object_id: "tennis_ball".into(),
+        room_id: "gym".into(),
+        description: None,
+        planner: None,
+    };
+    let mut spec = randomize(&selection, &SceneKey::new(5, 0, 0), &catalog, &config).unwrap();
+    let o = &spec.observer;
+    let g = Geometry::of(o);
+    let forearm = g.link_poses(&g.rest_pose([o.x, o.y, o.yaw]))[Part::LeftForearm as usize];
+    let left = [-o.yaw.sin(), o.yaw.cos(), 0.0];
+    let (speed, half) = (3.0, [0.04, 0.01, 0.03]);
+    let t_hit = spec.observation_window_s + 0.35;
+    let d = speed * t_hit + half[1] + 0.035;
+    spec.physics.gravity = [0.0; 3];
+    let h = &mut spec.bodies[0];
+    h.parts[0].shape = ShapeSpec::Box { half_extents: half };
+    h.mass = 1.5;
+    h.position = [0, 1, 2].map(|i| forearm.position[i] + d * left[i]);
+    h.rotation = [0.0, 0.0, (o.yaw / 2.0).sin(), (o.yaw / 2.0).cos()];
+    h.linvel = left.map(|c| -speed * c);
+    h.angvel = [0.0; 3];
+    h.restitution = 0.0;
+
+    let cf = simulate(&spec, counterfactual_options(&spec));
+    let s = cf.strike.expect("the slab meets the forearm");
+    assert_eq!(s.part, Part::LeftForearm, "{s:?}");
+    let t = s.first_touch as f64 * spec.physics.dt;
+    assert!((t - t_hit).abs() < 0.02, "{t} vs {t_hit}");
+    assert!(s.speed > 2.9 && s.impulse > 3.0 && s.impulse < 6.0, "{s:?}");
+    let l = rh_pipeline::label::label(&spec, &simulate(&spec, SimOptions::default()), cf.strike);
+    assert!(l.danger_present);
+
+    let cfg = ExecConfig::embedded_default();
+    let freeze = &plans()[0];
+    let out = replay(&spec).execute(freeze, &cfg);
+    assert_eq!(out.outcome, OutcomeKind::Struck, "{out:?}");
+    let st = out.strike.as_ref().unwrap();
+    assert_eq!(st.part, "left_forearm");
+    let dt_hit = t_hit - spec.observation_window_s;
+    assert!((st.t - dt_hit).abs() < 0.02, "{st:?}");
 }

@@ -22,7 +22,7 @@ fn striking_scene(family: &str, config: &Config, catalog: &Catalog) -> SceneSpec
         let selection = plan_group(catalog, &families, 3, g).unwrap();
         let results = produce_group(&selection, 3, g * 4, 4, catalog, config).unwrap();
         for r in results {
-            if !r.verdicts.all() || r.labels.strike_speed.is_none() {
+            if !r.verdicts.all() || !r.labels.danger_present {
                 continue;
             }
             let depth = observer_penetration(&r.spec, &simulate(&r.spec, SimOptions::default()));

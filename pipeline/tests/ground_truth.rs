@@ -1,15 +1,17 @@
-//! Label rule v2 (issue 11) checked against closed forms on constructed scenes, the
-//! intended-event validators against samples built to fail, and the rule's acceptance
-//! on a 680-scene build (17 families × 4 bands × 10 groups).
+//! Label rules v2 (issue 11) and v3 (the standing body is the humanoid's rest-pose links,
+//! issue 14) checked against closed forms on constructed scenes, the intended-event
+//! validators against samples built to fail, and the rule's acceptance on a 680-scene
+//! build (17 families × 4 bands × 10 groups).
 
 use rh_catalog::Catalog;
 use rh_pipeline::config::Config;
+use rh_pipeline::execute::humanoid::{Part, HIP_Y};
 use rh_pipeline::families;
 use rh_pipeline::label::{self, ImpactKind};
 use rh_pipeline::plan::plan_group;
 use rh_pipeline::randomize::{randomize, SceneKey};
 use rh_pipeline::scene::{counterfactual_options, produce_group_counted, run_scene};
-use rh_pipeline::simulate::{simulate, SimOptions};
+use rh_pipeline::simulate::{observer_penetration, simulate, SimOptions};
 use rh_pipeline::spec::{SceneSpec, Selection};
 use rh_pipeline::validate::{reaction_time_ok, VALIDATOR_COLUMNS};
 
@@ -232,6 +234,68 @@ fn a_body_that_starts_on_the_floor_lands_when_its_top_touches_the_floor() {
         assert!(t > 0.1 && t < sim.steps() as f64 * spec.physics.dt);
     }
     assert!(landed >= 3, "only {landed} of 6 wardrobes fell over");
+}
+
+/// A ball of radius `r` sliding (frictionless, no bounce) along the floor from `from`
+/// with velocity `v`, its centre at height `r`.
+fn slider(r: f64, from: [f64; 2], v: [f64; 2]) -> SceneSpec {
+    let mut spec = constructed("tennis_ball");
+    spec.room.floor_friction = 0.0;
+    spec.room.floor_restitution = 0.0;
+    let h = &mut spec.bodies[0];
+    h.parts[0].shape = rh_pipeline::spec::ShapeSpec::Sphere { radius: r };
+    h.position = [from[0], from[1], r];
+    h.rotation = [0.0, 0.0, 0.0, 1.0];
+    h.linvel = [v[0], v[1], 0.0];
+    h.angvel = [0.0; 3];
+    h.friction = 0.0;
+    h.restitution = 0.0;
+    spec
+}
+
+#[test]
+fn a_ball_rolled_between_the_legs_is_no_strike_but_at_a_shin_it_is() {
+    // Rule v3's standing body is the humanoid: two legs 0.18 m apart (shanks of radius
+    // 0.055 m), not v2's one 0.36 m capsule. A 2 cm ball along the midline passes
+    // between the shanks (0.035 m clear of the axis either side) and touches nothing,
+    // though it runs straight through the torso axis (v2's capsule stopped it).
+    let (_, config) = setup();
+    let spec = slider(0.02, [1.5, 0.0], [-2.0, 0.0]);
+    let cf = simulate(&spec, counterfactual_options(&spec));
+    assert_eq!(cf.strike, None);
+    assert_eq!(observer_penetration(&spec, &cf), 0.0);
+    let crossed = (0..=cf.steps()).any(|k| cf.hazard_com(k)[0] < -0.3);
+    assert!(crossed, "the ball stopped at the body");
+    let l = run_scene(spec, &config).labels;
+    assert!(!l.danger_present && l.closest_approach < 0.01, "{l:?}");
+
+    // The same ball along the left leg's line meets the left shank: a strike.
+    let spec = slider(0.02, [1.5, HIP_Y], [-2.0, 0.0]);
+    let cf = simulate(&spec, counterfactual_options(&spec));
+    let s = cf.strike.expect("the ball meets the shin");
+    assert_eq!(s.part, Part::LeftShank);
+    assert!((s.speed - 2.0).abs() < 0.05, "{s:?}");
+    // No bounce: about its momentum (more through the tilt of the shank's ankle cap).
+    let p = spec.bodies[0].mass * 2.0;
+    assert!(s.impulse > 0.9 * p && s.impulse < 1.5 * p, "{s:?} vs {p}");
+    assert!(run_scene(spec, &config).labels.danger_present);
+}
+
+#[test]
+fn a_ball_meeting_the_ankle_head_on_delivers_its_momentum() {
+    // Closed form: a ball of radius 0.05 m (its centre at the ankle's height) sliding
+    // sideways at 2 m/s, frictionless and without bounce, meets the left shank's ankle
+    // cap head on (the shank leans forward, so the nearest point to a sideways approach
+    // is the ankle): the body takes the ball's whole momentum, J = m v, at 2 m/s.
+    let spec = slider(0.05, [0.0, 1.0], [0.0, -2.0]);
+    let cf = simulate(&spec, counterfactual_options(&spec));
+    let s = cf.strike.expect("the ball meets the ankle");
+    assert_eq!(s.part, Part::LeftShank);
+    let p = spec.bodies[0].mass * 2.0;
+    assert!((s.speed - 2.0).abs() < 0.02, "{s:?}");
+    assert!((s.impulse - p).abs() < 0.03 * p, "{s:?} vs {p}");
+    let l = label::label(&spec, &simulate(&spec, SimOptions::default()), cf.strike);
+    assert!(l.danger_present && l.strike_impulse == Some(s.impulse));
 }
 
 #[test]

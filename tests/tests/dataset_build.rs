@@ -93,7 +93,8 @@ fn dataset_build_layout_card_and_manifest() {
         "path: eval/test-*.parquet",
         "n<1K",
         "| `impact_point` | float64[3], nullable |",
-        "Label rule `v2`",
+        "Label rule `v3`",
+        "the articulated humanoid the executor moves",
         "before Δ + 0.2 s",
         "reach envelope",
         "≥ 2 kg",
@@ -151,7 +152,7 @@ fn dataset_build_layout_card_and_manifest() {
     assert_eq!(manifest["seed"], 11);
     assert_eq!(manifest["n"], 40);
     assert_eq!(manifest["shard"], serde_json::json!([0, 1]));
-    assert_eq!(manifest["config"]["labels"]["rule_version"], "v2");
+    assert_eq!(manifest["config"]["labels"]["rule_version"], "v3");
 }
 
 #[test]

@@ -9,6 +9,7 @@
 //! 0.27 m, forearm to the palm centre 0.28 m (reach 0.55 m), hips 0.09 m either side,
 //! thigh and shank 0.37 m each, ankle 0.05 m above the floor.
 
+use super::motion::{REST_LEFT, REST_RIGHT};
 use crate::spec::{quat, vec3, ObserverSpec, Quat, Vec3, IDENTITY};
 
 pub const UPPER_ARM: f64 = 0.27;
@@ -20,6 +21,12 @@ pub const SHANK: f64 = 0.37;
 pub const ANKLE_Z: f64 = 0.05;
 /// Hands never come closer than this (centre to centre, m): two palms side by side.
 pub const HAND_GAP: f64 = 0.10;
+/// Surface of the body's links where nothing else sets it: the standing body of the
+/// counterfactual label run (`simulate` with `observer_collider`). The executor's links
+/// use `link_friction` / `link_restitution` of `[execution]`, equal to these (a unit
+/// test in `execute` holds them equal).
+pub const BODY_FRICTION: f64 = 1.0;
+pub const BODY_RESTITUTION: f64 = 0.0;
 
 /// The links, in the order of [`Part::ALL`] (also the order of their rapier bodies).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -74,7 +81,8 @@ impl Part {
         }
     }
 
-    /// Hands and forearms: the parts that may hold the hazard (a touch there is no strike).
+    /// Hands and forearms: the parts that may hold the hazard (while the plan is reaching,
+    /// a touch there is no strike; see `outcome`).
     pub fn is_catching(self) -> bool {
         matches!(
             self,
@@ -89,6 +97,20 @@ pub enum LinkShape {
     Box(Vec3),
     Capsule { half_height: f64, radius: f64 },
     Sphere(f64),
+}
+
+impl LinkShape {
+    /// Radius of a sphere about the link's centre that holds it (m).
+    pub fn bounding_radius(&self) -> f64 {
+        match *self {
+            LinkShape::Box(h) => vec3::norm(h),
+            LinkShape::Capsule {
+                half_height,
+                radius,
+            } => half_height + radius,
+            LinkShape::Sphere(r) => r,
+        }
+    }
 }
 
 /// A link's world pose.
@@ -124,6 +146,31 @@ impl Geometry {
             shoulder_z: o.shoulder_z,
             height: o.height,
         }
+    }
+
+    /// The body standing still at `base` (`(x, y, yaw)`): no knee bend, both palms at
+    /// their rest position (SPEC §2's `(0.10, ±0.15, 0.00)`, kept clear of the torso by
+    /// [`Geometry::reachable`]). The one standing body: the executor starts every plan
+    /// from it (the `freeze` plan keeps it), and the counterfactual label run
+    /// (`simulate` with `observer_collider`) places these links as fixed colliders.
+    pub fn rest_pose(&self, base: Vec3) -> BodyPose {
+        BodyPose {
+            base,
+            drop: 0.0,
+            left: self.reachable(1.0, REST_LEFT),
+            right: self.reachable(-1.0, REST_RIGHT),
+        }
+    }
+
+    /// How far the standing body reaches horizontally from its vertical axis (m): the
+    /// largest horizontal distance of a rest-pose link's centre plus its bounding radius.
+    pub fn rest_extent(&self) -> f64 {
+        let links = self.link_poses(&self.rest_pose([0.0; 3]));
+        links
+            .iter()
+            .zip(self.shapes())
+            .map(|(l, s)| l.position[0].hypot(l.position[1]) + s.bounding_radius())
+            .fold(0.0, f64::max)
     }
 
     /// Shoulder centre in the body frame (`side` +1 left, −1 right).

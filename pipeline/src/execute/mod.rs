@@ -31,7 +31,7 @@ pub use outcome::{Outcome, OutcomeKind, StrikeRecord};
 
 /// Version of the executor's code (humanoid, controller, outcome rule); part of the
 /// execution cache key together with the config's own `version`.
-pub const EXECUTOR_VERSION: &str = "exec-2";
+pub const EXECUTOR_VERSION: &str = "exec-3";
 
 /// One hand keyframe (body frame; `t` in seconds after the decision moment).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -128,6 +128,7 @@ pub struct ExecConfig {
     pub strike_impulse_heavy: f64,
     pub strike_window_s: f64,
     pub hand_strike_impulse: f64,
+    pub reaching_offset: f64,
     pub hold_time_s: f64,
     pub hold_speed_max: f64,
     pub attempt_reach: f64,
@@ -175,6 +176,7 @@ impl ExecConfig {
             ("strike_impulse_min", self.strike_impulse_min),
             ("strike_impulse_heavy", self.strike_impulse_heavy),
             ("hand_strike_impulse", self.hand_strike_impulse),
+            ("reaching_offset", self.reaching_offset),
             ("hold_speed_max", self.hold_speed_max),
             ("attempt_reach", self.attempt_reach),
             ("attempt_radius", self.attempt_radius),
@@ -336,5 +338,24 @@ mod tests {
         let mut d = c.clone();
         d.max_speed = f64::NAN;
         assert!(d.validate().unwrap_err().contains("max_speed"));
+    }
+
+    /// One body, one strike test: the executor's strike thresholds and link surface are
+    /// the counterfactual label's (`configs/labels.toml`, `humanoid::BODY_*`), so the
+    /// `freeze` plan is struck exactly where the standing body would be.
+    #[test]
+    fn execution_strikes_like_the_label() {
+        let c = ExecConfig::embedded_default();
+        let l = crate::config::Config::embedded().unwrap().labels;
+        assert_eq!(
+            (c.strike_speed_min, c.strike_impulse_min),
+            (l.strike_speed_min, l.strike_impulse_min)
+        );
+        assert_eq!(
+            (c.strike_impulse_heavy, c.strike_window_s),
+            (l.strike_impulse_heavy, l.strike_window_s)
+        );
+        assert_eq!(c.link_friction, humanoid::BODY_FRICTION);
+        assert_eq!(c.link_restitution, humanoid::BODY_RESTITUTION);
     }
 }

@@ -57,16 +57,22 @@ impl<'a> Motion<'a> {
             geometry,
             dt,
             start,
-            pose: BodyPose {
-                base: start,
-                drop: 0.0,
-                left: REST_LEFT,
-                right: REST_RIGHT,
-            },
+            pose: geometry.rest_pose(start),
             velocity: [0.0; 2],
             yaw_rate: 0.0,
             limits_hit: [false; 4],
         }
+    }
+
+    /// Whether the plan is reaching now: a palm is more than `reaching_offset` from its
+    /// rest position (body frame). Only then do the hands and forearms count as catching
+    /// (a touch there is no strike short of `hand_strike_impulse`); a body standing with
+    /// its hands at rest is struck on the forearms like anywhere else.
+    pub fn reaching(&self) -> bool {
+        let rest = self.geometry.rest_pose(self.pose.base);
+        let off = |a: Vec3, b: Vec3| vec3::norm(vec3::sub(a, b));
+        off(self.pose.left, rest.left) > self.cfg.reaching_offset
+            || off(self.pose.right, rest.right) > self.cfg.reaching_offset
     }
 
     /// Advances the body from step `k` to step `k + 1` after the decision.

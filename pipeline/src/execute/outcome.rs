@@ -1,14 +1,17 @@
 //! The execution loop and the outcome rule (versioned with `[execution]` in
 //! `configs/scoring.toml`; times are seconds after the decision moment Δ):
 //!
-//! * `struck` — the hazard touches a body part other than the hands and forearms and,
-//!   within `strike_window_s` of that first touch, its speed relative to the part (just
-//!   before the touch) is ≥ `strike_speed_min` with a total impulse on those parts ≥
-//!   `strike_impulse_min`, or the impulse alone is ≥ `strike_impulse_heavy` (the
-//!   counterfactual label's test, on the moving body). The part that took the most
-//!   impulse, the impulse and the time of the first touch are recorded.
-//!   The hands/forearms count as struck only under a blow of `hand_strike_impulse` or
-//!   more within the window (a slamming door, not a caught ball).
+//! * `struck` — the strike test of the counterfactual label (`crate::strike`, the same
+//!   [`StrikeMonitor`]; thresholds `strike_*` equal to the label's) on the moving body:
+//!   within `strike_window_s` of a touch, the hazard's contact point moves at ≥
+//!   `strike_speed_min` relative to the touched link with a total impulse ≥
+//!   `strike_impulse_min`, or the impulse alone is ≥ `strike_impulse_heavy`. The part that
+//!   took the most impulse, the impulse and the time of the touch are recorded.
+//!   While the plan is *reaching* (a palm more than `reaching_offset` from rest,
+//!   [`Motion::reaching`]) the hands and forearms are catching, not part of that test:
+//!   they count as struck only under a blow of `hand_strike_impulse` or more within the
+//!   window (a slamming door, not a caught ball). With the palms at rest they are body
+//!   parts like the label's.
 //! * `caught` — not struck, and the hazard was held: touching the hands/forearms, not the
 //!   floor, moving with the touching link (relative speed ≤ `hold_speed_max`) for
 //!   `hold_time_s` without a break, before it ever touched the floor after Δ.
@@ -19,13 +22,15 @@
 //!   `first_contact_t` says).
 //!
 //! The run stops at the first strike, at a catch, once the hazard lies still on the floor
-//! away from the body after the plan's last motion, or at `horizon_s`.
+//! away from the body after the plan's last motion, or at `horizon_s` (at most the scene's
+//! own horizon, `physics.max_steps`, where the label's counterfactual stops too).
 
 use super::humanoid::{Geometry, LinkShape, Part};
 use super::motion::Motion;
 use super::{ExecConfig, ExecFrame, ExecPlan};
 use crate::simulate::{hash_hex, lowest_z, SceneWorld};
 use crate::spec::{SceneSpec, Vec3};
+use crate::strike::{contact_point_speed, StrikeMonitor, StrikeRule, StrikeWindow};
 use rapier3d::prelude::*;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -128,43 +133,15 @@ fn norm(v: Vector) -> f64 {
     v.length() as f64
 }
 
-/// A strike window being followed.
-struct Window {
-    start: u32,
-    speed: f64,
-    impulse: f64,
-    per_part: [f64; 13],
-}
-
-impl Window {
-    /// Adds one step's contact impulses (per body part, in [`Part::ALL`] order).
-    fn add(&mut self, impulses: &[f64; 13]) {
-        for (acc, x) in self.per_part.iter_mut().zip(impulses) {
-            *acc += x;
-        }
-        self.impulse += impulses.iter().sum::<f64>();
-    }
-
-    /// The part that took the largest impulse in the window (the first on a tie).
-    fn heaviest_part(&self) -> String {
-        let (i, _) = self
-            .per_part
-            .iter()
-            .enumerate()
-            .fold(
-                (0, f64::MIN),
-                |best, (i, &x)| if x > best.1 { (i, x) } else { best },
-            );
-        Part::ALL[i].name().to_string()
-    }
-}
-
 /// What the loop has seen so far.
 struct Monitor {
     first_contact: Option<(u32, Part)>,
-    window: Option<Window>,
-    /// Impulse on the hands/forearms since their first touch (a slamming door).
-    hand_window: Option<Window>,
+    /// The strike test on the body (the hands/forearms too while not reaching).
+    strikes: StrikeMonitor,
+    /// Impulse on the hands/forearms since their first touch while reaching (a slamming door).
+    hand_window: Option<StrikeWindow>,
+    /// The plan is reaching this step (see [`Motion::reaching`]).
+    reaching: bool,
     strike: Option<StrikeRecord>,
     floor_step: Option<u32>,
     held_steps: u32,
@@ -199,8 +176,15 @@ pub(super) fn run(
     let hazard_c = sw.collider_handles[spec.hazard];
     let hazard_b = sw.body_handles[spec.hazard];
     let steps = |s: f64| (s / dt).round().max(1.0) as u32;
+    // Never past the scene's own horizon (where the build, and the label's counterfactual,
+    // stop too).
+    let scene_left = spec
+        .physics
+        .max_steps
+        .saturating_sub(crate::label::decision_step(spec))
+        .max(1);
     let (horizon, window_steps, hold_steps) = (
-        steps(cfg.horizon_s),
+        steps(cfg.horizon_s).min(scene_left),
         steps(cfg.strike_window_s),
         steps(cfg.hold_time_s),
     );
@@ -210,10 +194,18 @@ pub(super) fn run(
         .map(|k| k.t)
         .fold(plan.walking_duration, f64::max);
     let started_on_floor = lowest_z(&sw.world.colliders[hazard_c]) <= cfg.floor_contact_eps;
+    let rule = StrikeRule::new(
+        cfg.strike_speed_min,
+        cfg.strike_impulse_min,
+        cfg.strike_impulse_heavy,
+        cfg.strike_window_s,
+        dt,
+    );
     let mut m = Monitor {
         first_contact: None,
-        window: None,
+        strikes: StrikeMonitor::new(rule, Part::ALL.len()),
         hand_window: None,
+        reaching: false,
         strike: None,
         floor_step: None,
         held_steps: 0,
@@ -228,11 +220,13 @@ pub(super) fn run(
     }
     for k in 0..horizon {
         motion.advance(k);
+        m.reaching = motion.reaching();
         let poses = geometry.link_poses(&motion.pose);
         for (i, (b, _)) in links.iter().enumerate() {
             sw.world.bodies[*b].set_next_kinematic_position(pose_of(&poses[i]));
         }
         let v_before = sw.world.bodies[hazard_b].linvel();
+        let w_before = sw.world.bodies[hazard_b].angvel();
         sw.world.step();
         executed = k + 1;
         sw.hash_step(&mut hasher);
@@ -251,7 +245,7 @@ pub(super) fn run(
             &links,
             hazard_c,
             hazard_b,
-            v_before,
+            (v_before, w_before),
             executed,
             cfg,
             window_steps,
@@ -263,7 +257,7 @@ pub(super) fn run(
         }
         let quiet = m.floor_step.is_some()
             && norm(sw.world.bodies[hazard_b].linvel()) < cfg.settle_speed
-            && m.window.is_none()
+            && !m.strikes.window_open()
             && executed as f64 * dt > plan_end;
         if quiet {
             break;
@@ -307,7 +301,7 @@ fn observe(
     links: &[(RigidBodyHandle, ColliderHandle)],
     hazard_c: ColliderHandle,
     hazard_b: RigidBodyHandle,
-    v_before: Vector,
+    (v_before, w_before): (Vector, Vector),
     step: u32,
     cfg: &ExecConfig,
     window_steps: u32,
@@ -317,7 +311,7 @@ fn observe(
     let world = &sw.world;
     let hazard = &world.colliders[hazard_c];
     let v_hazard = world.bodies[hazard_b].linvel();
-    let (mut on_floor, mut touching_hands, mut body_touch) = (false, false, None::<(Part, f64)>);
+    let (mut on_floor, mut touching_hands, mut body_touch) = (false, false, None::<f64>);
     let mut hold_speed = f64::INFINITY;
     let mut impulses = [0.0f64; 13];
     let mut hand_impulses = [0.0f64; 13];
@@ -342,17 +336,15 @@ fn observe(
         if m.first_contact.is_none() {
             m.first_contact = Some((step, part));
         }
-        if part.is_catching() {
+        if part.is_catching() && m.reaching {
             touching_hands = true;
             m.hand_touched = true;
             hand_impulses[i] += pair.total_impulse_magnitude() as f64;
             hold_speed = hold_speed.min(norm(v_hazard - link_v));
         } else {
             impulses[i] += pair.total_impulse_magnitude() as f64;
-            let speed = norm(v_before - link_v);
-            if body_touch.is_none_or(|(_, s)| speed > s) {
-                body_touch = Some((part, speed));
-            }
+            let speed = contact_point_speed(world, hazard_c, v_before, w_before, other);
+            body_touch = Some(body_touch.map_or(speed, |s| s.max(speed)));
         }
     }
     for hand in [Part::LeftHand, Part::RightHand] {
@@ -373,7 +365,16 @@ fn observe(
     {
         m.floor_step = Some(step);
     }
-    follow_strike(m, body_touch, &impulses, step, window_steps, cfg);
+    m.strikes.step(step, body_touch, &impulses);
+    if let Some(w) = m.strikes.strike() {
+        // The test passed: stop here (the verdict cannot change within the window).
+        m.strike = Some(StrikeRecord {
+            part: Part::ALL[w.heaviest_part()].name().to_string(),
+            impulse: w.impulse,
+            speed: w.speed,
+            t: w.start as f64,
+        });
+    }
     if m.strike.is_none() {
         follow_hand_strike(m, touching_hands, &hand_impulses, step, window_steps, cfg);
     }
@@ -382,49 +383,6 @@ fn observe(
     m.held_steps = if holding { m.held_steps + 1 } else { 0 };
     if m.held_steps >= hold_steps && m.strike.is_none() {
         m.caught = true;
-    }
-}
-
-/// Opens, feeds and closes strike windows on the non-catching parts.
-fn follow_strike(
-    m: &mut Monitor,
-    touch: Option<(Part, f64)>,
-    impulses: &[f64; 13],
-    step: u32,
-    window_steps: u32,
-    cfg: &ExecConfig,
-) {
-    if m.window.is_none() && touch.is_some() {
-        m.window = Some(Window {
-            start: step,
-            speed: 0.0,
-            impulse: 0.0,
-            per_part: [0.0; 13],
-        });
-    }
-    let Some(w) = m.window.as_mut() else {
-        return;
-    };
-    if let Some((_, speed)) = touch {
-        w.speed = w.speed.max(speed);
-    }
-    w.add(impulses);
-    let struck = (w.speed >= cfg.strike_speed_min && w.impulse >= cfg.strike_impulse_min)
-        || w.impulse >= cfg.strike_impulse_heavy;
-    if struck || step >= w.start + window_steps {
-        if struck {
-            m.strike = Some(StrikeRecord {
-                part: w.heaviest_part(),
-                impulse: w.impulse,
-                speed: w.speed,
-                t: 0.0,
-            });
-        }
-        if let Some(s) = m.strike.as_mut() {
-            // In steps here; `run` turns it into seconds.
-            s.t = w.start as f64;
-        }
-        m.window = None;
     }
 }
 
@@ -439,20 +397,15 @@ fn follow_hand_strike(
     cfg: &ExecConfig,
 ) {
     if m.hand_window.is_none() && touching {
-        m.hand_window = Some(Window {
-            start: step,
-            speed: 0.0,
-            impulse: 0.0,
-            per_part: [0.0; 13],
-        });
+        m.hand_window = Some(StrikeWindow::new(step, Part::ALL.len()));
     }
     let Some(w) = m.hand_window.as_mut() else {
         return;
     };
-    w.add(impulses);
+    w.add(None, impulses);
     if w.impulse >= cfg.hand_strike_impulse {
         m.strike = Some(StrikeRecord {
-            part: w.heaviest_part(),
+            part: Part::ALL[w.heaviest_part()].name().to_string(),
             impulse: w.impulse,
             speed: 0.0,
             t: w.start as f64,
