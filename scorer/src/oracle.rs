@@ -114,8 +114,14 @@ pub fn catch(scene: &Scene, cfg: &Config) -> Value {
     }
     let dth = crate::baseline::wrap_angle(yaw1 - th0);
     let dist = (goal[0] - x0).hypot(goal[1] - y0);
-    let dur = (dist / CATCH_SPEED).max(dth.abs() / 3.0).max(0.1);
-    let cmd = solve_walk(scene.observer_pose, goal, th0 + dth, dur);
+    let mut dur = (dist / CATCH_SPEED).max(dth.abs() / 3.0).max(0.1);
+    let mut cmd = solve_walk(scene.observer_pose, goal, th0 + dth, dur);
+    // A turning walk is an arc, longer than the chord: stretch it to the speed.
+    let speed = cmd[0].hypot(cmd[1]);
+    if speed > CATCH_SPEED {
+        dur *= speed / CATCH_SPEED;
+        cmd = solve_walk(scene.observer_pose, goal, th0 + dth, dur);
+    }
     let knee = drop / MAX_DROP;
     let at = |x: f64| {
         (
