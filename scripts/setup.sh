@@ -8,6 +8,7 @@ apt_packages=(
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   libavfilter-dev libavdevice-dev libswresample-dev
   clang libclang-dev pkg-config ffmpeg
+  cmake nasm
   python3 python3-pip python3-venv
   chromium
   slurm-wlm munge

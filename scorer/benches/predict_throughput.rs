@@ -3,6 +3,8 @@
 //! CPU time of building the prompts (PNG decode, scaling, JPEG, base64) per decision,
 //! reported separately, the server's CPU per request, and the peak RSS of each run at
 //! three sizes (flat = memory does not grow with the number of scenes).
+//! Before the runs: the thread CPU per frame of each encoding stage (PNG decode, scaling,
+//! JPEG), mean of 100 frames.
 //!
 //! `cargo bench -p rh-score --bench predict_throughput [-- [SCENES ...] [--frames DIR]]`
 //! (default sizes 120 480 1200). Dataset: the fixture generator's scenes, each with five
@@ -201,6 +203,33 @@ fn options(dir: &Path, port: u16, out: &Path) -> PredictOptions {
     }
 }
 
+/// Thread CPU per frame of each encoding stage, mean over 20 passes over the five frames
+/// (after one warm-up pass).
+fn print_stages(proto: &Path) {
+    let cfg = PromptConfig::load(None).unwrap();
+    let im = &cfg.images;
+    let sub = rh_score::predict::prompt::subsampling(&im.chroma_subsampling).unwrap();
+    let mut sum = [0.0; 3];
+    let mut n = 0usize;
+    for pass in 0..21 {
+        for &t in &im.times {
+            let f = proto.join(format!("ego_t{t:.3}.png"));
+            let st =
+                rh_score::predict::prompt::frame_stage_cpu_s(&f, im.max_side, im.jpeg_quality, sub)
+                    .unwrap();
+            if pass > 0 {
+                sum.iter_mut().zip(st).for_each(|(a, b)| *a += b);
+                n += 1;
+            }
+        }
+    }
+    let ms = sum.map(|x| 1000.0 * x / n as f64);
+    println!(
+        "per frame (thread CPU, mean of {n}): PNG decode {:.2} ms, scaling {:.2} ms, JPEG {:.2} ms",
+        ms[0], ms[1], ms[2]
+    );
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let frames: Option<PathBuf> = args
@@ -226,6 +255,7 @@ fn main() {
         std::thread::available_parallelism().map_or(0, |n| n.get()),
         status_kib("VmHWM:") / 1024
     );
+    print_stages(&tmp.path().join("proto"));
     for (k, &n) in sizes.iter().enumerate() {
         let scenes = &ids[..n.min(ids.len())];
         let out = tmp.path().join(format!("run{k}.jsonl"));

@@ -6,7 +6,7 @@
 
 use crate::types::FastMap;
 use crate::types::{Action, InputError};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use arrow::array::{
     Array, ArrayRef, BooleanArray, FixedSizeListArray, Float64Array, ListArray, RecordBatch,
     StringArray,
@@ -144,17 +144,7 @@ impl Dataset {
         if !data.is_dir() {
             return Err(InputError(crate::layout::missing_parquet_message(dir)).into());
         }
-        let mut files: Vec<PathBuf> = std::fs::read_dir(&data)
-            .map_err(|e| {
-                InputError(format!(
-                    "dataset {} has no readable data/ folder: {e}",
-                    dir.display()
-                ))
-            })?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
-            .collect();
-        files.sort();
+        let files = parquet_files(&data)?;
         if files.is_empty() {
             return Err(InputError(crate::layout::missing_parquet_message(dir)).into());
         }
@@ -172,6 +162,38 @@ impl Dataset {
         }
         Ok(ds)
     }
+}
+
+/// The `.parquet` files directly in `folder`, in name order (the order every reader of a
+/// dataset uses). An unreadable folder is an input error naming it.
+pub fn parquet_files(folder: &Path) -> Result<Vec<PathBuf>, InputError> {
+    let rd = std::fs::read_dir(folder)
+        .map_err(|e| InputError(format!("cannot read {}: {e}", folder.display())))?;
+    let mut files: Vec<PathBuf> = rd
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
+/// A record-batch reader over one Parquet file; a file that cannot be opened or is not
+/// Parquet is an input error naming it.
+pub fn open_parquet(
+    file: &Path,
+    batch_size: usize,
+) -> Result<parquet::arrow::arrow_reader::ParquetRecordBatchReader, InputError> {
+    let f = std::fs::File::open(file)
+        .map_err(|e| InputError(format!("cannot open {}: {e}", file.display())))?;
+    ParquetRecordBatchReaderBuilder::try_new(f)
+        .and_then(|b| b.with_batch_size(batch_size).build())
+        .map_err(|e| {
+            InputError(format!(
+                "{} is not a readable Parquet file: {e}",
+                file.display()
+            ))
+        })
 }
 
 /// One scene as read from a row (or made by a fixture), before interning.
@@ -320,18 +342,7 @@ fn vec3s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Option<[f64
 }
 
 fn read_parquet(file: &Path) -> Result<Vec<SceneInput>> {
-    let f = std::fs::File::open(file)
-        .map_err(|e| InputError(format!("cannot open {}: {e}", file.display())))?;
-    let reader = ParquetRecordBatchReaderBuilder::try_new(f)
-        .map_err(|e| {
-            InputError(format!(
-                "{} is not a readable Parquet file: {e}",
-                file.display()
-            ))
-        })?
-        .with_batch_size(8192)
-        .build()
-        .with_context(|| format!("reading {}", file.display()))?;
+    let reader = open_parquet(file, 8192)?;
     let mut out = Vec::new();
     for batch in reader {
         let batch = batch.map_err(|e| InputError(format!("{}: {e}", file.display())))?;
@@ -426,25 +437,10 @@ pub struct ReplayKey {
 
 /// Reads the replay columns of `DIR/data/*.parquet` (absent optional columns are `None`).
 pub fn read_replay_keys(dir: &Path) -> Result<FastMap<String, ReplayKey>> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir.join("data"))
-        .map_err(|e| {
-            InputError(format!(
-                "dataset {} has no readable data/: {e}",
-                dir.display()
-            ))
-        })?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
-        .collect();
-    files.sort();
+    let files = parquet_files(&dir.join("data"))?;
     let mut out = FastMap::default();
     for file in &files {
-        let f = std::fs::File::open(file)
-            .map_err(|e| InputError(format!("cannot open {}: {e}", file.display())))?;
-        let reader = ParquetRecordBatchReaderBuilder::try_new(f)
-            .map_err(|e| InputError(format!("{}: {e}", file.display())))?
-            .build()
-            .with_context(|| format!("reading {}", file.display()))?;
+        let reader = open_parquet(file, 8192)?;
         for batch in reader {
             let batch = batch.map_err(|e| InputError(format!("{}: {e}", file.display())))?;
             let optional = |name: &str| -> Result<Vec<Option<String>>> {

@@ -199,24 +199,45 @@ pub fn plan_from_value(v: &Value, cfg: &Config) -> Result<Plan, PlanError> {
     )
 }
 
+/// Where a byte of a JSON text stands: inside a string literal (escapes respected) or not.
+#[derive(Default)]
+struct JsonStrings {
+    in_str: bool,
+    esc: bool,
+}
+
+impl JsonStrings {
+    /// Feeds the next byte; true when it is outside any string and not a quote, i.e. a
+    /// byte that can open or close a container.
+    fn structural(&mut self, b: u8) -> bool {
+        if self.in_str {
+            if self.esc {
+                self.esc = false;
+            } else if b == b'\\' {
+                self.esc = true;
+            } else if b == b'"' {
+                self.in_str = false;
+            }
+            false
+        } else if b == b'"' {
+            self.in_str = true;
+            false
+        } else {
+            true
+        }
+    }
+}
+
 /// Containers (`{`, `[`) and the deepest nesting of a JSON text, strings skipped: a
 /// bound on the tree a parse would build, had without building it.
 pub fn json_shape(text: &str) -> (usize, usize) {
     let (mut containers, mut depth, mut max_depth) = (0usize, 0usize, 0usize);
-    let (mut in_str, mut esc) = (false, false);
+    let mut strings = JsonStrings::default();
     for &b in text.as_bytes() {
-        if in_str {
-            if esc {
-                esc = false;
-            } else if b == b'\\' {
-                esc = true;
-            } else if b == b'"' {
-                in_str = false;
-            }
+        if !strings.structural(b) {
             continue;
         }
         match b {
-            b'"' => in_str = true,
             b'{' | b'[' => {
                 containers += 1;
                 depth += 1;
@@ -644,25 +665,17 @@ fn scan_braces<T>(text: &str, f: &mut dyn FnMut(&str) -> Option<T>) -> Option<T>
             return None;
         }
         candidates += 1;
-        let (mut depth, mut in_str, mut esc) = (0usize, false, false);
+        let (mut depth, mut strings) = (0usize, JsonStrings::default());
         let mut end = None;
         for (i, &b) in bytes[s..].iter().enumerate() {
             if budget == 0 {
                 break;
             }
             budget -= 1;
-            if in_str {
-                if esc {
-                    esc = false;
-                } else if b == b'\\' {
-                    esc = true;
-                } else if b == b'"' {
-                    in_str = false;
-                }
+            if !strings.structural(b) {
                 continue;
             }
             match b {
-                b'"' => in_str = true,
                 b'{' => depth += 1,
                 b'}' => {
                     depth -= 1;

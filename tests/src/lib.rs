@@ -48,6 +48,22 @@ pub fn run_ok(name: &str, args: &[&str]) -> String {
     String::from_utf8(out.stdout).expect("utf-8 stdout")
 }
 
+/// A synthetic scored dataset (`rh-score make-fixture`) of `n` scenes in `dir`.
+pub fn make_fixture(dir: &Path, n: u32, seed: u64) {
+    run_ok(
+        "rh-score",
+        &[
+            "make-fixture",
+            "--out",
+            dir.to_str().unwrap(),
+            "--n",
+            &n.to_string(),
+            "--seed",
+            &seed.to_string(),
+        ],
+    );
+}
+
 /// Runs a Python snippet (pyarrow and friends come from scripts/setup.sh).
 pub fn python(script: &str) -> String {
     let out = Command::new("python3")

@@ -225,18 +225,48 @@ fn once_each(ls: &[Value], n: usize) {
     assert_eq!(ls.len(), n);
 }
 
-#[test]
-fn answers_resume_cache_report_and_no_key_anywhere() {
+/// One `predict` run in a fresh directory against a fresh test server (scripted replies
+/// `script`, then `then`), checked to have written every scene exactly once.
+struct FirstRun {
+    dir: tempfile::TempDir,
+    srv: Server,
+    out: PathBuf,
+    summary: Value,
+    n: usize,
+    lines: Vec<Value>,
+}
+
+fn first_run(script: &str, then: &str, args: &[&str]) -> FirstRun {
     let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    let srv = Server::start(d, "refusal", "cycle", &[]);
-    let out = d.join("preds.jsonl");
-    let price = ["--price-in", "10", "--price-out", "100"];
-    let s = ok_json(&predict(d, &srv.url(), &out, &price));
-    let n = s["scenes"].as_u64().unwrap() as usize;
-    assert!(n >= 2, "the build has valid scenes: {s}");
+    let srv = Server::start(dir.path(), script, then, &[]);
+    let out = dir.path().join("preds.jsonl");
+    let summary = ok_json(&predict(dir.path(), &srv.url(), &out, args));
+    let n = summary["scenes"].as_u64().unwrap() as usize;
     let ls = lines(&out);
     once_each(&ls, n);
+    FirstRun {
+        dir,
+        srv,
+        out,
+        summary,
+        n,
+        lines: ls,
+    }
+}
+
+#[test]
+fn answers_resume_cache_report_and_no_key_anywhere() {
+    let price = ["--price-in", "10", "--price-out", "100"];
+    let FirstRun {
+        dir,
+        srv,
+        out,
+        summary: s,
+        n,
+        lines: ls,
+    } = first_run("refusal", "cycle", &price);
+    let d = dir.path();
+    assert!(n >= 2, "the build has valid scenes: {s}");
     assert_eq!(srv.requests().len(), n);
     for r in srv.requests() {
         assert_eq!(r["images"], 5, "five ego frames per request");
@@ -257,7 +287,7 @@ fn answers_resume_cache_report_and_no_key_anywhere() {
         assert!(l["error"].is_null());
         // 1000 prompt tokens at $10/M + 100 completion tokens at $100/M.
         assert!((l["usage"]["cost"].as_f64().unwrap() - 0.02).abs() < 1e-12);
-        assert_eq!(l["prompt_version"], "rh-prompt-v2");
+        assert_eq!(l["prompt_version"], "rh-prompt-v3");
         assert_eq!(l["prompt_hash"].as_str().unwrap().len(), 64);
         assert!(l["latency_s"].as_f64().unwrap() >= 0.0);
     }
@@ -287,7 +317,7 @@ fn answers_resume_cache_report_and_no_key_anywhere() {
         ],
     );
     let rep: Value = serde_json::from_str(&rep).unwrap();
-    assert_eq!(rep["models"][0]["prompt_version"], "rh-prompt-v2");
+    assert_eq!(rep["models"][0]["prompt_version"], "rh-prompt-v3");
     assert_eq!(rep["models"][0]["lost"], 0);
     assert_eq!(rep["models"][0]["overall"]["first_rule"]["R1"], 1);
     let table = run_ok(
@@ -298,30 +328,25 @@ fn answers_resume_cache_report_and_no_key_anywhere() {
             dataset().to_str().unwrap(),
         ],
     );
-    assert!(table.contains("rh-prompt-v2"), "{table}");
+    assert!(table.contains("rh-prompt-v3"), "{table}");
     assert_no_key_under(d);
 }
 
 #[test]
 fn transient_failures_are_retried_and_retry_after_is_honoured() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    let srv = Server::start(
-        d,
+    let FirstRun {
+        dir,
+        srv,
+        summary: s,
+        n,
+        lines: ls,
+        ..
+    } = first_run(
         "429ra=1;429;500;502;503;malformed;empty;drop;hang",
         "bare",
-        &[],
-    );
-    let out = d.join("preds.jsonl");
-    let s = ok_json(&predict(
-        d,
-        &srv.url(),
-        &out,
         &["--concurrency", "1", "--timeout", "1", "--no-cache"],
-    ));
-    let n = s["scenes"].as_u64().unwrap() as usize;
-    let ls = lines(&out);
-    once_each(&ls, n);
+    );
+    let d = dir.path();
     assert!(
         ls.iter()
             .all(|l| l["error"].is_null() && l["plan"].is_object()),
@@ -345,16 +370,17 @@ fn transient_failures_are_retried_and_retry_after_is_honoured() {
 
 #[test]
 fn lost_decisions_retry_errors_and_fatal_errors() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    let srv = Server::start(d, "500;503", "bare", &[]);
-    let out = d.join("preds.jsonl");
     let args = ["--concurrency", "1", "--max-retries", "1"];
-    let s = ok_json(&predict(d, &srv.url(), &out, &args));
-    let n = s["scenes"].as_u64().unwrap() as usize;
+    let FirstRun {
+        dir,
+        srv,
+        out,
+        summary: s,
+        n,
+        lines: ls,
+    } = first_run("500;503", "bare", &args);
+    let d = dir.path();
     assert_eq!(s["lost"], 1);
-    let ls = lines(&out);
-    once_each(&ls, n);
     let lost: Vec<&Value> = ls.iter().filter(|l| !l["error"].is_null()).collect();
     assert_eq!(lost.len(), 1);
     assert!(
@@ -534,7 +560,7 @@ fn dry_run_prints_the_request_and_paper_layout_is_refused() {
         .iter()
         .all(|u| u.contains("base64 characters elided")));
     assert!(user.iter().any(|p| p["text"] == "t = 0.60 s (ego camera)"));
-    assert_eq!(v["prompt_version"], "rh-prompt-v2");
+    assert_eq!(v["prompt_version"], "rh-prompt-v3");
     assert_eq!(v["body"]["temperature"], 0.0);
 
     // The paper's metadata-only layout, and a directory without Parquet.

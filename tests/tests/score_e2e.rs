@@ -42,18 +42,7 @@ fn fixture_dataset() -> &'static Path {
     static DS: OnceLock<PathBuf> = OnceLock::new();
     DS.get_or_init(|| {
         let dir = scratch("fixture").join("ds");
-        run_ok(
-            "rh-score",
-            &[
-                "make-fixture",
-                "--out",
-                dir.to_str().unwrap(),
-                "--n",
-                "120",
-                "--seed",
-                "5",
-            ],
-        );
+        rh_e2e::make_fixture(&dir, 120, 5);
         dir
     })
 }

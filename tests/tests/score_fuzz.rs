@@ -35,18 +35,7 @@ fn scratch(name: &str) -> PathBuf {
 fn garbage_truncated_and_huge_lines_never_stop_the_run() {
     let work = scratch("fuzz");
     let ds = work.join("ds");
-    run_ok(
-        "rh-score",
-        &[
-            "make-fixture",
-            "--out",
-            ds.to_str().unwrap(),
-            "--n",
-            "40",
-            "--seed",
-            "3",
-        ],
-    );
+    rh_e2e::make_fixture(&ds, 40, 3);
     let valid = run_ok(
         "rh-score",
         &["baseline", "random", "--dataset", ds.to_str().unwrap()],

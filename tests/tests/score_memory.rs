@@ -22,18 +22,7 @@ fn children_peak_rss_mib() -> f64 {
 fn hostile_predictions_score_as_r1_with_flat_memory() {
     let tmp = tempfile::tempdir().unwrap();
     let ds = tmp.path().join("ds");
-    run_ok(
-        "rh-score",
-        &[
-            "make-fixture",
-            "--out",
-            ds.to_str().unwrap(),
-            "--n",
-            "40",
-            "--seed",
-            "3",
-        ],
-    );
+    rh_e2e::make_fixture(&ds, 40, 3);
     let base = run_ok(
         "rh-score",
         &["baseline", "oracle", "--dataset", ds.to_str().unwrap()],

@@ -2,16 +2,15 @@
 //! files.
 
 use crate::types::InputError;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use arrow::array::{
     Array, ArrayRef, BooleanArray, FixedSizeListArray, Float32Array, Float64Array, Int32Array,
     Int64Array, ListArray, StringArray, UInt32Array, UInt64Array,
 };
 use arrow::datatypes::DataType;
-use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use serde_json::{Map, Value};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 fn num(x: f64) -> Value {
     serde_json::Number::from_f64(x).map_or(Value::Null, Value::Number)
@@ -51,29 +50,10 @@ fn value(a: &ArrayRef, i: usize) -> Value {
 /// Every row of `dir/data/*.parquet` (files in name order) as a JSON object, keyed by
 /// `scene_id` (the first row of a duplicated id wins, as in [`crate::dataset`]).
 pub fn read_rows(dir: &Path) -> Result<BTreeMap<String, Map<String, Value>>> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir.join("data"))
-        .map_err(|e| {
-            InputError(format!(
-                "dataset {} has no readable data/ folder: {e}",
-                dir.display()
-            ))
-        })?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
-        .collect();
-    files.sort();
+    let files = crate::dataset::parquet_files(&dir.join("data"))?;
     let mut rows = BTreeMap::new();
     for file in files {
-        let f =
-            std::fs::File::open(&file).with_context(|| format!("opening {}", file.display()))?;
-        let reader = ParquetRecordBatchReaderBuilder::try_new(f)
-            .and_then(|b| b.build())
-            .map_err(|e| {
-                InputError(format!(
-                    "{}: not a readable Parquet file: {e}",
-                    file.display()
-                ))
-            })?;
+        let reader = crate::dataset::open_parquet(&file, 1024)?;
         for batch in reader {
             let batch = batch.map_err(|e| InputError(format!("{}: {e}", file.display())))?;
             let schema = batch.schema();

@@ -27,6 +27,8 @@ pub struct ImageOptions {
     pub times: Vec<f64>,
     pub max_side: u32,
     pub jpeg_quality: u8,
+    /// "4:2:0" or "4:4:4".
+    pub chroma_subsampling: String,
     pub detail: String,
 }
 
@@ -84,6 +86,11 @@ impl PromptConfig {
         }
         if !(1..=100).contains(&cfg.images.jpeg_quality) {
             return Err(bad("[images] jpeg_quality must be 1-100".into()));
+        }
+        if super::prompt::subsampling(&cfg.images.chroma_subsampling).is_none() {
+            return Err(bad(
+                "[images] chroma_subsampling must be \"4:2:0\" or \"4:4:4\"".into(),
+            ));
         }
         if cfg.images.max_side < 16 {
             return Err(bad("[images] max_side must be at least 16".into()));

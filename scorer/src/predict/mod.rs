@@ -16,7 +16,6 @@ use crate::dataset::Dataset;
 use crate::types::InputError;
 use anyhow::Result;
 use arrow::array::{Array, StringArray};
-use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
@@ -54,26 +53,18 @@ pub struct PredictOptions {
 
 /// Scene ids of the dataset's `eval/*.parquet`, or `None` when it has no eval config.
 fn eval_scene_ids(dir: &Path) -> Result<Option<BTreeSet<String>>> {
-    let Ok(rd) = std::fs::read_dir(dir.join("eval")) else {
+    let eval = dir.join("eval");
+    if !eval.is_dir() {
         return Ok(None);
-    };
-    let mut files: Vec<PathBuf> = rd
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
-        .collect();
+    }
+    let files = crate::dataset::parquet_files(&eval)?;
     if files.is_empty() {
         return Ok(None);
     }
-    files.sort();
     let mut ids = BTreeSet::new();
     for f in files {
         let bad = |e: &dyn std::fmt::Display| InputError(format!("{}: {e}", f.display()));
-        let file = std::fs::File::open(&f).map_err(|e| bad(&e))?;
-        let reader = ParquetRecordBatchReaderBuilder::try_new(file)
-            .map_err(|e| bad(&e))?
-            .build()
-            .map_err(|e| bad(&e))?;
+        let reader = crate::dataset::open_parquet(&f, 1024)?;
         for batch in reader {
             let batch = batch.map_err(|e| bad(&e))?;
             let col = batch

@@ -61,6 +61,7 @@ struct Scratch {
     decoded: Vec<u8>,
     rgb: Vec<u8>,
     scaled: Vec<u8>,
+    jpeg: Vec<u8>,
 }
 
 thread_local! {
@@ -80,16 +81,24 @@ fn decode_png(path: &Path, sc: &mut Scratch) -> Result<(u32, u32), String> {
         .ok_or_else(|| bad(&"image too large"))?;
     sc.decoded.resize(size, 0);
     let info = reader.next_frame(&mut sc.decoded).map_err(|e| bad(&e))?;
-    let px = &sc.decoded[..info.buffer_size()];
-    sc.rgb.clear();
-    match info.color_type {
-        png::ColorType::Rgb => sc.rgb.extend_from_slice(px),
-        png::ColorType::Rgba => sc
-            .rgb
-            .extend(px.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]])),
-        png::ColorType::Grayscale => sc.rgb.extend(px.iter().flat_map(|&g| [g, g, g])),
-        png::ColorType::GrayscaleAlpha => sc.rgb.extend(px.chunks_exact(2).flat_map(|p| [p[0]; 3])),
-        png::ColorType::Indexed => return Err(bad(&"palette was not expanded")),
+    let n = info.buffer_size();
+    if info.color_type == png::ColorType::Rgb {
+        // Already RGB: the decoded buffer becomes the frame (no copy).
+        sc.decoded.truncate(n);
+        std::mem::swap(&mut sc.decoded, &mut sc.rgb);
+    } else {
+        let px = &sc.decoded[..n];
+        sc.rgb.clear();
+        match info.color_type {
+            png::ColorType::Rgba => sc
+                .rgb
+                .extend(px.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]])),
+            png::ColorType::Grayscale => sc.rgb.extend(px.iter().flat_map(|&g| [g, g, g])),
+            png::ColorType::GrayscaleAlpha => {
+                sc.rgb.extend(px.chunks_exact(2).flat_map(|p| [p[0]; 3]))
+            }
+            other => return Err(bad(&format!("unexpected colour type {other:?}"))),
+        }
     }
     Ok((info.width, info.height))
 }
@@ -117,35 +126,111 @@ fn scale_down(sc: &mut Scratch, (w, h): (u32, u32), max_side: u32) -> Result<(u3
     Ok((nw, nh))
 }
 
-/// Reads a PNG frame and returns it as JPEG bytes (baseline, 4:2:0 below quality 90) no
-/// larger than `max_side`. Deterministic: the scalar JPEG encoder, whose bytes do not
-/// depend on the CPU (its AVX2 path rounds differently, so it is not enabled).
-pub fn encode_frame(path: &Path, max_side: u32, quality: u8) -> Result<Vec<u8>, String> {
+/// Chroma subsampling of the prompt's JPEGs (`[images] chroma_subsampling`).
+pub fn subsampling(name: &str) -> Option<turbojpeg::Subsamp> {
+    match name {
+        "4:2:0" => Some(turbojpeg::Subsamp::Sub2x2),
+        "4:4:4" => Some(turbojpeg::Subsamp::None),
+        _ => None,
+    }
+}
+
+thread_local! {
+    static COMPRESSOR: std::cell::RefCell<Option<turbojpeg::Compressor>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// JPEG-encodes packed 8-bit RGB (w×h) with libjpeg-turbo into `out`: baseline, the
+/// standard's Huffman tables, the accurate integer DCT (`JDCT_ISLOW`; the fast and float
+/// DCTs are off), libjpeg's quality scaling. libjpeg-turbo's SIMD paths for this
+/// configuration (colour conversion, downsampling, DCT, quantisation, Huffman coding) write
+/// the bytes its C path writes, so the result does not depend on the CPU (tested with
+/// `JSIMD_FORCENONE` / `JSIMD_FORCESSE2` in a child process). Returns the JPEG's length.
+fn encode_jpeg(
+    pixels: &[u8],
+    (w, h): (u32, u32),
+    quality: u8,
+    sub: turbojpeg::Subsamp,
+    out: &mut Vec<u8>,
+) -> Result<usize, String> {
+    let bad = |e: turbojpeg::Error| format!("JPEG encoder: {e}");
+    COMPRESSOR.with(|c| {
+        let mut slot = c.borrow_mut();
+        if slot.is_none() {
+            *slot = Some(turbojpeg::Compressor::new().map_err(bad)?);
+        }
+        let comp = slot.as_mut().expect("compressor was just created");
+        comp.set_quality(quality.clamp(1, 100) as i32)
+            .map_err(bad)?;
+        comp.set_subsamp(sub).map_err(bad)?;
+        comp.set_optimize(false).map_err(bad)?;
+        comp.set_progressive(false).map_err(bad)?;
+        comp.set_arithmetic(false).map_err(bad)?;
+        let image = turbojpeg::Image {
+            pixels,
+            width: w as usize,
+            pitch: w as usize * 3,
+            height: h as usize,
+            format: turbojpeg::PixelFormat::RGB,
+        };
+        // The worst-case size, allocated once per thread and size.
+        out.resize(comp.buf_len(w as usize, h as usize).map_err(bad)?, 0);
+        comp.compress_to_slice(image, out).map_err(bad)
+    })
+}
+
+/// Reads a PNG frame and returns it as JPEG bytes no larger than `max_side` (see
+/// [`encode_jpeg`]). Deterministic: the same bytes on every CPU, thread and run.
+pub fn encode_frame(
+    path: &Path,
+    max_side: u32,
+    quality: u8,
+    sub: turbojpeg::Subsamp,
+) -> Result<Vec<u8>, String> {
     SCRATCH.with(|sc| {
         let sc = &mut *sc.borrow_mut();
         let (w, h) = decode_png(path, sc)?;
-        let (w, h, pixels) = if w.max(h) > max_side {
-            let (nw, nh) = scale_down(sc, (w, h), max_side)?;
-            (nw, nh, &sc.scaled[..])
+        let (size, pixels) = if w.max(h) > max_side {
+            let size = scale_down(sc, (w, h), max_side)?;
+            (size, &sc.scaled[..])
         } else {
-            (w, h, &sc.rgb[..])
+            ((w, h), &sc.rgb[..])
         };
-        let too_big = || format!("{}: frame larger than 65535 pixels", path.display());
-        let (w, h) = (
-            u16::try_from(w).map_err(|_| too_big())?,
-            u16::try_from(h).map_err(|_| too_big())?,
-        );
-        let mut out = Vec::with_capacity(pixels.len() / 8);
-        jpeg_encoder::Encoder::new(&mut out, quality.clamp(1, 100))
-            .encode(pixels, w, h, jpeg_encoder::ColorType::Rgb)
+        let n = encode_jpeg(pixels, size, quality, sub, &mut sc.jpeg)
             .map_err(|e| format!("cannot encode frame {} as JPEG: {e}", path.display()))?;
-        Ok(out)
+        Ok(sc.jpeg[..n].to_vec())
+    })
+}
+
+/// Thread CPU seconds of each stage of [`encode_frame`] for one frame: PNG decode, scaling,
+/// JPEG (the benchmark's breakdown of the prompt-building cost).
+pub fn frame_stage_cpu_s(
+    path: &Path,
+    max_side: u32,
+    quality: u8,
+    sub: turbojpeg::Subsamp,
+) -> Result<[f64; 3], String> {
+    SCRATCH.with(|sc| {
+        let sc = &mut *sc.borrow_mut();
+        let t0 = thread_cpu_s();
+        let (w, h) = decode_png(path, sc)?;
+        let t1 = thread_cpu_s();
+        let size = scale_down(sc, (w, h), max_side.min(w.max(h)))?;
+        let t2 = thread_cpu_s();
+        encode_jpeg(&sc.scaled, size, quality, sub, &mut sc.jpeg)?;
+        Ok([t1 - t0, t2 - t1, thread_cpu_s() - t2])
     })
 }
 
 /// The messages for one scene of the dataset at `dir`.
 pub fn build(cfg: &PromptConfig, dir: &Path, scene_id: &str) -> Result<BuiltPrompt, String> {
     let cpu0 = thread_cpu_s();
+    let sub = subsampling(&cfg.images.chroma_subsampling).ok_or_else(|| {
+        format!(
+            "unknown chroma subsampling {:?}",
+            cfg.images.chroma_subsampling
+        )
+    })?;
     let mut content = vec![json!({"type": "text", "text": fill(&cfg.text.user_intro, cfg)})];
     for &t in &cfg.images.times {
         for cam in &cfg.images.cameras {
@@ -157,7 +242,7 @@ pub fn build(cfg: &PromptConfig, dir: &Path, scene_id: &str) -> Result<BuiltProm
                     path.display()
                 ));
             }
-            let jpeg = encode_frame(&path, cfg.images.max_side, cfg.images.jpeg_quality)?;
+            let jpeg = encode_frame(&path, cfg.images.max_side, cfg.images.jpeg_quality, sub)?;
             let label = cfg
                 .text
                 .frame_label
@@ -250,6 +335,14 @@ mod tests {
             .collect()
     }
 
+    /// [`test_frame`] as `frame.png` in a new temporary directory.
+    fn test_frame_in_tempdir() -> (tempfile::TempDir, std::path::PathBuf) {
+        let d = tempfile::tempdir().unwrap();
+        let f = d.path().join("frame.png");
+        test_frame(&f);
+        (d, f)
+    }
+
     /// A 1280×720 frame with edges, gradients and flat areas, written as the pipeline
     /// writes frames (RGB, fast deflate, Sub filter).
     fn test_frame(path: &Path) {
@@ -277,55 +370,129 @@ mod tests {
         std::fs::write(path, bytes).unwrap();
     }
 
+    const SUB: turbojpeg::Subsamp = turbojpeg::Subsamp::Sub2x2;
+
+    /// Set in the child process of `jpeg_bytes_do_not_depend_on_simd`: the frame to
+    /// encode and the file to write its JPEG bytes to.
+    const CHILD_ENV: &str = "RH_TEST_ENCODE_CHILD";
+
+    /// Runs only as the child of `jpeg_bytes_do_not_depend_on_simd` (libjpeg-turbo reads
+    /// `JSIMD_FORCE*` once per thread, so another SIMD path needs another process).
+    #[test]
+    #[ignore]
+    fn encode_child() {
+        let Ok(arg) = std::env::var(CHILD_ENV) else {
+            return;
+        };
+        let (frame, out) = arg.split_once('\n').unwrap();
+        let jpeg = encode_frame(Path::new(frame), 768, 85, SUB).unwrap();
+        std::fs::write(out, jpeg).unwrap();
+    }
+
     /// The JPEG bytes of a frame are pinned: they must not depend on the machine (CPU
-    /// features: the scaler's SIMD paths are exact, the JPEG encoder's AVX2 path is off),
-    /// the thread or the run, or `prompt_hash` and every cache key would.
+    /// features), the thread or the run, or `prompt_hash` and every cache key would.
     #[test]
     fn frame_bytes_are_pinned_and_thread_independent() {
-        let d = tempfile::tempdir().unwrap();
-        let f = d.path().join("frame.png");
-        test_frame(&f);
-        let jpeg = encode_frame(&f, 768, 85).unwrap();
+        let (_d, f) = test_frame_in_tempdir();
+        let jpeg = encode_frame(&f, 768, 85, SUB).unwrap();
         let back = image::load_from_memory(&jpeg).unwrap();
         assert_eq!((back.width(), back.height()), (768, 432));
         assert_eq!(
             sha256_hex(&jpeg),
-            "f53749249d89181173ce06585509ac72129015222f05a3066286c540596a3de3",
+            "1d1464c2357283ebefd1ee065bc71d26269bee8997e300c8029f14987c480fde",
             "the frame encoder's bytes changed: bump the prompt version in configs/prompt.toml"
         );
         let others: Vec<Vec<u8>> = std::thread::scope(|s| {
             let hs: Vec<_> = (0..4)
-                .map(|_| s.spawn(|| encode_frame(&f, 768, 85).unwrap()))
+                .map(|_| s.spawn(|| encode_frame(&f, 768, 85, SUB).unwrap()))
                 .collect();
             hs.into_iter().map(|h| h.join().unwrap()).collect()
         });
         assert!(others.iter().all(|o| *o == jpeg));
-        // The scaler's SIMD path (this CPU's best) gives the scalar path's bytes.
+        // 4:4:4 is another encoding of the same frame.
+        let full = encode_frame(&f, 768, 85, turbojpeg::Subsamp::None).unwrap();
+        assert_ne!(full, jpeg);
+        assert_eq!(image::load_from_memory(&full).unwrap().width(), 768);
+    }
+
+    /// libjpeg-turbo's SIMD paths (AVX2 and SSE2 on x86-64) write the bytes of its plain C
+    /// path: the same frame encoded in child processes with `JSIMD_FORCENONE=1` (C only),
+    /// `JSIMD_FORCESSE2=1`, `JSIMD_FORCEAVX2=1` and `JSIMD_NOHUFFENC=1` (C Huffman coder)
+    /// gives this process's bytes (its best SIMD).
+    #[test]
+    fn jpeg_bytes_do_not_depend_on_simd() {
+        let (d, f) = test_frame_in_tempdir();
+        let here = encode_frame(&f, 768, 85, SUB).unwrap();
+        for (i, force) in [
+            "JSIMD_FORCENONE",
+            "JSIMD_FORCESSE2",
+            "JSIMD_FORCEAVX2",
+            "JSIMD_NOHUFFENC",
+        ]
+        .iter()
+        .enumerate()
+        {
+            let out = d.path().join(format!("child{i}.jpg"));
+            let st = std::process::Command::new(std::env::current_exe().unwrap())
+                .args([
+                    "--exact",
+                    "predict::prompt::tests::encode_child",
+                    "--ignored",
+                ])
+                .env(CHILD_ENV, format!("{}\n{}", f.display(), out.display()))
+                .env(force, "1")
+                .stdout(std::process::Stdio::null())
+                .status()
+                .unwrap();
+            assert!(st.success(), "child with {force}=1 failed");
+            let child = std::fs::read(&out).unwrap();
+            assert!(child == here, "{force}=1 gives other JPEG bytes");
+        }
+    }
+
+    /// The scaler gives the same bytes on every CPU extension this machine has (plain
+    /// Rust, SSE4.1, AVX2 on x86-64), so its default (the best one) is safe.
+    #[test]
+    fn scaling_does_not_depend_on_simd() {
+        use fast_image_resize as fr;
+        let (_d, f) = test_frame_in_tempdir();
         let mut sc = Scratch::default();
         let (w, h) = decode_png(&f, &mut sc).unwrap();
         let size = scale_down(&mut sc, (w, h), 768).unwrap();
-        use fast_image_resize as fr;
         let src = fr::images::ImageRef::new(w, h, &sc.rgb, fr::PixelType::U8x3).unwrap();
-        let mut scalar = fr::images::Image::new(size.0, size.1, fr::PixelType::U8x3);
-        let mut rs = fr::Resizer::new();
-        // SAFETY: `None` (plain Rust) is supported on every CPU.
-        unsafe { rs.set_cpu_extensions(fr::CpuExtensions::None) };
         let opts = fr::ResizeOptions::new()
             .resize_alg(fr::ResizeAlg::Convolution(fr::FilterType::Bilinear));
-        rs.resize(&src, &mut scalar, &opts).unwrap();
-        assert!(scalar.buffer() == &sc.scaled[..]);
-        // Grey and RGBA PNGs are read too (as RGB), and small frames are not upscaled.
+        let mut exts = vec![fr::CpuExtensions::None];
+        #[cfg(target_arch = "x86_64")]
+        exts.extend([fr::CpuExtensions::Sse4_1, fr::CpuExtensions::Avx2]);
+        #[cfg(target_arch = "aarch64")]
+        exts.push(fr::CpuExtensions::Neon);
+        for ext in exts.into_iter().filter(|e| e.is_supported()) {
+            let mut out = fr::images::Image::new(size.0, size.1, fr::PixelType::U8x3);
+            let mut rs = fr::Resizer::new();
+            // SAFETY: only extensions this CPU supports.
+            unsafe { rs.set_cpu_extensions(ext) };
+            rs.resize(&src, &mut out, &opts).unwrap();
+            assert!(out.buffer() == &sc.scaled[..], "{ext:?} scales differently");
+        }
+    }
+
+    /// Grey and RGBA PNGs are read too (as RGB), small frames are not upscaled, and a
+    /// file that is not a PNG is an error naming it.
+    #[test]
+    fn other_png_kinds_and_bad_files() {
+        let d = tempfile::tempdir().unwrap();
         let g = d.path().join("grey.png");
         image::GrayImage::from_pixel(300, 200, image::Luma([90]))
             .save(&g)
             .unwrap();
-        let back = image::load_from_memory(&encode_frame(&g, 768, 85).unwrap()).unwrap();
+        let back = image::load_from_memory(&encode_frame(&g, 768, 85, SUB).unwrap()).unwrap();
         assert_eq!((back.width(), back.height()), (300, 200));
         let a = d.path().join("rgba.png");
         image::RgbaImage::from_pixel(1000, 400, image::Rgba([10, 200, 30, 128]))
             .save(&a)
             .unwrap();
-        let back = image::load_from_memory(&encode_frame(&a, 500, 85).unwrap())
+        let back = image::load_from_memory(&encode_frame(&a, 500, 85, SUB).unwrap())
             .unwrap()
             .to_rgb8();
         assert_eq!(back.dimensions(), (500, 200));
@@ -333,8 +500,10 @@ mod tests {
         assert!(p[1] > 180 && p[0] < 40 && p[2] < 60, "{p:?}");
         let bad = d.path().join("bad.png");
         std::fs::write(&bad, b"not a png").unwrap();
-        assert!(encode_frame(&bad, 768, 85)
-            .unwrap_err()
-            .contains("cannot read frame"));
+        let err = encode_frame(&bad, 768, 85, SUB).unwrap_err();
+        assert!(
+            err.contains("cannot read frame") && err.contains("bad.png"),
+            "{err}"
+        );
     }
 }
