@@ -23,11 +23,10 @@
 
 use crate::baseline::solve_walk;
 use crate::config::Config;
-use crate::dataset::{read_replay_keys, Dataset, Scene};
+use crate::dataset::{open_parquet, parquet_files, read_replay_keys, Dataset, Scene};
 use crate::types::Action;
 use anyhow::Result;
 use arrow::array::{Array, FixedSizeListArray, Float32Array, Float64Array, ListArray};
-use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
 
@@ -198,18 +197,11 @@ pub fn oracle_plan(scene: &Scene, hints: Option<&OracleHints>, cfg: &Config) -> 
 pub fn load_hints(ds: &Dataset) -> Result<BTreeMap<String, OracleHints>> {
     let deltas = decision_times(ds);
     let mut out = BTreeMap::new();
-    let mut files: Vec<_> = match std::fs::read_dir(ds.dir.join("data")) {
-        Ok(rd) => rd
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
-            .collect(),
-        Err(_) => return Ok(out),
+    let Ok(files) = parquet_files(&ds.dir.join("data")) else {
+        return Ok(out);
     };
-    files.sort();
     for file in files {
-        let reader = ParquetRecordBatchReaderBuilder::try_new(std::fs::File::open(&file)?)?
-            .with_batch_size(8192)
-            .build()?;
+        let reader = open_parquet(&file, 8192)?;
         for batch in reader {
             let batch = batch?;
             let (Some(ids), Some(tti), Some(traj)) = (
