@@ -134,6 +134,52 @@ fn recording_the_steps_leaves_outcome_and_hash_unchanged() {
     }
 }
 
+/// A constructed scene: the observer at the origin facing +x, and one ball of `mass` kg
+/// (radius 0.04 m) at `(x, y, z)` moving straight down at `vz` m/s at the decision
+/// moment (Δ = 0), nothing else but the floor.
+fn ball_scene(mass: f64, at: [f64; 3], vz: f64) -> rh_pipeline::spec::SceneSpec {
+    use rh_pipeline::spec::{PartSpec, ShapeSpec};
+    let mut spec = scenes("thrown_object", 0).remove(0).spec;
+    let mut ball = spec.hazard_body().clone();
+    ball.parts = vec![PartSpec {
+        shape: ShapeSpec::Sphere { radius: 0.04 },
+        offset: [0.0; 3],
+        rotation: [0.0, 0.0, 0.0, 1.0],
+    }];
+    ball.position = at;
+    ball.rotation = [0.0, 0.0, 0.0, 1.0];
+    ball.mass = mass;
+    ball.restitution = 0.3;
+    ball.friction = 0.8;
+    ball.linvel = [0.0, 0.0, vz];
+    ball.angvel = [0.0; 3];
+    ball.ccd = true;
+    spec.bodies = vec![ball];
+    spec.joints.clear();
+    spec.hazard = 0;
+    spec.source_support = None;
+    spec.observation_window_s = 0.0;
+    spec.observer.x = 0.0;
+    spec.observer.y = 0.0;
+    spec.observer.yaw = 0.0;
+    spec
+}
+
+/// Both palms side by side 0.40 m ahead and 0.10 m above the pelvis from t = 0.2 s on
+/// (palm tops at z = pelvis + 0.115), no walking.
+fn cupped_hands() -> ExecPlan {
+    ExecPlan {
+        walking_cmd: [0.0; 3],
+        walking_duration: 0.0,
+        keyframes: vec![ExecKeyframe {
+            t: 0.2,
+            left: [0.40, 0.06, 0.10],
+            right: [0.40, -0.06, 0.10],
+            knee_bend: 0.0,
+        }],
+    }
+}
+
 #[test]
 fn a_slab_flung_at_the_resting_forearm_strikes_label_and_freeze_alike() {
     // A 1.5 kg slab flies sideways (no gravity) at 3 m/s into the left forearm of the
@@ -185,4 +231,61 @@ fn a_slab_flung_at_the_resting_forearm_strikes_label_and_freeze_alike() {
     assert_eq!(st.part, "left_forearm");
     let dt_hit = t_hit - spec.observation_window_s;
     assert!((st.t - dt_hit).abs() < 0.02, "{st:?}");
+}
+
+#[test]
+fn grasp_catches_a_gentle_drop_and_refuses_a_fast_or_heavy_one() {
+    let cfg = ExecConfig::embedded_default();
+    let g = 9.81;
+    let palm_top = |spec: &rh_pipeline::spec::SceneSpec| spec.observer.pelvis_z + 0.10 + 0.015;
+    // Dropped from rest 0.5 m above the palms: it lands at sqrt(2h/g) = 0.319 s with
+    // sqrt(2gh) = 3.1 m/s (< grasp_speed_max), the hand closes, and it is caught.
+    let h = 0.5;
+    let probe = ball_scene(0.2, [0.0; 3], 0.0);
+    let z0 = palm_top(&probe) + 0.04 + h;
+    let spec = ball_scene(0.2, [0.40, 0.0, z0], 0.0);
+    let out = replay(&spec).execute(&cupped_hands(), &cfg);
+    assert_eq!(out.outcome, OutcomeKind::Caught, "{out:?}");
+    let t_land = (2.0 * h / g).sqrt();
+    let t = out.first_contact_t.unwrap();
+    assert!(
+        (t - t_land).abs() < 0.02,
+        "contact at {t}, closed form {t_land}"
+    );
+    assert!(out.floor_t.is_none(), "{out:?}");
+    // The same plan standing with the hands at rest does not grasp: it is no catch.
+    let rest = ExecPlan {
+        keyframes: vec![],
+        ..cupped_hands()
+    };
+    let out = replay(&spec).execute(&rest, &cfg);
+    assert_ne!(out.outcome, OutcomeKind::Caught, "{out:?}");
+    // Arriving at 3x grasp_speed_max (contact at about 0.3 s, the hands in place): the
+    // hand does not close and the blow (0.3 kg x 22.5 m/s) is a strike on the hands.
+    let v = 3.0 * cfg.grasp_speed_max;
+    let (t_hit, v0) = (0.3, v - g * 0.3);
+    let drop = v0 * t_hit + 0.5 * g * t_hit * t_hit;
+    let spec = ball_scene(0.3, [0.40, 0.0, palm_top(&probe) + 0.04 + drop], -v0);
+    let out = replay(&spec).execute(&cupped_hands(), &cfg);
+    assert_ne!(out.outcome, OutcomeKind::Caught, "{out:?}");
+    assert_eq!(out.outcome, OutcomeKind::Struck, "{out:?}");
+    // Too heavy (4 kg > grasp_mass_max), gently dropped: never caught.
+    let spec = ball_scene(4.0, [0.40, 0.0, z0], 0.0);
+    let out = replay(&spec).execute(&cupped_hands(), &cfg);
+    assert_ne!(out.outcome, OutcomeKind::Caught, "{out:?}");
+}
+
+#[test]
+fn a_ball_that_misses_the_hands_reaches_the_floor_and_is_missed() {
+    let cfg = ExecConfig::embedded_default();
+    // 0.25 m in front of the palms' centres (0.15 m between their edges and the ball's):
+    // the plan reached out and a palm came within attempt_radius, the ball hits the floor.
+    let spec = ball_scene(0.2, [0.65, 0.0, 1.5], 0.0);
+    let out = replay(&spec).execute(&cupped_hands(), &cfg);
+    assert_eq!(out.outcome, OutcomeKind::Missed, "{out:?}");
+    assert!(
+        out.first_contact_t.is_none() && out.floor_t.is_some(),
+        "{out:?}"
+    );
+    assert!(out.min_hand_distance <= cfg.attempt_radius, "{out:?}");
 }

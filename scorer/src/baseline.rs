@@ -1,11 +1,9 @@
 //! Reference baselines (`rh-score baseline KIND`): predictions written as `preds.jsonl`.
 //!
 //! * `oracle` — on every scene a plan the action rule classifies as the ground-truth
-//!   action; on CATCH scenes the final hands land exactly on the impact point. The base
-//!   walks (constant twist, ≤ 1.2 m/s) to a stance with the impact point 0.40 m straight
-//!   ahead of the pelvis at the end of the walk; when standing behind the impact point
-//!   would mean backing away from it (an impact point very close to the observer), the
-//!   base walks past it and turns to face it instead, so the rule never reads a retreat.
+//!   action, timed and placed so that the humanoid can carry it out in physics: see
+//!   [`crate::oracle`] (CATCH: hands on the impact point before the object arrives;
+//!   DODGE: out of the hazard's path).
 //! * `always-catch` — arms forward (0.45 m), no walking. `always-dodge` — walk 0.8 m
 //!   straight away from the hazard, hands at rest. `freeze` — no walking, hands at rest.
 //! * `majority` — the dataset's most frequent ground-truth action (ties: DODGE, NO_ACTION,
@@ -15,6 +13,7 @@
 
 use crate::config::Config;
 use crate::dataset::{Dataset, Scene};
+use crate::oracle::{oracle_plan, OracleHints};
 use crate::types::Action;
 use anyhow::Result;
 use rand::{RngExt, SeedableRng};
@@ -45,11 +44,6 @@ impl BaselineKind {
         }
     }
 }
-
-/// Oracle stance: hands this far ahead of the pelvis at the end of the walk (m).
-const ORACLE_STANDOFF: f64 = 0.40;
-/// Oracle walking speed cap (m/s), below the robot's 1.5 m/s.
-const ORACLE_MAX_SPEED: f64 = 1.2;
 
 fn kf(t: f64, left: [f64; 3], right: [f64; 3]) -> Value {
     json!({"t": t, "left_hand": left, "right_hand": right, "knee_bend": 0.0})
@@ -114,7 +108,7 @@ pub fn freeze_template(cfg: &Config) -> Value {
     )
 }
 
-fn wrap_angle(a: f64) -> f64 {
+pub(crate) fn wrap_angle(a: f64) -> f64 {
     let mut a = (a + PI).rem_euclid(2.0 * PI) - PI;
     if a <= -PI {
         a += 2.0 * PI;
@@ -141,51 +135,25 @@ pub fn solve_walk(start: [f64; 3], goal: [f64; 2], yaw1: f64, dur: f64) -> [f64;
     [(a * dx - b * dy) / det, (b * dx + a * dy) / det, w]
 }
 
-/// The oracle's plan for a CATCH scene: final mean hand exactly at the impact point.
-pub fn oracle_catch(scene: &Scene, cfg: &Config) -> Value {
-    let [x0, y0, th0] = scene.observer_pose;
-    let p = scene.hazard_point();
-    let (rx, ry) = (p[0] - x0, p[1] - y0);
-    let d = rx.hypot(ry);
-    let a = ORACLE_STANDOFF;
-    let margin = 0.05;
-    // Option A: keep the heading, stand `a` behind the point along the forward axis.
-    let (s0, c0) = th0.sin_cos();
-    let goal_a = [p[0] - a * c0, p[1] - a * s0];
-    let d_dot_u = if d > 1e-9 {
-        ((goal_a[0] - x0) * rx + (goal_a[1] - y0) * ry) / d
-    } else {
-        0.0
-    };
-    let (goal, yaw1) = if d_dot_u > -cfg.action_rule.retreat_threshold + margin {
-        (goal_a, th0)
-    } else {
-        // Option B: walk past the point (away from the observer) and turn to face it.
-        let u = [rx / d, ry / d];
-        ([p[0] + a * u[0], p[1] + a * u[1]], (-u[1]).atan2(-u[0]))
-    };
-    let dth = wrap_angle(yaw1 - th0);
-    // Speed for a 1 s walk, then stretch the duration to respect the speed cap.
-    let v1 = solve_walk(scene.observer_pose, goal, th0 + dth, 1.0);
-    let speed1 = v1[0].hypot(v1[1]);
-    let dur = (speed1 / ORACLE_MAX_SPEED).max(1.0);
-    let cmd = solve_walk(scene.observer_pose, goal, th0 + dth, dur);
-    let zb = p[2] - cfg.body.pelvis_height;
-    plan(
-        "Step toward the object, reach out and catch it with both hands.",
-        cmd,
-        dur,
-        vec![rest_kf(0.0, cfg), kf(dur, [a, 0.05, zb], [a, -0.05, zb])],
-    )
-}
-
-/// The plan a baseline writes for one scene.
+/// The plan a baseline writes for one scene (the oracle without its optional hints).
 pub fn baseline_plan(
     kind: BaselineKind,
     scene: &Scene,
     majority: Action,
     seed: u64,
     cfg: &Config,
+) -> Value {
+    baseline_plan_with(kind, scene, majority, seed, cfg, None)
+}
+
+/// [`baseline_plan`] with the oracle's hints (the hazard's motion) when there are any.
+pub fn baseline_plan_with(
+    kind: BaselineKind,
+    scene: &Scene,
+    majority: Action,
+    seed: u64,
+    cfg: &Config,
+    hints: Option<&OracleHints>,
 ) -> Value {
     let template = |a: Action| match a {
         Action::Catch => catch_template(),
@@ -197,10 +165,7 @@ pub fn baseline_plan(
         BaselineKind::AlwaysDodge => template(Action::Dodge),
         BaselineKind::Freeze => template(Action::NoAction),
         BaselineKind::Majority => template(majority),
-        BaselineKind::Oracle => match scene.gt_action {
-            Action::Catch => oracle_catch(scene, cfg),
-            a => template(a),
-        },
+        BaselineKind::Oracle => oracle_plan(scene, hints, cfg),
         BaselineKind::Random => random_plan(scene, seed, cfg),
     }
 }
@@ -276,6 +241,11 @@ pub fn write_baseline(
     out: &mut dyn Write,
 ) -> Result<()> {
     let majority = majority_action(ds);
+    let hints = if kind == BaselineKind::Oracle {
+        crate::oracle::load_hints(ds)?
+    } else {
+        Default::default()
+    };
     #[derive(serde::Serialize)]
     struct Line<'a> {
         scene_id: &'a str,
@@ -286,7 +256,7 @@ pub fn write_baseline(
         let line = Line {
             scene_id: &scene.scene_id,
             model,
-            plan: baseline_plan(kind, scene, majority, seed, cfg),
+            plan: baseline_plan_with(kind, scene, majority, seed, cfg, hints.get(&scene.scene_id)),
         };
         serde_json::to_writer(&mut *out, &line)?;
         out.write_all(b"\n")?;
@@ -319,12 +289,17 @@ mod tests {
             assert!(r.safe(), "{}", s.scene_id);
             assert_eq!(r.aia, 1.0, "{}", p.intent);
             if s.gt_action == Action::Catch {
+                // Exact, but for the knee bend's pelvis drop that rule v1 leaves out.
+                let drop = 0.25 * p.keyframes.last().unwrap().knee_bend;
                 assert!(
-                    r.d_end.unwrap() < 1e-6,
+                    r.d_end.unwrap() < drop + 1e-6,
                     "{} d_end {:?}",
                     s.scene_id,
                     r.d_end
                 );
+                if s.hazard_point()[2] >= 0.70 {
+                    assert!(r.d_end.unwrap() < 1e-6, "{} {:?}", s.scene_id, r.d_end);
+                }
                 let speed = p.walking_cmd[0].hypot(p.walking_cmd[1]);
                 assert!(speed <= 1.5 + 1e-9, "speed {speed}");
             }
@@ -359,16 +334,17 @@ mod tests {
             ];
             let mut sc = crate::rule::tests::scene(pose, Some(p));
             sc.gt_action = Action::Catch;
-            let v = oracle_catch(&sc, &cfg);
+            let v = crate::oracle::catch(&sc, &cfg);
             let pl = plan_from_value(&v, &cfg).unwrap();
             let r = score_decision(Some(&pl), &sc, &cfg, &aia);
             assert_eq!(r.action, Some(Action::Catch), "yaw {yaw} rel {rel:?}");
+            let drop = 0.25 * pl.keyframes.last().unwrap().knee_bend;
             assert!(
-                r.d_end.unwrap() < 1e-6,
+                r.d_end.unwrap() < drop + 1e-6,
                 "yaw {yaw} rel {rel:?}: {:?}",
                 r.d_end
             );
-            assert!(pl.walking_cmd[0].hypot(pl.walking_cmd[1]) <= 1.2 + 1e-9);
+            assert!(pl.walking_cmd[0].hypot(pl.walking_cmd[1]) <= 1.5 + 1e-9);
         }
     }
 

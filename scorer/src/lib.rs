@@ -40,6 +40,7 @@ pub mod fixture;
 pub mod html;
 pub mod layout;
 pub mod metrics;
+pub mod oracle;
 pub mod plan;
 pub mod predict;
 pub mod preds;

@@ -16,6 +16,7 @@
 //! from the same bits, whatever the order, thread or process. Nothing here reads a clock
 //! or iterates a hash map.
 
+pub mod grasp;
 pub mod humanoid;
 pub mod motion;
 pub mod outcome;
@@ -31,7 +32,7 @@ pub use outcome::{Outcome, OutcomeKind, StrikeRecord};
 
 /// Version of the executor's code (humanoid, controller, outcome rule); part of the
 /// execution cache key together with the config's own `version`.
-pub const EXECUTOR_VERSION: &str = "exec-3";
+pub const EXECUTOR_VERSION: &str = "exec-4";
 
 /// One hand keyframe (body frame; `t` in seconds after the decision moment).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -131,6 +132,9 @@ pub struct ExecConfig {
     pub reaching_offset: f64,
     pub hold_time_s: f64,
     pub hold_speed_max: f64,
+    pub grasp_speed_max: f64,
+    pub grasp_mass_max: f64,
+    pub grasp_momentum_max: f64,
     pub attempt_reach: f64,
     pub attempt_radius: f64,
     pub floor_contact_eps: f64,
@@ -178,6 +182,9 @@ impl ExecConfig {
             ("hand_strike_impulse", self.hand_strike_impulse),
             ("reaching_offset", self.reaching_offset),
             ("hold_speed_max", self.hold_speed_max),
+            ("grasp_speed_max", self.grasp_speed_max),
+            ("grasp_mass_max", self.grasp_mass_max),
+            ("grasp_momentum_max", self.grasp_momentum_max),
             ("attempt_reach", self.attempt_reach),
             ("attempt_radius", self.attempt_radius),
             ("floor_contact_eps", self.floor_contact_eps),

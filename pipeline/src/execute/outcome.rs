@@ -11,10 +11,13 @@
 //!   [`Motion::reaching`]) the hands and forearms are catching, not part of that test:
 //!   they count as struck only under a blow of `hand_strike_impulse` or more within the
 //!   window (a slamming door, not a caught ball). With the palms at rest they are body
-//!   parts like the label's.
-//! * `caught` — not struck, and the hazard was held: touching the hands/forearms, not the
-//!   floor, moving with the touching link (relative speed ≤ `hold_speed_max`) for
-//!   `hold_time_s` without a break, before it ever touched the floor after Δ.
+//!   parts like the label's. Once a hand has closed on the hazard ([`super::grasp`]) its
+//!   contacts with the hands stop counting.
+//! * `caught` — not struck, and the hazard was held: touching the hands/forearms (or
+//!   grasped by a closed hand, see [`super::grasp`]), not the floor, moving with the
+//!   touching link (relative speed ≤ `hold_speed_max`) for `hold_time_s` without a break,
+//!   before it ever touched the floor after Δ. A hazard heavier than `grasp_mass_max` is
+//!   never caught (the arms cannot hold it, even balanced on flat palms).
 //! * `missed` — neither, but a catch was attempted: the hands/forearms touched the hazard,
 //!   or the plan reached out (forward extension ≥ `attempt_reach`) and a hand came within
 //!   `attempt_radius` of it.
@@ -25,6 +28,7 @@
 //! away from the body after the plan's last motion, or at `horizon_s` (at most the scene's
 //! own horizon, `physics.max_steps`, where the label's counterfactual stops too).
 
+use super::grasp::{self, GraspState};
 use super::humanoid::{Geometry, LinkShape, Part};
 use super::motion::Motion;
 use super::{ExecConfig, ExecFrame, ExecPlan};
@@ -148,6 +152,7 @@ struct Monitor {
     caught: bool,
     hand_touched: bool,
     min_hand_distance: f64,
+    grasp: GraspState,
 }
 
 /// Runs `plan` in `sw` (the world at Δ) and classifies the outcome. With `record`, every
@@ -212,7 +217,9 @@ pub(super) fn run(
         caught: false,
         hand_touched: false,
         min_hand_distance: f64::INFINITY,
+        grasp: GraspState::Open,
     };
+    let attempting = plan.reach() >= cfg.attempt_reach;
     let mut hasher = Sha256::new();
     let mut executed = 0;
     if let Some(r) = record.as_deref_mut() {
@@ -251,6 +258,18 @@ pub(super) fn run(
             window_steps,
             hold_steps,
             started_on_floor,
+        );
+        grasp::update(
+            &mut m.grasp,
+            &mut sw,
+            &links,
+            hazard_c,
+            hazard_b,
+            v_before,
+            attempting,
+            m.floor_step.is_some(),
+            executed,
+            cfg,
         );
         if m.strike.is_some() || m.caught {
             break;
@@ -365,6 +384,10 @@ fn observe(
     {
         m.floor_step = Some(step);
     }
+    if let Some(g) = m.grasp.held() {
+        touching_hands = true;
+        hold_speed = hold_speed.min(grasp::held_speed(sw, links, g, hazard_b));
+    }
     m.strikes.step(step, body_touch, &impulses);
     if let Some(w) = m.strikes.strike() {
         // The test passed: stop here (the verdict cannot change within the window).
@@ -375,11 +398,17 @@ fn observe(
             t: w.start as f64,
         });
     }
-    if m.strike.is_none() {
+    // A closed hand holds the hazard: its weight and the grip are no blow (the blow of
+    // the catch itself, at the touch before the hand closed, is counted).
+    if m.strike.is_none() && m.grasp.held().is_none() {
         follow_hand_strike(m, touching_hands, &hand_impulses, step, window_steps, cfg);
     }
-    let holding =
-        touching_hands && !on_floor && hold_speed <= cfg.hold_speed_max && m.floor_step.is_none();
+    let liftable = world.bodies[hazard_b].mass() as f64 <= cfg.grasp_mass_max;
+    let holding = touching_hands
+        && liftable
+        && !on_floor
+        && hold_speed <= cfg.hold_speed_max
+        && m.floor_step.is_none();
     m.held_steps = if holding { m.held_steps + 1 } else { 0 };
     if m.held_steps >= hold_steps && m.strike.is_none() {
         m.caught = true;
