@@ -9,9 +9,9 @@
 //!   final keyframe, at the end of the walk (≥ 0.2 s, the hands' travel), puts the mean
 //!   hand exactly on the impact point. Impact points too low for the standing arm (below
 //!   ≈ 0.66 m) are met with a knee bend (the least that brings the point within reach,
-//!   ≤ 1), the hands raised in the body frame by the pelvis drop so that in physics they
-//!   are at the point; action rule v1 ignores the knee bend (hands at `pelvis_height +
-//!   z`), so there d_end is the pelvis drop (≤ 0.25 m), elsewhere < 1e-6 m. When the
+//!   ≤ 1); the hands stay where action rule v1 puts the point (hands at `pelvis_height +
+//!   z`, the knee bend ignored), so d_end is < 1e-6 m everywhere and in physics the
+//!   crouched hands are under the point by the pelvis drop (≤ 0.25 m). When the
 //!   point is closer than the stance (walking there would be a retreat) the base stays
 //!   and only the hands go. A first keyframe at 0.15 s reaches ≥ 0.30 m forward whenever
 //!   the final one does not, so the rule's reach test (≥ 0.20 m) holds.
@@ -122,10 +122,14 @@ pub fn catch(scene: &Scene, cfg: &Config) -> Value {
         cmd = solve_walk(scene.observer_pose, goal, th0 + dth, dur);
     }
     let knee = drop / MAX_DROP;
+    // The hands at the point as action rule v1 reads them (`pelvis_height + z`, knee bend
+    // ignored), so the oracle's d_end is exactly 0; in physics the bend lowers them with
+    // the pelvis, under the point by the drop.
+    let z_rule = p[2] - pelvis;
     let at = |x: f64| {
         (
-            [x, hand[1] + HAND_HALF_GAP, zb],
-            [x, hand[1] - HAND_HALF_GAP, zb],
+            [x, hand[1] + HAND_HALF_GAP, z_rule],
+            [x, hand[1] - HAND_HALF_GAP, z_rule],
         )
     };
     let mut keyframes = Vec::new();
