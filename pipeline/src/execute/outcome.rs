@@ -155,6 +155,32 @@ struct Monitor {
     grasp: GraspState,
 }
 
+impl Monitor {
+    /// Nothing seen yet; the strike test with `[execution]`'s numbers at step `dt`.
+    fn new(cfg: &ExecConfig, dt: f64) -> Monitor {
+        let rule = StrikeRule::new(
+            cfg.strike_speed_min,
+            cfg.strike_impulse_min,
+            cfg.strike_impulse_heavy,
+            cfg.strike_window_s,
+            dt,
+        );
+        Monitor {
+            first_contact: None,
+            strikes: StrikeMonitor::new(rule, Part::ALL.len()),
+            hand_window: None,
+            reaching: false,
+            strike: None,
+            floor_step: None,
+            held_steps: 0,
+            caught: false,
+            hand_touched: false,
+            min_hand_distance: f64::INFINITY,
+            grasp: GraspState::Open,
+        }
+    }
+}
+
 /// Runs `plan` in `sw` (the world at Δ) and classifies the outcome. With `record`, every
 /// step's state is pushed onto it as well (a side output: it only reads the world).
 pub(super) fn run(
@@ -199,26 +225,7 @@ pub(super) fn run(
         .map(|k| k.t)
         .fold(plan.walking_duration, f64::max);
     let started_on_floor = lowest_z(&sw.world.colliders[hazard_c]) <= cfg.floor_contact_eps;
-    let rule = StrikeRule::new(
-        cfg.strike_speed_min,
-        cfg.strike_impulse_min,
-        cfg.strike_impulse_heavy,
-        cfg.strike_window_s,
-        dt,
-    );
-    let mut m = Monitor {
-        first_contact: None,
-        strikes: StrikeMonitor::new(rule, Part::ALL.len()),
-        hand_window: None,
-        reaching: false,
-        strike: None,
-        floor_step: None,
-        held_steps: 0,
-        caught: false,
-        hand_touched: false,
-        min_hand_distance: f64::INFINITY,
-        grasp: GraspState::Open,
-    };
+    let mut m = Monitor::new(cfg, dt);
     let attempting = plan.reach() >= cfg.attempt_reach;
     let mut hasher = Sha256::new();
     let mut executed = 0;
