@@ -488,15 +488,7 @@ pub fn observer_links(o: &ObserverSpec) -> Vec<(Pose, SharedShape)> {
         .map(|(p, shape)| {
             let q = p.rotation;
             let pose = Pose::from_parts(v3(p.position), rot(q));
-            let shape = match shape {
-                LinkShape::Box(h) => SharedShape::cuboid(h[0] as Real, h[1] as Real, h[2] as Real),
-                LinkShape::Capsule {
-                    half_height,
-                    radius,
-                } => SharedShape::capsule_z(half_height as Real, radius as Real),
-                LinkShape::Sphere(r) => SharedShape::ball(r as Real),
-            };
-            (pose, shape)
+            (pose, link_shape(shape))
         })
         .collect()
 }
@@ -668,6 +660,39 @@ pub(crate) fn contact_impulse(world: &PhysicsWorld, a: ColliderHandle, b: Collid
         .map_or(0.0, |pair| pair.total_impulse_magnitude() as f64)
 }
 
+/// The collision shape of one of the humanoid's links (the label's standing body and the
+/// executor's moving one alike).
+pub fn link_shape(shape: LinkShape) -> SharedShape {
+    match shape {
+        LinkShape::Box(h) => SharedShape::cuboid(h[0] as Real, h[1] as Real, h[2] as Real),
+        LinkShape::Capsule {
+            half_height,
+            radius,
+        } => SharedShape::capsule_z(half_height as Real, radius as Real),
+        LinkShape::Sphere(r) => SharedShape::ball(r as Real),
+    }
+}
+
+/// The contact pairs of collider `c` with an active contact this step, each with the
+/// other collider.
+pub fn active_contacts(
+    world: &PhysicsWorld,
+    c: ColliderHandle,
+) -> impl Iterator<Item = (&ContactPair, ColliderHandle)> {
+    world
+        .narrow_phase
+        .contact_pairs_with(c)
+        .filter(|pair| pair.has_any_active_contact())
+        .map(move |pair| {
+            let other = if pair.collider1 == c {
+                pair.collider2
+            } else {
+                pair.collider1
+            };
+            (pair, other)
+        })
+}
+
 /// The hazard's active contacts this step, as `TOUCH_*` flags.
 fn hazard_contact_flags(
     world: &PhysicsWorld,
@@ -677,15 +702,7 @@ fn hazard_contact_flags(
     observer: &[ColliderHandle],
 ) -> u8 {
     let mut flags = 0u8;
-    for pair in world.narrow_phase.contact_pairs_with(hazard_collider) {
-        if !pair.has_any_active_contact() {
-            continue;
-        }
-        let other = if pair.collider1 == hazard_collider {
-            pair.collider2
-        } else {
-            pair.collider1
-        };
+    for (_, other) in active_contacts(world, hazard_collider) {
         flags |= if other == floor {
             TOUCH_FLOOR
         } else if Some(other) == source_collider {

@@ -66,7 +66,8 @@ fn hazard_dir_body(scene: &Scene) -> [f64; 2] {
     [(c * dx + s * dy) / n, (-s * dx + c * dy) / n]
 }
 
-fn plan(intent: &str, cmd: [f64; 3], dur: f64, keyframes: Vec<Value>) -> Value {
+/// A plan in the SPEC §9 schema (confidence 1).
+pub(crate) fn plan(intent: &str, cmd: [f64; 3], dur: f64, keyframes: Vec<Value>) -> Value {
     json!({
         "intent": intent,
         "confidence": 1.0,

@@ -21,7 +21,7 @@
 //!   from the dataset's `trajectory` column, when the dataset has it: [`OracleHints`]).
 //! * **NO_ACTION** — stand still, hands at rest.
 
-use crate::baseline::solve_walk;
+use crate::baseline::{plan, solve_walk};
 use crate::config::Config;
 use crate::dataset::{open_parquet, parquet_files, read_replay_keys, Dataset, Scene};
 use crate::types::Action;
@@ -60,16 +60,6 @@ pub struct OracleHints {
 
 fn kf(t: f64, left: [f64; 3], right: [f64; 3], knee: f64) -> Value {
     json!({"t": t, "left_hand": left, "right_hand": right, "knee_bend": knee})
-}
-
-fn plan(intent: &str, cmd: [f64; 3], dur: f64, keyframes: Vec<Value>) -> Value {
-    json!({
-        "intent": intent,
-        "confidence": 1.0,
-        "walking_cmd": cmd,
-        "walking_duration": dur,
-        "keyframes": keyframes,
-    })
 }
 
 /// Largest forward distance of the mean hand at body height `zb` above the pelvis that

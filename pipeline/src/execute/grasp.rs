@@ -90,15 +90,7 @@ fn palm_touch(
     let world = &sw.world;
     let hazard = &world.bodies[hazard_b];
     let mut best: Option<Touch> = None;
-    for pair in world.narrow_phase.contact_pairs_with(hazard_c) {
-        if !pair.has_any_active_contact() {
-            continue;
-        }
-        let other = if pair.collider1 == hazard_c {
-            pair.collider2
-        } else {
-            pair.collider1
-        };
+    for (_, other) in crate::simulate::active_contacts(world, hazard_c) {
         let Some(i) = links.iter().position(|(_, c)| *c == other) else {
             continue;
         };

@@ -119,18 +119,11 @@ fn pose_of(p: &super::humanoid::LinkPose) -> Pose {
 }
 
 fn collider(shape: LinkShape, cfg: &ExecConfig) -> ColliderBuilder {
-    match shape {
-        LinkShape::Box(h) => ColliderBuilder::cuboid(h[0] as Real, h[1] as Real, h[2] as Real),
-        LinkShape::Capsule {
-            half_height,
-            radius,
-        } => ColliderBuilder::capsule_z(half_height as Real, radius as Real),
-        LinkShape::Sphere(r) => ColliderBuilder::ball(r as Real),
-    }
-    .friction(cfg.link_friction as Real)
-    .restitution(cfg.link_restitution as Real)
-    .friction_combine_rule(CoefficientCombineRule::Average)
-    .restitution_combine_rule(CoefficientCombineRule::Average)
+    ColliderBuilder::new(crate::simulate::link_shape(shape))
+        .friction(cfg.link_friction as Real)
+        .restitution(cfg.link_restitution as Real)
+        .friction_combine_rule(CoefficientCombineRule::Average)
+        .restitution_combine_rule(CoefficientCombineRule::Average)
 }
 
 fn norm(v: Vector) -> f64 {
@@ -341,15 +334,7 @@ fn observe(
     let mut hold_speed = f64::INFINITY;
     let mut impulses = [0.0f64; 13];
     let mut hand_impulses = [0.0f64; 13];
-    for pair in world.narrow_phase.contact_pairs_with(hazard_c) {
-        if !pair.has_any_active_contact() {
-            continue;
-        }
-        let other = if pair.collider1 == hazard_c {
-            pair.collider2
-        } else {
-            pair.collider1
-        };
+    for (pair, other) in crate::simulate::active_contacts(world, hazard_c) {
         if other == sw.floor {
             on_floor = true;
             continue;
