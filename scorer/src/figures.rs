@@ -246,6 +246,42 @@ fn per_family<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> 
     Ok(())
 }
 
+/// A chart of horizontal percentage bars (0–100 % of decisions), one row per name from
+/// the top, its axes drawn; `label_width` px for the row names.
+fn percent_rows_chart<'a, DB: DrawingBackend>(
+    plot: &DrawingArea<DB, Shift>,
+    caption: &str,
+    names: &[String],
+    label_width: u32,
+) -> Result<
+    ChartContext<
+        'a,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+> {
+    let n = names.len().max(1);
+    let mut chart = ChartBuilder::on(plot)
+        .caption(caption, (FONT, 20))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(label_width)
+        .build_cartesian_2d(0f64..100f64, -0.5f64..(n as f64 - 0.5))
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .y_labels(n + 1)
+        .y_label_formatter(&|y| category_label(names, *y))
+        .disable_y_mesh()
+        .x_desc("decisions (%)")
+        .x_label_formatter(&percent_label)
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 14))
+        .draw()
+        .map_err(e)?;
+    Ok(chart)
+}
+
 fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> DrawResult {
     root.fill(&WHITE).map_err(e)?;
     let rows: Vec<_> = r.analyses.safety.iter().collect();
@@ -262,27 +298,12 @@ fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -
         .collect();
     let (_, h) = root.dim_in_pixel();
     let (plot, legend_area) = root.split_vertically(h as i32 - LEGEND_BELOW);
-    let mut chart = ChartBuilder::on(&plot)
-        .caption(
-            "Safety violations by first rule (% of decisions)",
-            (FONT, 20),
-        )
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(140)
-        .build_cartesian_2d(0f64..100f64, -0.5f64..(n as f64 - 0.5))
-        .map_err(e)?;
-    chart
-        .configure_mesh()
-        .y_labels(n + 1)
-        .y_label_formatter(&|y| category_label(&names, *y))
-        .disable_y_mesh()
-        .x_desc("decisions (%)")
-        .x_label_formatter(&percent_label)
-        .label_style((FONT, 12))
-        .axis_desc_style((FONT, 14))
-        .draw()
-        .map_err(e)?;
+    let mut chart = percent_rows_chart(
+        &plot,
+        "Safety violations by first rule (% of decisions)",
+        &names,
+        140,
+    )?;
     for (i, s) in rows.iter().enumerate() {
         let y = (n - 1 - i) as f64;
         let label = if s.decisions == 0 {
@@ -367,27 +388,12 @@ fn outcomes<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> Dr
     let longest = names.iter().map(|s| s.chars().count()).max().unwrap_or(0);
     let (_, h) = root.dim_in_pixel();
     let (plot, legend_area) = root.split_vertically(h as i32 - 40);
-    let mut chart = ChartBuilder::on(&plot)
-        .caption(
-            "Execution outcomes (% of decisions; per model and ground-truth action)",
-            (FONT, 20),
-        )
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size((20 + longest * 7).clamp(140, 420) as u32)
-        .build_cartesian_2d(0f64..100f64, -0.5f64..(n as f64 - 0.5))
-        .map_err(e)?;
-    chart
-        .configure_mesh()
-        .y_labels(n + 1)
-        .y_label_formatter(&|y| category_label(&names, *y))
-        .disable_y_mesh()
-        .x_desc("decisions (%)")
-        .x_label_formatter(&percent_label)
-        .label_style((FONT, 12))
-        .axis_desc_style((FONT, 14))
-        .draw()
-        .map_err(e)?;
+    let mut chart = percent_rows_chart(
+        &plot,
+        "Execution outcomes (% of decisions; per model and ground-truth action)",
+        &names,
+        (20 + longest * 7).clamp(140, 420) as u32,
+    )?;
     for (si, (_, c)) in OUTCOME_SEGMENTS.iter().enumerate() {
         let bars: Vec<_> = rows
             .iter()
