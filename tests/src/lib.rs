@@ -64,6 +64,15 @@ pub fn make_fixture(dir: &Path, n: u32, seed: u64) {
     );
 }
 
+/// The JSON values of a JSON-lines file (`--decisions`, `preds.jsonl`), one a line.
+pub fn read_json_lines(path: &Path) -> Vec<serde_json::Value> {
+    std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
 /// Runs a Python snippet (pyarrow and friends come from scripts/setup.sh).
 pub fn python(script: &str) -> String {
     let out = Command::new("python3")

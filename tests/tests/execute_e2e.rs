@@ -77,11 +77,7 @@ fn execute(
         String::from_utf8_lossy(&out.stderr)
     );
     let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    let lines = std::fs::read_to_string(&decisions)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    let lines = rh_e2e::read_json_lines(&decisions);
     (report, lines, String::from_utf8(out.stdout).unwrap())
 }
 

@@ -91,11 +91,7 @@ fn score(
     args.extend_from_slice(extra);
     run_ok("rh-score", &args);
     let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    let lines = std::fs::read_to_string(&decisions)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    let lines = rh_e2e::read_json_lines(&decisions);
     (report, lines)
 }
 

@@ -101,11 +101,7 @@ fn score(ds: &Path, preds: &Path, work: &Path) -> (Value, Vec<Value>) {
         ],
     );
     let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    let decisions = std::fs::read_to_string(&dec)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    let decisions = rh_e2e::read_json_lines(&dec);
     (report, decisions)
 }
 
