@@ -508,8 +508,10 @@ commits its plan then, so every label about reaching the observer looks at t ≥
 * **Reach envelope**: every point within {arm} m (arm reach) of the *shoulder region* — the \
 horizontal discs around the observer's torso axis of radius {offset} m (half the shoulder \
 width) + {step} m (one step), at heights from shoulder height − {crouch} m (a knee bend) up to \
-shoulder height ({shoulder} m). It reaches {reach_out:.2} m from the torso axis at shoulder height \
-and spans heights {lo:.2}–{hi:.2} m near the body.
+shoulder height ({shoulder} m), and never below {min_h} m (rule v4: lower than that the crouched \
+knees and thighs are in front of the hands, so nothing is held there). It reaches \
+{reach_out:.2} m from the torso axis at shoulder height and spans heights {lo:.2}–{hi:.2} m \
+near the body.
 * **Impact point** (`impact_kind = envelope`): the hazard's centre of mass at the first \
 physics step at or after Δ at which it is inside the reach envelope and within {tol} m of the \
 closest it comes to the torso axis (the vertical segment floor → head) while inside — where \
@@ -543,8 +545,15 @@ first touch; the executor's `freeze` plan disagreed with it on slow rollers pass
 between the legs and on blows to the forearms.
 * **reachable**: the hazard passes within {reach} m of the torso axis at or after Δ, or \
 danger is present.
-* **gt_action**: `NO_ACTION` when not reachable; else `DODGE` when dangerous, or the impact \
-speed is > {fast} m/s, or the impact kinetic energy is > {energy} J; else `CATCH`.",
+* **gt_action** (rule v4): `NO_ACTION` when not reachable; else `DODGE` when dangerous, or \
+the impact speed is > {fast} m/s, or the impact kinetic energy is > {energy} J; else `CATCH` \
+when the impact point is in the reach envelope (`impact_kind = envelope`: the hands can meet \
+the hazard there); else — a benign hazard that comes near only outside the envelope, such as \
+a ball rolling, sliding or bouncing along the floor to the feet, below anything a hand \
+reaches — `DODGE` when danger is present (it would strike the standing body) and `NO_ACTION` \
+when it is not. Rules v2–v3 called every benign reachable hazard `CATCH`, including those \
+whose impact point lay on the floor (`impact_kind = closest_approach`), an action no plan \
+can carry out: the executor's hands never got them off the floor.",
         until = validator("frame_check_until_within", 0.45),
         vis_fraction = validator("visible_fraction_min", 0.5),
         vis_margin = validator("visibility_observer_margin", 0.08),
@@ -560,7 +569,8 @@ speed is > {fast} m/s, or the impact kinetic energy is > {energy} J; else `CATCH
         crouch = l.envelope_crouch,
         shoulder = shoulder,
         reach_out = l.envelope_shoulder_offset + l.envelope_step + l.envelope_arm_reach,
-        lo = shoulder - l.envelope_crouch - l.envelope_arm_reach,
+        lo = (shoulder - l.envelope_crouch - l.envelope_arm_reach).max(l.envelope_min_height),
+        min_h = l.envelope_min_height,
         hi = shoulder + l.envelope_arm_reach,
         tol = l.interception_tolerance,
         closest = l.closest_approach_max,

@@ -26,6 +26,17 @@ pub struct LabelConfig {
     pub envelope_step: f64,
     pub envelope_arm_reach: f64,
     pub envelope_crouch: f64,
+    /// Lowest height of the envelope (rule v4; absent in older specs: no limit).
+    #[serde(default)]
+    pub envelope_min_height: f64,
+    /// Rule v4's walking limits and hand preparation time for `label::time_to_hands`
+    /// (absent in older specs: no timing).
+    #[serde(default)]
+    pub catch_walk_speed: f64,
+    #[serde(default)]
+    pub catch_walk_accel: f64,
+    #[serde(default)]
+    pub catch_prepare_s: f64,
     pub interception_tolerance: f64,
     pub closest_approach_max: f64,
     pub reach_radius: f64,
@@ -320,6 +331,10 @@ impl Config {
             ("labels.envelope_step", l.envelope_step),
             ("labels.envelope_arm_reach", l.envelope_arm_reach),
             ("labels.envelope_crouch", l.envelope_crouch),
+            ("labels.envelope_min_height", l.envelope_min_height),
+            ("labels.catch_walk_speed", l.catch_walk_speed),
+            ("labels.catch_walk_accel", l.catch_walk_accel),
+            ("labels.catch_prepare_s", l.catch_prepare_s),
             ("labels.interception_tolerance", l.interception_tolerance),
             ("labels.reaction_time_min", l.reaction_time_min),
             ("labels.floor_contact_eps", l.floor_contact_eps),
@@ -454,7 +469,7 @@ mod tests {
     fn embedded_config_is_valid() {
         let c = Config::embedded().unwrap();
         assert!((c.physics.dt - 1.0 / 240.0).abs() < 1e-15);
-        assert_eq!(c.labels.rule_version, "v3");
+        assert_eq!(c.labels.rule_version, "v4");
         for f in &c.build.families {
             assert!(
                 c.speed_bands(f).is_some(),

@@ -20,6 +20,10 @@ pub enum ImpactKind {
     /// Where the hazard's centre of mass, at or after Δ, is inside the reach envelope
     /// and (within `interception_tolerance`) as close to the torso axis as it gets there.
     Envelope,
+    /// Rule v4: it is in the envelope after Δ only where the hands cannot be in time
+    /// ([`time_to_hands`]); the interception is chosen as for `Envelope` among all its
+    /// envelope points. Never a CATCH.
+    EnvelopeLate,
     /// It never enters the envelope after Δ; its closest approach to the torso axis is used.
     ClosestApproach,
 }
@@ -28,6 +32,7 @@ impl ImpactKind {
     pub fn name(self) -> &'static str {
         match self {
             ImpactKind::Envelope => "envelope",
+            ImpactKind::EnvelopeLate => "envelope_late",
             ImpactKind::ClosestApproach => "closest_approach",
         }
     }
@@ -65,14 +70,23 @@ fn length(v: Vec3) -> f64 {
 }
 
 /// How far `p` lies outside the observer's reach envelope (≤ 0 inside): its distance to
-/// the shoulder region minus the arm's reach (see `configs/labels.toml`).
+/// the shoulder region minus the arm's reach, or its depth below the envelope's lowest
+/// height if that is more (see `configs/labels.toml`).
 pub fn envelope_excess(spec: &SceneSpec, p: Vec3) -> f64 {
     let cfg = &spec.labels;
+    let (rho, d_z) = shoulder_band_offsets(spec, p);
+    let d_rho = (rho - (cfg.envelope_shoulder_offset + cfg.envelope_step)).max(0.0);
+    let outside_reach = (d_rho * d_rho + d_z * d_z).sqrt() - cfg.envelope_arm_reach;
+    outside_reach.max(cfg.envelope_min_height - p[2])
+}
+
+/// `p`'s horizontal distance from the torso axis and its height outside the shoulder band
+/// (shoulder height − `envelope_crouch` … shoulder height; 0 within it).
+fn shoulder_band_offsets(spec: &SceneSpec, p: Vec3) -> (f64, f64) {
     let o = &spec.observer;
     let rho = ((p[0] - o.x).powi(2) + (p[1] - o.y).powi(2)).sqrt();
-    let d_rho = (rho - (cfg.envelope_shoulder_offset + cfg.envelope_step)).max(0.0);
     let top = o.shoulder_z;
-    let bottom = o.shoulder_z - cfg.envelope_crouch;
+    let bottom = o.shoulder_z - spec.labels.envelope_crouch;
     let d_z = if p[2] > top {
         p[2] - top
     } else if p[2] < bottom {
@@ -80,7 +94,40 @@ pub fn envelope_excess(spec: &SceneSpec, p: Vec3) -> f64 {
     } else {
         0.0
     };
-    (d_rho * d_rho + d_z * d_z).sqrt() - cfg.envelope_arm_reach
+    (rho, d_z)
+}
+
+/// Rule v4: the time the observer, standing still at Δ, needs to have its hands at `p`
+/// (an envelope point): walk the horizontal distance by which `p` lies beyond the arms'
+/// reach at its height (the envelope without its step: `envelope_shoulder_offset` +
+/// √(arm² − Δz²)), from rest, at most `catch_walk_accel` and `catch_walk_speed` (the
+/// robot's base limits), plus `catch_prepare_s` for the hands to get there. Specs of
+/// rules ≤ v3 (no walking limits stored) need no time.
+pub fn time_to_hands(spec: &SceneSpec, p: Vec3) -> f64 {
+    let cfg = &spec.labels;
+    if cfg.catch_walk_accel <= 0.0 || cfg.catch_walk_speed <= 0.0 {
+        return 0.0;
+    }
+    let (rho, d_z) = shoulder_band_offsets(spec, p);
+    let arm = cfg.envelope_arm_reach;
+    if d_z >= arm {
+        return f64::INFINITY;
+    }
+    let reach = cfg.envelope_shoulder_offset + (arm * arm - d_z * d_z).sqrt();
+    walk_time(
+        (rho - reach).max(0.0),
+        cfg.catch_walk_speed,
+        cfg.catch_walk_accel,
+    ) + cfg.catch_prepare_s
+}
+
+/// Time to cover `s` m from rest at acceleration ≤ `a` and speed ≤ `v` (closed form).
+fn walk_time(s: f64, v: f64, a: f64) -> f64 {
+    if s <= v * v / a {
+        (2.0 * s / a).sqrt()
+    } else {
+        s / v + v / (2.0 * a)
+    }
 }
 
 /// The physics step of the decision moment Δ (the end of the observation window).
@@ -100,20 +147,54 @@ pub fn approach(
     if from > steps {
         return None;
     }
-    let d = |k: u32| spec.observer.torso_axis_distance(sim.hazard_com(k));
-    let inside = |k: u32| envelope_excess(spec, sim.hazard_com(k)) <= 0.0;
-    let closest_inside = (from..=steps)
-        .filter(|&k| inside(k))
-        .map(d)
-        .fold(f64::INFINITY, f64::min);
-    if closest_inside.is_finite() {
-        let tolerance = spec.labels.interception_tolerance;
-        return (from..=steps)
-            .find(|&k| inside(k) && d(k) <= closest_inside + tolerance)
-            .map(|k| (k, ImpactKind::Envelope));
+    if let Some(k) = in_envelope(spec, sim, from, |_| true) {
+        return Some((k, ImpactKind::Envelope));
     }
     let (k, dist) = closest_after(spec, sim, from);
     (dist <= max_distance).then_some((k, ImpactKind::ClosestApproach))
+}
+
+/// Rule v4's impact point from the decision step `from` on: the interception among the
+/// envelope points the hands reach in time ([`time_to_hands`] ≤ the time since `from`),
+/// `Envelope`; else [`approach`]'s, an envelope point then being `EnvelopeLate`.
+pub fn interception(
+    spec: &SceneSpec,
+    sim: &Simulation,
+    from: u32,
+    max_distance: f64,
+) -> Option<(u32, ImpactKind)> {
+    if from > sim.steps() {
+        return None;
+    }
+    let in_time =
+        |k: u32| time_to_hands(spec, sim.hazard_com(k)) <= (k - from) as f64 * sim.dt + 1e-12;
+    if let Some(k) = in_envelope(spec, sim, from, in_time) {
+        return Some((k, ImpactKind::Envelope));
+    }
+    approach(spec, sim, from, max_distance).map(|(k, kind)| match kind {
+        ImpactKind::Envelope => (k, ImpactKind::EnvelopeLate),
+        other => (k, other),
+    })
+}
+
+/// The first step (≥ `from`) at which the hazard's centre of mass is inside the envelope,
+/// `eligible`, and within `interception_tolerance` of the closest it comes to the torso
+/// axis at such steps.
+fn in_envelope(
+    spec: &SceneSpec,
+    sim: &Simulation,
+    from: u32,
+    eligible: impl Fn(u32) -> bool,
+) -> Option<u32> {
+    let steps = sim.steps();
+    let d = |k: u32| spec.observer.torso_axis_distance(sim.hazard_com(k));
+    let ok = |k: u32| envelope_excess(spec, sim.hazard_com(k)) <= 0.0 && eligible(k);
+    let closest = (from..=steps)
+        .filter(|&k| ok(k))
+        .map(d)
+        .fold(f64::INFINITY, f64::min);
+    let tolerance = spec.labels.interception_tolerance;
+    (from..=steps).find(|&k| closest.is_finite() && ok(k) && d(k) <= closest + tolerance)
 }
 
 /// First step (≥ `from`) of the hazard's closest approach to the torso axis, and that distance.
@@ -226,13 +307,33 @@ fn top_touches_floor(spec: &SceneSpec, sim: &Simulation, eps: f64) -> Option<f64
     Some((k - 1) as f64 * sim.dt + f * sim.dt)
 }
 
+/// `gt_action` (rule v4): NO_ACTION when nothing can reach the observer; DODGE when the
+/// hazard is dangerous or too fast/energetic to catch; CATCH when it is benign and passes
+/// through the reach envelope where the hands get in time (`impact_kind = envelope`); a
+/// benign hazard that comes near only outside the envelope, or in it only too soon (rolling, sliding or bouncing along the floor to the feet,
+/// where no hand reaches) is DODGE when it would strike the standing body
+/// (`danger_present`) and NO_ACTION when it would not.
+fn action(reachable: bool, dodge_it: bool, in_hands_reach: bool, danger_present: bool) -> Action {
+    if !reachable {
+        Action::NoAction
+    } else if dodge_it {
+        Action::Dodge
+    } else if in_hands_reach {
+        Action::Catch
+    } else if danger_present {
+        Action::Dodge
+    } else {
+        Action::NoAction
+    }
+}
+
 pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labels {
     let cfg = &spec.labels;
     let steps = sim.steps();
     let decision = decision_step(spec).min(steps);
     let at = |k: u32| k as f64 * sim.dt;
 
-    let impact = approach(spec, sim, decision, cfg.closest_approach_max);
+    let impact = interception(spec, sim, decision, cfg.closest_approach_max);
     let closest_approach = closest_after(spec, sim, decision).1;
     let impact_speed = impact.map(|(k, _)| length(sim.hazard_velocity(k)));
 
@@ -274,13 +375,13 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labe
 
     let speed = impact_speed.unwrap_or(max_speed);
     let too_fast = speed > cfg.catch_speed_max || 0.5 * mass * speed * speed > cfg.catch_energy_max;
-    let gt_action = if !reachable {
-        Action::NoAction
-    } else if dangerous || too_fast {
-        Action::Dodge
-    } else {
-        Action::Catch
-    };
+    let in_hands_reach = impact.is_some_and(|(_, kind)| kind == ImpactKind::Envelope);
+    let gt_action = action(
+        reachable,
+        dangerous || too_fast,
+        in_hands_reach,
+        danger_present,
+    );
 
     Labels {
         gt_action,
@@ -467,7 +568,7 @@ mod tests {
     }
 
     #[test]
-    fn closest_approach_is_used_when_the_envelope_is_never_entered() {
+    fn closest_approach_is_used_when_the_envelope_is_never_entered_and_is_no_catch() {
         let s = spec("apple");
         // Rolling along the floor (below the envelope), passing 0.4 m from the observer.
         let sim = synthetic(&s, 720, |t| [2.0 - 1.0 * t, 0.4, 0.04]);
@@ -477,11 +578,94 @@ mod tests {
         assert!(p[0].abs() < 0.01 && (p[1] - 0.4).abs() < 1e-6);
         assert!((l.closest_approach - 0.4).abs() < 1e-3);
         assert!((l.time_to_impact.unwrap() - 2.0).abs() <= s.physics.dt);
+        // Rule v4: 0.46 m below the envelope's lowest height (0.50 m) no hand holds it, so
+        // a benign roller is no CATCH: NO_ACTION when it would not strike the standing
+        // body …
+        assert!((envelope_excess(&s, p) - 0.46).abs() < 1e-9);
+        assert!(l.reachable && !l.dangerous && !l.danger_present);
+        assert_eq!(l.gt_action, Action::NoAction);
+        // … and DODGE when it would (the same roller striking a shank at 1 m/s).
+        let shin = Strike {
+            step: 480,
+            first_touch: 480,
+            speed: 1.0,
+            impulse: 0.2,
+            part: crate::execute::humanoid::Part::LeftShank,
+        };
+        let struck = label(&s, &sim, Some(shin));
+        assert!(struck.danger_present && !struck.dangerous);
+        assert_eq!(struck.gt_action, Action::Dodge);
+        // The same apple carried 0.9 m above the floor on the same line enters the
+        // envelope and is a CATCH whether or not it would strike.
+        let high = synthetic(&s, 720, |t| [2.0 - 1.0 * t, 0.4, 0.9]);
+        assert_eq!(
+            label(&s, &high, None).impact_kind,
+            Some(ImpactKind::Envelope)
+        );
+        assert_eq!(label(&s, &high, None).gt_action, Action::Catch);
+        assert_eq!(label(&s, &high, Some(shin)).gt_action, Action::Catch);
+        // Carried at 0.45 m it is within an arm's reach of the crouched shoulder (whose
+        // sphere goes down to 0.30 m) but under the envelope's 0.50 m floor: no CATCH.
+        let knee_high = synthetic(&s, 720, |t| [2.0 - 1.0 * t, 0.4, 0.45]);
+        let l = label(&s, &knee_high, None);
+        assert_eq!(l.impact_kind, Some(ImpactKind::ClosestApproach));
+        assert_eq!(l.gt_action, Action::NoAction);
         // Never within reach: no impact point at all.
         let sim = synthetic(&s, 720, |t| [2.0 - 1.0 * t, 2.0, 0.04]);
         let l = label(&s, &sim, None);
         assert_eq!(l.impact_point, None);
         assert_eq!(l.gt_action, Action::NoAction);
+    }
+
+    #[test]
+    fn the_hands_must_get_there_in_time() {
+        // Rule v4 on constructed paths at shoulder-band height (z 1.0: the arms reach
+        // 0.15 + 0.55 = 0.70 m from the torso axis without a step).
+        let s = spec("apple");
+        let delta = s.observation_window_s;
+        let dt = s.physics.dt;
+        assert_eq!(
+            (s.labels.catch_walk_speed, s.labels.catch_walk_accel),
+            (1.5, 4.0)
+        );
+        // Hovering 1.0 m away: 0.30 m to walk, under v²/a = 0.5625 m, so √(2·0.30/4) s,
+        // plus 0.1 s for the hands; the interception is the first step after Δ that late.
+        let need = (2.0f64 * 0.30 / 4.0).sqrt() + 0.1;
+        assert!((time_to_hands(&s, [1.0, 0.0, 1.0]) - need).abs() < 1e-12);
+        let hover = synthetic(&s, 720, |_| [1.0, 0.0, 1.0]);
+        let l = label(&s, &hover, None);
+        assert_eq!(l.impact_kind, Some(ImpactKind::Envelope));
+        assert_eq!(l.gt_action, Action::Catch);
+        let t = l.time_to_impact.unwrap() - delta;
+        assert!(t >= need - 1e-9 && t < need + dt + 1e-9, "{t} vs {need}");
+        // Within arm's reach no walk: only the hands' 0.1 s.
+        assert!((time_to_hands(&s, [0.6, 0.0, 1.0]) - 0.1).abs() < 1e-12);
+        // Beyond 1.5²/(2·4) m the walk cruises: s/1.5 + 1.5/8.
+        let far = 0.70 + 0.9;
+        let cruise = 0.9 / 1.5 + 1.5 / 8.0 + 0.1;
+        assert!((time_to_hands(&s, [far, 0.0, 1.0]) - cruise).abs() < 1e-12);
+        // Crossing the envelope's rim 1.1 m out at 3 m/s: inside for 0.32 s only, and the
+        // hands need ≥ √(2·0.40/4) + 0.1 = 0.547 s to get 1.1 m out: too late. A benign
+        // apple that would not strike is then NO_ACTION, not CATCH.
+        let cross = synthetic(&s, 720, move |t| [1.1, -0.6 + 3.0 * (t - delta), 1.0]);
+        let l = label(&s, &cross, None);
+        assert_eq!(l.impact_kind, Some(ImpactKind::EnvelopeLate));
+        assert!(envelope_excess(&s, l.impact_point.unwrap()) <= 0.0);
+        assert_eq!(l.gt_action, Action::NoAction);
+        // The same crossing at 0.5 m/s is slow enough: CATCH, at the first envelope step
+        // the hands make in time (near the closest in-time approach to the axis).
+        let slow = synthetic(&s, 960, move |t| [1.1, -0.6 + 0.5 * (t - delta), 1.0]);
+        let l = label(&s, &slow, None);
+        assert_eq!(l.impact_kind, Some(ImpactKind::Envelope));
+        assert_eq!(l.gt_action, Action::Catch);
+        let k = ((l.time_to_impact.unwrap()) / dt).round() as u32;
+        let late = |k: u32| time_to_hands(&s, slow.hazard_com(k)) - (k as f64 * dt - delta);
+        assert!(
+            late(k) <= 1e-9 && late(k - 1) > 0.0,
+            "{} {}",
+            late(k),
+            late(k - 1)
+        );
     }
 
     #[test]
@@ -496,9 +680,18 @@ mod tests {
         // Straight up from the shoulder, and down from the crouched shoulder.
         assert!(envelope_excess(&s, [0.0, 0.0, sz + reach - 1e-6]) <= 0.0);
         assert!(envelope_excess(&s, [0.0, 0.0, sz + reach + 1e-3]) > 0.0);
+        // Down from the crouched shoulder (0.30 m) only to the envelope's lowest height.
         let low = sz - s.labels.envelope_crouch - reach;
-        assert!(envelope_excess(&s, [0.0, 0.3, low + 1e-6]) <= 0.0);
+        let floor = s.labels.envelope_min_height;
+        assert!((low - 0.30).abs() < 1e-9 && floor == 0.50);
+        assert!(envelope_excess(&s, [0.0, 0.3, floor + 1e-6]) <= 0.0);
+        assert!((envelope_excess(&s, [0.0, 0.3, floor - 0.1]) - 0.1).abs() < 1e-9);
         assert!(envelope_excess(&s, [0.0, 0.3, low - 1e-3]) > 0.0);
+        // Without the floor (older specs: absent = 0) the crouched arm's sphere ends it.
+        let mut old = s.clone();
+        old.labels.envelope_min_height = 0.0;
+        assert!(envelope_excess(&old, [0.0, 0.3, low + 1e-6]) <= 0.0);
+        assert!(envelope_excess(&old, [0.0, 0.3, low - 1e-3]) > 0.0);
     }
 
     #[test]

@@ -290,8 +290,8 @@ mod tests {
             assert!(r.safe(), "{}", s.scene_id);
             assert_eq!(r.aia, 1.0, "{}", p.intent);
             if s.gt_action == Action::Catch {
-                // Exact under rule v1 (the knee bend's pelvis drop is left out by the rule
-                // and by the oracle's hand targets alike).
+                // Exact under rule v2 (the knee bend's pelvis drop lowers the rule's
+                // hands and the oracle's crouched body frame alike).
                 assert!(
                     r.d_end.unwrap() < 1e-6,
                     "{} d_end {:?}",

@@ -39,7 +39,9 @@ PREDICTIONS (preds.jsonl, SPEC §9)
     absurd. Keyframes are sorted by t
     (stable); the first is keyframe 1, the last is the final one. A plan without
     keyframes has one implicit keyframe: hands at rest at the end of the walk.
-    knee_bend is read but does not enter v1 metrics.
+    knee_bend (0 straight … 1 deep crouch, clamped) lowers the pelvis, the body frame's
+    origin, by knee_bend × {drop} m (the executor's max_pelvis_drop): it moves the hands'
+    height in the metrics (since action rule v2; v1 left it out), not the classification.
   * Numbers may be JSON numbers or numeric strings. Sanity policy: a plan with a NaN/inf
     or out-of-range number — |vx|,|vy| > {ms} m/s, |yaw_rate| > {my} rad/s,
     walking_duration or keyframe t outside [0, {md}] s, |hand coordinate| > {mc} m — is
@@ -80,7 +82,8 @@ ACTION RULE {rule} (SPEC §10)
 
 METRICS (SPEC §11), per decision (scene s, model m)
   Hands in the world: a body-frame hand (hx, hy, hz) at keyframe time t is at
-  base_xy(t) + R(yaw(t)) (hx, hy), height {ph} + hz. h_i = mean of both hands at keyframe i.
+  base_xy(t) + R(yaw(t)) (hx, hy), height {ph} - knee_bend × {drop} + hz (the crouch lowers
+  the pelvis). h_i = mean of both hands at keyframe i.
   1. SAA = 1[action == gt_action].
   2. Safety: unsafe if any rule fires; the first in order is recorded, every rule that
      fires is counted:
@@ -124,6 +127,7 @@ AIA VOCABULARIES AND NEGATION
         fill = list(&aia.coordination_fillers),
         coord = list(&aia.coordinators),
         ph = b.pelvis_height,
+        drop = cfg.execution.max_pelvis_drop,
         rl = b.rest_left,
         rr = b.rest_right,
         rt = a.reach_threshold,

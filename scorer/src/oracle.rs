@@ -9,9 +9,9 @@
 //!   final keyframe, at the end of the walk (≥ 0.2 s, the hands' travel), puts the mean
 //!   hand exactly on the impact point. Impact points too low for the standing arm (below
 //!   ≈ 0.66 m) are met with a knee bend (the least that brings the point within reach,
-//!   ≤ 1); the hands stay where action rule v1 puts the point (hands at `pelvis_height +
-//!   z`, the knee bend ignored), so d_end is < 1e-6 m everywhere and in physics the
-//!   crouched hands are under the point by the pelvis drop (≤ 0.25 m). When the
+//!   ≤ 1); the hands are on the point in the crouched body frame (action rule v2 lowers
+//!   them with the pelvis, as the executor does), so d_end is < 1e-6 m everywhere and the
+//!   executed hands are where the metric reads them. When the
 //!   point is closer than the stance (walking there would be a retreat) the base stays
 //!   and only the hands go. A first keyframe at 0.15 s reaches ≥ 0.30 m forward whenever
 //!   the final one does not, so the rule's reach test (≥ 0.20 m) holds.
@@ -39,12 +39,11 @@ pub const DODGE_DISTANCE: f64 = 1.6;
 pub const DODGE_SPEED: f64 = 1.45;
 /// SPEC §2 arm (the executor's body): shoulder height above the pelvis, shoulder offset
 /// sideways, reach used for planning (a little short of the 0.55 m arm), the palms'
-/// offset either side of the mean hand, the pelvis drop of knee_bend 1.
+/// offset either side of the mean hand.
 const SHOULDER_Z: f64 = 0.30;
 const SHOULDER_Y: f64 = 0.17;
 const PLAN_REACH: f64 = 0.53;
 const HAND_HALF_GAP: f64 = 0.05;
-const MAX_DROP: f64 = 0.25;
 /// Forward hand distance that passes rule v1's reach test with margin (rest x 0.10).
 const REACH_X: f64 = 0.32;
 /// SPEC §1's default decision moment Δ (s), for datasets without specs.
@@ -80,16 +79,17 @@ pub fn catch(scene: &Scene, cfg: &Config) -> Value {
     let [x0, y0, th0] = scene.observer_pose;
     let p = scene.hazard_point();
     let pelvis = cfg.body.pelvis_height;
+    let max_drop = cfg.execution.max_pelvis_drop;
     let (dx, dy) = (p[0] - x0, p[1] - y0);
     let d = dx.hypot(dy);
     // The least knee bend (in 0.01 m steps of pelvis drop) that brings the point within
     // a forward reach of REACH_X - 0.02; only for points below the shoulder.
     let mut drop = 0.0;
     while forward_reach(p[2] - (pelvis - drop)) < REACH_X - 0.02
-        && drop < MAX_DROP
+        && drop < max_drop
         && p[2] < pelvis + SHOULDER_Z
     {
-        drop = (drop + 0.01).min(MAX_DROP);
+        drop = (drop + 0.01).min(max_drop);
     }
     let zb = p[2] - (pelvis - drop);
     let a = CATCH_STANDOFF.min(forward_reach(zb).max(0.12));
@@ -111,11 +111,10 @@ pub fn catch(scene: &Scene, cfg: &Config) -> Value {
         dur *= speed / CATCH_SPEED;
         cmd = solve_walk(scene.observer_pose, goal, th0 + dth, dur);
     }
-    let knee = drop / MAX_DROP;
-    // The hands at the point as action rule v1 reads them (`pelvis_height + z`, knee bend
-    // ignored), so the oracle's d_end is exactly 0; in physics the bend lowers them with
-    // the pelvis, under the point by the drop.
-    let z_rule = p[2] - pelvis;
+    let knee = drop / max_drop;
+    // The hands on the point in the crouched body frame, where action rule v2 (and the
+    // executor) put them: the oracle's d_end is exactly 0.
+    let z_rule = p[2] - crate::rule::pelvis_height(knee, cfg);
     let at = |x: f64| {
         (
             [x, hand[1] + HAND_HALF_GAP, z_rule],

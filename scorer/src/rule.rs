@@ -1,4 +1,4 @@
-//! Action rule v1 (SPEC §10) and the world-frame kinematics of a plan.
+//! Action rule v2 (SPEC §10) and the world-frame kinematics of a plan.
 //!
 //! The base follows the walking command `[vx, vy, yaw_rate]` (body frame, constant twist)
 //! for `walking_duration` seconds and then stands still. With constant twist the path is
@@ -11,7 +11,11 @@
 //!
 //! and, for `|w t| < 1e-9`, the straight-line limit `x0 + R(yaw0) (vx, vy) t`.
 //! A hand at body-frame `(hx, hy, hz)` at keyframe time `t` is at world
-//! `base_xy(t) + R(yaw(t)) (hx, hy)` and height `pelvis_height + hz`.
+//! `base_xy(t) + R(yaw(t)) (hx, hy)` and height `pelvis_height − drop + hz`, where the
+//! keyframe's knee bend lowers the pelvis (the body frame's origin) by
+//! `drop = clamp(knee_bend, 0, 1) × max_pelvis_drop` — the executor's body (`[execution]`),
+//! so the metrics read the hands where `--execute` puts them. Rule v1 left the drop out;
+//! the classification itself (reach, D, u) is unchanged.
 
 use crate::config::Config;
 use crate::dataset::Scene;
@@ -40,6 +44,17 @@ pub fn body_to_world(pose: BasePose, p: [f64; 3], pelvis_height: f64) -> [f64; 3
         pose.y + s * p[0] + c * p[1],
         pelvis_height + p[2],
     ]
+}
+
+/// Height of the pelvis (the body frame's origin) above the floor at a keyframe's knee
+/// bend (0 straight … 1 deep crouch, clamped; NaN counts as straight): the executor's.
+pub fn pelvis_height(knee_bend: f64, cfg: &Config) -> f64 {
+    let bend = if knee_bend.is_nan() {
+        0.0
+    } else {
+        knee_bend.clamp(0.0, 1.0)
+    };
+    cfg.body.pelvis_height - bend * cfg.execution.max_pelvis_drop
 }
 
 /// What the rule saw in a plan.
@@ -77,7 +92,11 @@ pub fn kinematics(plan: &Plan, scene: &Scene, cfg: &Config) -> Kinematics {
         reach = reach.max(k.left[0] - cfg.body.rest_left[0]);
         reach = reach.max(k.right[0] - cfg.body.rest_right[0]);
         let pose = base_pose_at(start, plan.walking_cmd, dur, k.t);
-        hands_world.push(body_to_world(pose, k.mid(), cfg.body.pelvis_height));
+        hands_world.push(body_to_world(
+            pose,
+            k.mid(),
+            pelvis_height(k.knee_bend, cfg),
+        ));
     }
     if plan.keyframes.is_empty() {
         let mid = [
@@ -101,7 +120,7 @@ pub fn kinematics(plan: &Plan, scene: &Scene, cfg: &Config) -> Kinematics {
 /// threshold (0.30 − 0.10 = 0.19999999999999998) counts as on it.
 pub const THRESHOLD_EPS: f64 = 1e-9;
 
-/// Action rule v1: reach ≥ τ_reach and not (D·u ≤ −τ_retreat) → CATCH; else
+/// Action rule v2's classification (as v1's): reach ≥ τ_reach and not (D·u ≤ −τ_retreat) → CATCH; else
 /// |D| ≥ τ_move → DODGE; else NO_ACTION (comparisons with [`THRESHOLD_EPS`]).
 pub fn classify_kinematics(k: &Kinematics, cfg: &Config) -> Action {
     let r = &cfg.action_rule;
@@ -192,6 +211,28 @@ pub(crate) mod tests {
         // Walking forward with yaw π/2 moves along world +y.
         let p = base_pose_at([0.0, 0.0, FRAC_PI_2], [1.0, 0.0, 0.0], 2.0, 2.0);
         assert!(close([p.x, p.y, p.yaw], [0.0, 2.0, FRAC_PI_2]), "{p:?}");
+    }
+
+    #[test]
+    fn knee_bend_lowers_the_hands_with_the_pelvis() {
+        // Rule v2: knee_bend b lowers the body frame by clamp(b, 0, 1) × 0.25 m.
+        let c = Config::default();
+        assert_eq!(c.execution.max_pelvis_drop, 0.25);
+        let s = scene([0.0, 0.0, 0.0], Some([0.4, 0.0, 0.3]));
+        let z = |bend: f64| {
+            let mut p = plan([0.0; 3], 0.0, &[[0.4, 0.0, -0.3]]);
+            p.keyframes[0].knee_bend = bend;
+            kinematics(&p, &s, &c).hands_world[0][2]
+        };
+        assert!((z(0.0) - 0.49).abs() < 1e-12);
+        assert!((z(0.4) - (0.49 - 0.1)).abs() < 1e-12);
+        assert!((z(1.0) - 0.24).abs() < 1e-12);
+        assert!((z(3.0) - 0.24).abs() < 1e-12, "clamped to 1");
+        assert!((z(-1.0) - 0.49).abs() < 1e-12, "clamped to 0");
+        // The classification does not depend on it.
+        let mut p = plan([0.0; 3], 0.0, &[[0.4, 0.0, -0.3]]);
+        p.keyframes[0].knee_bend = 1.0;
+        assert_eq!(classify(&p, &s, &c).0, Action::Catch);
     }
 
     #[test]

@@ -152,7 +152,7 @@ fn dataset_build_layout_card_and_manifest() {
     assert_eq!(manifest["seed"], 11);
     assert_eq!(manifest["n"], 40);
     assert_eq!(manifest["shard"], serde_json::json!([0, 1]));
-    assert_eq!(manifest["config"]["labels"]["rule_version"], "v3");
+    assert_eq!(manifest["config"]["labels"]["rule_version"], "v4");
 }
 
 #[test]

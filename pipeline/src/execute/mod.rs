@@ -362,6 +362,11 @@ mod tests {
             (c.strike_impulse_heavy, c.strike_window_s),
             (l.strike_impulse_heavy, l.strike_window_s)
         );
+        // Rule v4's catch timing walks with the executor's base limits.
+        assert_eq!(
+            (c.max_speed, c.max_accel),
+            (l.catch_walk_speed, l.catch_walk_accel)
+        );
         assert_eq!(c.link_friction, humanoid::BODY_FRICTION);
         assert_eq!(c.link_restitution, humanoid::BODY_RESTITUTION);
     }
