@@ -81,6 +81,7 @@ pub mod col {
     pub const VALID_VISIBLE: &str = "valid_visible";
     pub const VALID_INTENDED_EVENT: &str = "valid_intended_event";
     pub const VALID_REACTION_TIME: &str = "valid_reaction_time";
+    pub const VALID_ESCAPABLE: &str = "valid_escapable";
     pub const SPEC_FILE: &str = "spec_file";
     pub const EGO_FILE_NAME: &str = "ego_file_name";
     pub const CLOSEUP_FILE_NAME: &str = "closeup_file_name";
@@ -91,7 +92,7 @@ pub mod col {
 }
 
 /// The validator verdict columns, in column order (each `true` when that check passed).
-pub const VALIDATOR_COLUMNS: [&str; 7] = [
+pub const VALIDATOR_COLUMNS: [&str; 8] = [
     col::VALID_NO_INTERPENETRATION,
     col::VALID_ENERGY,
     col::VALID_NO_TUNNELLING,
@@ -99,6 +100,7 @@ pub const VALIDATOR_COLUMNS: [&str; 7] = [
     col::VALID_VISIBLE,
     col::VALID_INTENDED_EVENT,
     col::VALID_REACTION_TIME,
+    col::VALID_ESCAPABLE,
 ];
 
 /// The `<cam>_hazard_visible_px` column of a camera (`CAMERAS`).
@@ -419,6 +421,12 @@ pub const COLUMNS: &[Column] = &[
         Bool,
         false,
         "Validator: the hazard reaches the observer no earlier than Δ plus the minimum reaction time (label rule v2)",
+    ),
+    c(
+        col::VALID_ESCAPABLE,
+        Bool,
+        false,
+        "Validator: a DODGE scene whose hazard would strike the standing body has an escape walk that physics does not strike (label rule v4)",
     ),
     c(
         col::SPEC_FILE,

@@ -31,6 +31,9 @@ pub struct Verdicts {
     /// The hazard reaches the observer no earlier than Δ + `labels.reaction_time_min`
     /// (label rule v2): a decision made at Δ can still matter.
     pub reaction_time: bool,
+    /// Label rule v4: a DODGE scene whose hazard would strike the standing body has an
+    /// escape (`execute::escape`): some walk under the robot's limits is not struck.
+    pub escapable: bool,
 }
 
 impl Verdicts {
@@ -38,7 +41,7 @@ impl Verdicts {
         self.as_array().iter().all(|&v| v)
     }
 
-    pub fn as_array(&self) -> [bool; 7] {
+    pub fn as_array(&self) -> [bool; 8] {
         [
             self.no_interpenetration,
             self.energy,
@@ -47,6 +50,7 @@ impl Verdicts {
             self.visible,
             self.intended_event,
             self.reaction_time,
+            self.escapable,
         ]
     }
 
@@ -84,7 +88,16 @@ pub fn validate(
         visible: visibility::assess(spec, sim, &framing).passes(&framing),
         intended_event: family.event_happened(spec, sim),
         reaction_time: reaction_time_ok(spec, labels),
+        escapable: escapable(spec, labels),
     }
+}
+
+/// Label rule v4: only a DODGE scene whose hazard would strike the standing body needs an
+/// escape walk that is not struck (`execute::escape`); every other scene passes without
+/// a physics run.
+pub fn escapable(spec: &SceneSpec, labels: &Labels) -> bool {
+    !(labels.danger_present && labels.gt_action == crate::label::Action::Dodge)
+        || crate::execute::escape::escapable(spec)
 }
 
 /// Label rule v2's reaction-time rule: neither the moment the hazard first reaches the

@@ -243,7 +243,7 @@ pub fn write_baseline(
 ) -> Result<()> {
     let majority = majority_action(ds);
     let hints = if kind == BaselineKind::Oracle {
-        crate::oracle::load_hints(ds)?
+        crate::oracle::load_hints(ds, cfg)?
     } else {
         Default::default()
     };

@@ -55,6 +55,9 @@ pub struct OracleHints {
     /// The hazard's horizontal displacement (world) from Δ to the impact (else to the end
     /// of the stored trajectory).
     pub hazard_motion: Option<[f64; 2]>,
+    /// The DODGE plan checked in physics ([`physics_dodges`]) when the heuristic dodge
+    /// would be struck and an escape walk is not.
+    pub dodge: Option<Value>,
 }
 
 fn kf(t: f64, left: [f64; 3], right: [f64; 3], knee: f64) -> Value {
@@ -136,8 +139,17 @@ pub fn catch(scene: &Scene, cfg: &Config) -> Value {
     )
 }
 
-/// The oracle's DODGE plan (see the module doc).
+/// The oracle's DODGE plan (see the module doc): the physics-checked one when the hints
+/// have it, else the heuristic walk.
 pub fn dodge(scene: &Scene, hints: Option<&OracleHints>, cfg: &Config) -> Value {
+    match hints.and_then(|h| h.dodge.clone()) {
+        Some(plan) => plan,
+        None => heuristic_dodge(scene, hints, cfg),
+    }
+}
+
+/// The heuristic walk away from the impact point (see the module doc).
+fn heuristic_dodge(scene: &Scene, hints: Option<&OracleHints>, cfg: &Config) -> Value {
     let [x0, y0, th0] = scene.observer_pose;
     let p = scene.hazard_point();
     let (ux, uy) = (p[0] - x0, p[1] - y0);
@@ -185,9 +197,73 @@ pub fn oracle_plan(scene: &Scene, hints: Option<&OracleHints>, cfg: &Config) -> 
     }
 }
 
+/// The hints of every scene: [`read_hints`], then the physics-checked dodges
+/// ([`physics_dodges`]).
+pub fn load_hints(ds: &Dataset, cfg: &Config) -> Result<BTreeMap<String, OracleHints>> {
+    let mut hints = read_hints(ds)?;
+    for (id, plan) in physics_dodges(ds, &hints, cfg) {
+        hints.entry(id).or_default().dodge = Some(plan);
+    }
+    Ok(hints)
+}
+
+/// DODGE plans checked in physics with `--execute`'s executor (`cfg.execution`): for every
+/// valid DODGE scene whose spec replays (checked against the dataset's hash), the
+/// heuristic dodge is executed; when it is struck, the first escape walk that is not
+/// (`rh_pipeline::execute::escape`, the walks of the label's validator
+/// `valid_escapable`, so one exists in every valid scene of rule v4 that would strike)
+/// replaces it. Scenes without specs, or where nothing escapes, keep the heuristic.
+pub fn physics_dodges(
+    ds: &Dataset,
+    hints: &BTreeMap<String, OracleHints>,
+    cfg: &Config,
+) -> BTreeMap<String, Value> {
+    use rayon::prelude::*;
+    use rh_pipeline::execute::escape::{escape_plans, first_unstruck};
+    let Ok(keys) = read_replay_keys(&ds.dir) else {
+        return BTreeMap::new();
+    };
+    let dodges: Vec<&Scene> = ds
+        .scenes
+        .iter()
+        .filter(|s| s.valid && s.gt_action == Action::Dodge)
+        .collect();
+    let found: Vec<Option<(String, Value)>> = dodges
+        .par_iter()
+        .map(|s| {
+            let key = keys.get(&s.scene_id)?;
+            let (replay, _) = crate::execution::checked_replay(&ds.dir, key, &s.scene_id).ok()?;
+            let heuristic = heuristic_dodge(s, hints.get(&s.scene_id), cfg);
+            let parsed = crate::plan::plan_from_value(&heuristic, cfg).ok()?;
+            let mut plans = vec![crate::execution::exec_plan(&parsed)];
+            plans.extend(escape_plans(replay.spec()));
+            match first_unstruck(&replay, &plans, &cfg.execution)? {
+                0 => None,
+                i => Some((s.scene_id.clone(), escape_json(&plans[i]))),
+            }
+        })
+        .collect();
+    found.into_iter().flatten().collect()
+}
+
+/// An escape walk as a plan line's `plan` (numbers unchanged through JSON).
+fn escape_json(p: &rh_pipeline::execute::ExecPlan) -> Value {
+    let keyframes = p
+        .keyframes
+        .iter()
+        .map(|k| kf(k.t, k.left, k.right, k.knee_bend))
+        .collect();
+    plan(
+        "Dodge: walk out of the hazard's path.",
+        p.walking_cmd,
+        p.walking_duration,
+        keyframes,
+    )
+}
+
 /// Reads the hints of every scene from `DIR/data/*.parquet` (`time_to_impact`,
 /// `trajectory`) and `DIR/specs/` (Δ); a dataset without those columns gives none.
-pub fn load_hints(ds: &Dataset) -> Result<BTreeMap<String, OracleHints>> {
+fn read_hints(ds: &Dataset) -> Result<BTreeMap<String, OracleHints>> {
     let deltas = decision_times(ds);
     let mut out = BTreeMap::new();
     let Ok(files) = parquet_files(&ds.dir.join("data")) else {
@@ -224,6 +300,7 @@ pub fn load_hints(ds: &Dataset) -> Result<BTreeMap<String, OracleHints>> {
                     id,
                     OracleHints {
                         hazard_motion: motion,
+                        dodge: None,
                     },
                 );
             }

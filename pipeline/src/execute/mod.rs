@@ -16,6 +16,7 @@
 //! from the same bits, whatever the order, thread or process. Nothing here reads a clock
 //! or iterates a hash map.
 
+pub mod escape;
 pub mod grasp;
 pub mod humanoid;
 pub mod motion;
