@@ -508,16 +508,22 @@ commits its plan then, so every label about reaching the observer looks at t ≥
 * **Reach envelope**: every point within {arm} m (arm reach) of the *shoulder region* — the \
 horizontal discs around the observer's torso axis of radius {offset} m (half the shoulder \
 width) + {step} m (one step), at heights from shoulder height − {crouch} m (a knee bend) up to \
-shoulder height ({shoulder} m), and never below {min_h} m (rule v4: lower than that the crouched \
-knees and thighs are in front of the hands, so nothing is held there). It reaches \
-{reach_out:.2} m from the torso axis at shoulder height and spans heights {lo:.2}–{hi:.2} m \
-near the body.
-* **Impact point** (`impact_kind = envelope`): the hazard's centre of mass at the first \
-physics step at or after Δ at which it is inside the reach envelope and within {tol} m of the \
-closest it comes to the torso axis (the vertical segment floor → head) while inside — where \
-the hands would meet it. A hazard that never enters the envelope after Δ: its closest \
-approach to the torso axis after Δ if within {closest} m (`closest_approach`); else null. \
-`time_to_impact` and `impact_speed` (of the centre of mass) are taken at that step.
+shoulder height ({shoulder} m). It reaches {reach_out:.2} m from the torso axis at shoulder \
+height and spans heights {lo:.2}–{hi:.2} m near the body. The hands **hold** a hazard only in \
+the part above {min_h} m (rule v4: lower, the crouched knees and thighs are in front of the \
+hands).
+* **Impact point** (`impact_kind = envelope`, rule v4): the hazard's centre of mass at the \
+first physics step at or after Δ at which it is where the hands can hold it (in the envelope, \
+above {min_h} m) *and where they can be in time* — the observer, standing still at Δ, walks the \
+horizontal distance by which the point lies beyond the arms' reach at its height (from rest, \
+≤ {walk_a} m/s² and ≤ {walk_v} m/s, the robot's base limits) and takes {prep} s for the hands, \
+all before the hazard gets there — and within {tol} m of the closest it comes to the torso \
+axis (the vertical segment floor → head) at such steps: where the hands would meet it. A \
+hazard that is in the envelope after Δ only too low or too soon: the same choice among all \
+its envelope steps (`envelope_late`, rule v3's point). A hazard that never enters the \
+envelope after Δ: its closest approach to the torso axis after Δ if within {closest} m \
+(`closest_approach`); else null. `time_to_impact` and `impact_speed` (of the centre of mass) \
+are taken at that step.
 * **Reaction time** (validator `valid_reaction_time`): the hazard must not reach the \
 observer — the same interception computed from t = 0, a closest approach within {reach} m, \
 or a strike of the standing body — before Δ + {reaction} s; such a scene is resampled.
@@ -547,13 +553,18 @@ between the legs and on blows to the forearms.
 danger is present.
 * **gt_action** (rule v4): `NO_ACTION` when not reachable; else `DODGE` when dangerous, or \
 the impact speed is > {fast} m/s, or the impact kinetic energy is > {energy} J; else `CATCH` \
-when the impact point is in the reach envelope (`impact_kind = envelope`: the hands can meet \
-the hazard there); else — a benign hazard that comes near only outside the envelope, such as \
-a ball rolling, sliding or bouncing along the floor to the feet, below anything a hand \
-reaches — `DODGE` when danger is present (it would strike the standing body) and `NO_ACTION` \
-when it is not. Rules v2–v3 called every benign reachable hazard `CATCH`, including those \
-whose impact point lay on the floor (`impact_kind = closest_approach`), an action no plan \
-can carry out: the executor's hands never got them off the floor.",
+when the hands can meet the hazard in time (`impact_kind = envelope`); else — a benign \
+hazard that comes near only along the floor, below the knees, or too soon for the hands \
+(`envelope_late`, `closest_approach`) — `DODGE` when danger is present (it would strike the \
+standing body) and `NO_ACTION` when it is not. Rules v2–v3 called every benign reachable \
+hazard `CATCH`, including balls rolling or bouncing to the feet and throws that arrive at \
+knee height before any step could bring the hands there: the executor's humanoid could not \
+catch them (its oracle caught 58 of 146 such labels).
+* **Escape** (validator `valid_escapable`, rule v4): a `DODGE` scene with danger present must \
+be escapable — of {esc_n} walks of {esc_d} m at {esc_v} m/s in evenly spaced directions (the \
+first straight back), hands at rest, executed in physics from Δ by the executor of `rh-score \
+--execute`, at least one is not struck. A scene no walk escapes (a heavy object sliding into \
+the shins 0.3 s after Δ) is resampled: no decision could matter.",
         until = validator("frame_check_until_within", 0.45),
         vis_fraction = validator("visible_fraction_min", 0.5),
         vis_margin = validator("visibility_observer_margin", 0.08),
@@ -569,8 +580,14 @@ can carry out: the executor's hands never got them off the floor.",
         crouch = l.envelope_crouch,
         shoulder = shoulder,
         reach_out = l.envelope_shoulder_offset + l.envelope_step + l.envelope_arm_reach,
-        lo = (shoulder - l.envelope_crouch - l.envelope_arm_reach).max(l.envelope_min_height),
+        lo = shoulder - l.envelope_crouch - l.envelope_arm_reach,
         min_h = l.envelope_min_height,
+        walk_a = l.catch_walk_accel,
+        walk_v = l.catch_walk_speed,
+        prep = l.catch_prepare_s,
+        esc_n = l.escape_directions,
+        esc_d = l.escape_distance,
+        esc_v = l.escape_speed,
         hi = shoulder + l.envelope_arm_reach,
         tol = l.interception_tolerance,
         closest = l.closest_approach_max,

@@ -20,9 +20,9 @@ pub enum ImpactKind {
     /// Where the hazard's centre of mass, at or after Δ, is inside the reach envelope
     /// and (within `interception_tolerance`) as close to the torso axis as it gets there.
     Envelope,
-    /// Rule v4: it is in the envelope after Δ only where the hands cannot be in time
-    /// ([`time_to_hands`]); the interception is chosen as for `Envelope` among all its
-    /// envelope points. Never a CATCH.
+    /// Rule v4: it is in the envelope after Δ only where the hands cannot hold it (below
+    /// `envelope_min_height`) or cannot be in time ([`time_to_hands`]); the interception
+    /// is chosen as in rule v3, among all its envelope points. Never a CATCH.
     EnvelopeLate,
     /// It never enters the envelope after Δ; its closest approach to the torso axis is used.
     ClosestApproach,
@@ -70,14 +70,20 @@ fn length(v: Vec3) -> f64 {
 }
 
 /// How far `p` lies outside the observer's reach envelope (≤ 0 inside): its distance to
-/// the shoulder region minus the arm's reach, or its depth below the envelope's lowest
-/// height if that is more (see `configs/labels.toml`).
+/// the shoulder region minus the arm's reach (see `configs/labels.toml`). Where the hazard
+/// reaches the observer; [`catch_excess`] is where the hands can hold it.
 pub fn envelope_excess(spec: &SceneSpec, p: Vec3) -> f64 {
     let cfg = &spec.labels;
     let (rho, d_z) = shoulder_band_offsets(spec, p);
     let d_rho = (rho - (cfg.envelope_shoulder_offset + cfg.envelope_step)).max(0.0);
-    let outside_reach = (d_rho * d_rho + d_z * d_z).sqrt() - cfg.envelope_arm_reach;
-    outside_reach.max(cfg.envelope_min_height - p[2])
+    (d_rho * d_rho + d_z * d_z).sqrt() - cfg.envelope_arm_reach
+}
+
+/// Rule v4: how far `p` lies outside the part of the envelope where the hands can hold
+/// the hazard (≤ 0 inside): the envelope above `envelope_min_height` (lower, the crouched
+/// knees are in front of the hands).
+pub fn catch_excess(spec: &SceneSpec, p: Vec3) -> f64 {
+    envelope_excess(spec, p).max(spec.labels.envelope_min_height - p[2])
 }
 
 /// `p`'s horizontal distance from the torso axis and its height outside the shoulder band
@@ -147,7 +153,8 @@ pub fn approach(
     if from > steps {
         return None;
     }
-    if let Some(k) = in_envelope(spec, sim, from, |_| true) {
+    let inside = |k: u32| envelope_excess(spec, sim.hazard_com(k)) <= 0.0;
+    if let Some(k) = first_near_closest(spec, sim, from, inside) {
         return Some((k, ImpactKind::Envelope));
     }
     let (k, dist) = closest_after(spec, sim, from);
@@ -155,8 +162,9 @@ pub fn approach(
 }
 
 /// Rule v4's impact point from the decision step `from` on: the interception among the
-/// envelope points the hands reach in time ([`time_to_hands`] ≤ the time since `from`),
-/// `Envelope`; else [`approach`]'s, an envelope point then being `EnvelopeLate`.
+/// points where the hands can hold the hazard ([`catch_excess`] ≤ 0) and get in time
+/// ([`time_to_hands`] ≤ the time since `from`), `Envelope`; else [`approach`]'s, an
+/// envelope point then being `EnvelopeLate` (too low or too soon to hold).
 pub fn interception(
     spec: &SceneSpec,
     sim: &Simulation,
@@ -166,9 +174,11 @@ pub fn interception(
     if from > sim.steps() {
         return None;
     }
-    let in_time =
-        |k: u32| time_to_hands(spec, sim.hazard_com(k)) <= (k - from) as f64 * sim.dt + 1e-12;
-    if let Some(k) = in_envelope(spec, sim, from, in_time) {
+    let holdable_in_time = |k: u32| {
+        let p = sim.hazard_com(k);
+        catch_excess(spec, p) <= 0.0 && time_to_hands(spec, p) <= (k - from) as f64 * sim.dt + 1e-12
+    };
+    if let Some(k) = first_near_closest(spec, sim, from, holdable_in_time) {
         return Some((k, ImpactKind::Envelope));
     }
     approach(spec, sim, from, max_distance).map(|(k, kind)| match kind {
@@ -177,18 +187,16 @@ pub fn interception(
     })
 }
 
-/// The first step (≥ `from`) at which the hazard's centre of mass is inside the envelope,
-/// `eligible`, and within `interception_tolerance` of the closest it comes to the torso
-/// axis at such steps.
-fn in_envelope(
+/// The first step (≥ `from`) that is `eligible` and within `interception_tolerance` of the
+/// closest the hazard's centre of mass comes to the torso axis at eligible steps.
+fn first_near_closest(
     spec: &SceneSpec,
     sim: &Simulation,
     from: u32,
-    eligible: impl Fn(u32) -> bool,
+    ok: impl Fn(u32) -> bool,
 ) -> Option<u32> {
     let steps = sim.steps();
     let d = |k: u32| spec.observer.torso_axis_distance(sim.hazard_com(k));
-    let ok = |k: u32| envelope_excess(spec, sim.hazard_com(k)) <= 0.0 && eligible(k);
     let closest = (from..=steps)
         .filter(|&k| ok(k))
         .map(d)
@@ -578,10 +586,10 @@ mod tests {
         assert!(p[0].abs() < 0.01 && (p[1] - 0.4).abs() < 1e-6);
         assert!((l.closest_approach - 0.4).abs() < 1e-3);
         assert!((l.time_to_impact.unwrap() - 2.0).abs() <= s.physics.dt);
-        // Rule v4: 0.46 m below the envelope's lowest height (0.50 m) no hand holds it, so
-        // a benign roller is no CATCH: NO_ACTION when it would not strike the standing
+        // Rule v4: 0.46 m below the lowest height a hand holds anything (0.50 m), so a
+        // benign roller is no CATCH: NO_ACTION when it would not strike the standing
         // body …
-        assert!((envelope_excess(&s, p) - 0.46).abs() < 1e-9);
+        assert!((catch_excess(&s, p) - 0.46).abs() < 1e-9);
         assert!(l.reachable && !l.dangerous && !l.danger_present);
         assert_eq!(l.gt_action, Action::NoAction);
         // … and DODGE when it would (the same roller striking a shank at 1 m/s).
@@ -605,10 +613,12 @@ mod tests {
         assert_eq!(label(&s, &high, None).gt_action, Action::Catch);
         assert_eq!(label(&s, &high, Some(shin)).gt_action, Action::Catch);
         // Carried at 0.45 m it is within an arm's reach of the crouched shoulder (whose
-        // sphere goes down to 0.30 m) but under the envelope's 0.50 m floor: no CATCH.
+        // sphere goes down to 0.30 m), so it reaches the observer there, but under the
+        // 0.50 m a hand holds anything: no CATCH.
         let knee_high = synthetic(&s, 720, |t| [2.0 - 1.0 * t, 0.4, 0.45]);
         let l = label(&s, &knee_high, None);
-        assert_eq!(l.impact_kind, Some(ImpactKind::ClosestApproach));
+        assert_eq!(l.impact_kind, Some(ImpactKind::EnvelopeLate));
+        assert!(envelope_excess(&s, l.impact_point.unwrap()) <= 0.0);
         assert_eq!(l.gt_action, Action::NoAction);
         // Never within reach: no impact point at all.
         let sim = synthetic(&s, 720, |t| [2.0 - 1.0 * t, 2.0, 0.04]);
@@ -680,18 +690,19 @@ mod tests {
         // Straight up from the shoulder, and down from the crouched shoulder.
         assert!(envelope_excess(&s, [0.0, 0.0, sz + reach - 1e-6]) <= 0.0);
         assert!(envelope_excess(&s, [0.0, 0.0, sz + reach + 1e-3]) > 0.0);
-        // Down from the crouched shoulder (0.30 m) only to the envelope's lowest height.
+        // Down to the crouched shoulder's arm reach (0.30 m); the hands hold things only
+        // down to `envelope_min_height` (rule v4).
         let low = sz - s.labels.envelope_crouch - reach;
         let floor = s.labels.envelope_min_height;
         assert!((low - 0.30).abs() < 1e-9 && floor == 0.50);
-        assert!(envelope_excess(&s, [0.0, 0.3, floor + 1e-6]) <= 0.0);
-        assert!((envelope_excess(&s, [0.0, 0.3, floor - 0.1]) - 0.1).abs() < 1e-9);
+        assert!(envelope_excess(&s, [0.0, 0.3, low + 1e-6]) <= 0.0);
         assert!(envelope_excess(&s, [0.0, 0.3, low - 1e-3]) > 0.0);
-        // Without the floor (older specs: absent = 0) the crouched arm's sphere ends it.
+        assert!(catch_excess(&s, [0.0, 0.3, floor + 1e-6]) <= 0.0);
+        assert!((catch_excess(&s, [0.0, 0.3, floor - 0.1]) - 0.1).abs() < 1e-9);
+        // Older specs (no `envelope_min_height`: 0) hold wherever the envelope reaches.
         let mut old = s.clone();
         old.labels.envelope_min_height = 0.0;
-        assert!(envelope_excess(&old, [0.0, 0.3, low + 1e-6]) <= 0.0);
-        assert!(envelope_excess(&old, [0.0, 0.3, low - 1e-3]) > 0.0);
+        assert!(catch_excess(&old, [0.0, 0.3, low + 1e-6]) <= 0.0);
     }
 
     #[test]

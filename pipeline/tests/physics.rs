@@ -354,7 +354,7 @@ fn labels_follow_physics_not_appearance() {
 
     // A steel twin of a light object is dangerous; the real apple is caught.
     let (apple, steel) =
-        twin_labels("thrown_object", "apple", "steel_apple").expect("a reachable layout");
+        twin_labels("object_drop", "apple", "steel_apple").expect("a reachable layout");
     assert_eq!(apple.labels.gt_action, Action::Catch);
     assert!(!apple.labels.dangerous);
     assert_eq!(steel.labels.gt_action, Action::Dodge);

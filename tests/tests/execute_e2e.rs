@@ -105,14 +105,11 @@ fn labels(ds: &Path) -> std::collections::BTreeMap<String, (String, bool)> {
         .collect()
 }
 
-// Issue 14's acceptance targets, asserted as written; they do not hold yet with executor
-// exec-4 (measured on this 340-scene build: oracle CATCH caught 58/146 = 40%, oracle DODGE
-// struck 5/138): 61 of the 146 CATCH labels have their impact point on the floor (z <
-// 0.30 m, below anything the hands reach even crouching: rolling, bouncing, sliding,
-// tumbling objects ending at the feet), a label matter; see README "Execution in
-// physics". Run it with `--ignored`.
+// Issue 14's acceptance targets, asserted as written. Measured on this 340-scene build with
+// label rule v4 and executor exec-4: oracle CATCH caught 66/70 (94%), oracle DODGE struck
+// 0/164. (Rule v3 labelled balls rolling to the feet and knee-high throws no step could
+// reach in time CATCH: 58/146; see README "Execution in physics".)
 #[test]
-#[ignore = "issue 14 target not met: 61/146 CATCH labels have an impact point on the floor, no hand reaches; oracle caught 58/146, DODGE struck 5/138"]
 fn oracle_plans_catch_and_never_get_struck_dodging() {
     let (_tmp, ds) = dataset();
     let work = tempfile::tempdir().unwrap();
