@@ -1,5 +1,5 @@
 //! The `oracle` baseline's plans (`rh-score baseline oracle`): from the scene's ground
-//! truth, a plan that action rule v1 classifies as the ground-truth action and that the
+//! truth, a plan that the action rule classifies as the ground-truth action and that the
 //! humanoid can carry out in physics (`--execute`, SPEC §12) in time.
 //!
 //! * **CATCH** — the base turns to face the impact point and walks straight towards it
@@ -19,6 +19,8 @@
 //!   from the impact point, turned towards the side of the hazard's path the observer is
 //!   already on (the path from the hazard's horizontal motion between Δ and the impact,
 //!   from the dataset's `trajectory` column, when the dataset has it: [`OracleHints`]).
+//!   With the dataset's specs that walk is executed first ([`physics_dodges`]); if it
+//!   would be struck, the first of the label's escape walks that is not replaces it.
 //! * **NO_ACTION** — stand still, hands at rest.
 
 use crate::baseline::{plan, solve_walk};

@@ -294,6 +294,26 @@ pub fn elide_images(v: &Value) -> Value {
 mod tests {
     use super::*;
 
+    /// The canonical prompt's body numbers are the scorer's and executor's (rh-prompt-v4
+    /// tells the model what knee_bend does; action rule v2 and `--execute` do just that).
+    #[test]
+    fn the_prompt_states_the_scoring_body() {
+        let cfg = PromptConfig::load(None).unwrap();
+        let text = system_text(&cfg);
+        let c = crate::config::Config::default();
+        let drop = c.execution.max_pelvis_drop;
+        assert!(
+            text.contains(&format!("by knee_bend x {drop:.2} m")),
+            "{text}"
+        );
+        let low = c.body.pelvis_height - drop;
+        assert!(
+            text.contains(&format!("{low:.2} m above the floor")),
+            "{text}"
+        );
+        assert!(text.contains(&format!("pelvis {:.2} m", c.body.pelvis_height)));
+    }
+
     #[test]
     fn builds_labelled_frames_and_elides_them() {
         let d = tempfile::tempdir().unwrap();
