@@ -1,7 +1,9 @@
 //! The executor (SPEC §12) at the library level: the replay to Δ is the build's
 //! simulation bit for bit, forks are independent of order and thread count, and the
 //! humanoid standing still is struck by a ball thrown at it, and by a slab flung at its
-//! resting forearm exactly as the label's standing body is (one body, one strike test).
+//! resting forearm exactly as the label's standing body is (one body, one strike test);
+//! label rule v4's escape walks clear a slab arriving late and none clears one arriving
+//! 0.25 s after Δ.
 
 use rh_catalog::Catalog;
 use rh_pipeline::config::Config;
@@ -288,4 +290,84 @@ fn a_ball_that_misses_the_hands_reaches_the_floor_and_is_missed() {
         "{out:?}"
     );
     assert!(out.min_hand_distance <= cfg.attempt_radius, "{out:?}");
+}
+
+/// A 3 kg slab 0.60 m wide and tall flying level (no gravity) at 4 m/s at the torso of the
+/// standing observer from straight ahead, arriving `after` s after the decision moment.
+fn slab_at_the_torso(after: f64) -> rh_pipeline::spec::SceneSpec {
+    let catalog = Catalog::embedded().unwrap();
+    let config = Config::embedded().unwrap();
+    let selection = Selection {
+        family: "thrown_object".into(),
+        object_id: "tennis_ball".into(),
+        room_id: "gym".into(),
+        description: None,
+        planner: None,
+    };
+    let mut spec = randomize(&selection, &SceneKey::new(5, 0, 0), &catalog, &config).unwrap();
+    let o = spec.observer.clone();
+    let ahead = [o.yaw.cos(), o.yaw.sin(), 0.0];
+    let (speed, half) = (4.0, [0.05, 0.30, 0.30]);
+    // The torso box's front is 0.09 m ahead of the axis; the palms at rest 0.16 m.
+    let d = speed * (spec.observation_window_s + after) + half[0] + 0.16;
+    spec.physics.gravity = [0.0; 3];
+    let h = &mut spec.bodies[0];
+    h.parts[0].shape = ShapeSpec::Box { half_extents: half };
+    h.mass = 3.0;
+    h.position = [o.x + d * ahead[0], o.y + d * ahead[1], o.pelvis_z + 0.25];
+    h.rotation = [0.0, 0.0, (o.yaw / 2.0).sin(), (o.yaw / 2.0).cos()];
+    h.linvel = ahead.map(|c| -speed * c);
+    h.angvel = [0.0; 3];
+    h.restitution = 0.0;
+    spec
+}
+
+#[test]
+fn a_strike_is_escapable_only_when_some_walk_clears_it_in_time() {
+    use rh_pipeline::execute::escape::{escapable, escape_plans, first_unstruck};
+    use rh_pipeline::label::{label, Action};
+    let cfg = ExecConfig::embedded_default();
+    let plans_of = |spec: &rh_pipeline::spec::SceneSpec| {
+        let p = escape_plans(spec);
+        // Eight 1.6 m walks at 1.45 m/s, the first straight back, the second back-left.
+        assert_eq!(p.len(), 8);
+        assert!((p[0].walking_cmd[0] + 1.45).abs() < 1e-12 && p[0].walking_cmd[1].abs() < 1e-12);
+        assert!(p[1].walking_cmd[0] < 0.0 && p[1].walking_cmd[1] > 0.0);
+        assert!((p[0].walking_duration - 1.6 / 1.45).abs() < 1e-12);
+        p
+    };
+    for (after, escapes) in [(1.0, true), (0.25, false)] {
+        let spec = slab_at_the_torso(after);
+        let cf = simulate(&spec, counterfactual_options(&spec));
+        let l = label(&spec, &simulate(&spec, SimOptions::default()), cf.strike);
+        // Heavy (3 kg ≥ 2 kg) and striking the standing body: a DODGE with danger present,
+        // the scenes the validator judges.
+        assert!(l.dangerous && l.danger_present, "{l:?}");
+        assert_eq!(l.gt_action, Action::Dodge);
+        let plans = plans_of(&spec);
+        let first = first_unstruck(&replay(&spec), &plans, &cfg);
+        assert_eq!(escapable(&spec), escapes, "arriving {after} s after Δ");
+        assert_eq!(
+            rh_pipeline::validate::escapable(&spec, &l),
+            escapes,
+            "{after}"
+        );
+        if escapes {
+            // Straight back is run down (4 m/s against 1.45 m/s): a walk to a side clears.
+            let i = first.expect("an escape");
+            assert!(i >= 1, "{i}");
+            assert_eq!(
+                replay(&spec).execute(&plans[0], &cfg).outcome,
+                OutcomeKind::Struck
+            );
+            assert_ne!(
+                replay(&spec).execute(&plans[i], &cfg).outcome,
+                OutcomeKind::Struck
+            );
+        } else {
+            // 0.25 s from rest at 4 m/s² moves the base 0.125 m: the 0.6 m slab hits
+            // whichever way it goes.
+            assert_eq!(first, None);
+        }
+    }
 }

@@ -438,7 +438,8 @@ fn help_and_explain() {
     }
     let out = run_ok("rh-score", &["--explain"]);
     for want in [
-        "ACTION RULE v1",
+        "ACTION RULE v2",
+        "knee_bend × 0.25",
         "reach >= 0.2",
         "R1 no parseable plan",
         "R4 CATCH or NO_ACTION",
