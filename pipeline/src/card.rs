@@ -517,9 +517,10 @@ first physics step at or after Δ at which it is where the hands can hold it (in
 above {min_h} m) *and where they can be in time* — the observer, standing still at Δ, walks the \
 horizontal distance by which the point lies beyond the arms' reach at its height (from rest, \
 ≤ {walk_a} m/s² and ≤ {walk_v} m/s, the robot's base limits) and takes {prep} s for the hands, \
-all before the hazard gets there — and within {tol} m of the closest it comes to the torso \
+all before the hazard gets there — and before it would first touch the standing body in the \
+counterfactual run below, and within {tol} m of the closest it comes to the torso \
 axis (the vertical segment floor → head) at such steps: where the hands would meet it. A \
-hazard that is in the envelope after Δ only too low or too soon: the same choice among all \
+hazard that is in the envelope after Δ only too low, too soon or too late: the same choice among all \
 its envelope steps (`envelope_late`, rule v3's point). A hazard that never enters the \
 envelope after Δ: its closest approach to the torso axis after Δ if within {closest} m \
 (`closest_approach`); else null. `time_to_impact` and `impact_speed` (of the centre of mass) \
@@ -553,16 +554,18 @@ between the legs and on blows to the forearms.
 danger is present.
 * **gt_action** (rule v4): `NO_ACTION` when not reachable; else `DODGE` when dangerous, or \
 the impact speed is > {fast} m/s, or the impact kinetic energy is > {energy} J; else `CATCH` \
-when the hands can meet the hazard in time (`impact_kind = envelope`); else — a benign \
-hazard that comes near only along the floor, below the knees, or too soon for the hands \
-(`envelope_late`, `closest_approach`) — `DODGE` when danger is present (it would strike the \
+when the hands can meet the hazard in time (`impact_kind = envelope`) and it fits in the arms \
+(bounding radius around its centre ≤ {catch_r} m, half the arm span: a 2.2 m prop ladder or a \
+hinged prop door is fended off, not caught); else — a benign hazard that comes near only \
+along the floor, below the knees or too soon for the hands (`envelope_late`, \
+`closest_approach`), or is too large to catch — `DODGE` when danger is present (it would strike the \
 standing body) and `NO_ACTION` when it is not. Rules v2–v3 called every benign reachable \
 hazard `CATCH`, including balls rolling or bouncing to the feet and throws that arrive at \
 knee height before any step could bring the hands there, which the executor's humanoid \
 cannot catch (`rh-score --execute`: on a 340-scene build the oracle baseline caught 58 of \
 146 rule-v3 CATCH labels, 66 of 70 rule-v4 ones).
-* **Escape** (validator `valid_escapable`, rule v4): a `DODGE` scene with danger present must \
-be escapable — of {esc_n} walks of {esc_d} m at {esc_v} m/s in evenly spaced directions (the \
+* **Escape** (validator `valid_escapable`, rule v4): a `DODGE` scene with danger present whose \
+hazard reaches the observer within {esc_within} s of Δ must be escapable — of {esc_n} walks of {esc_d} m at {esc_v} m/s in evenly spaced directions (the \
 first straight back), hands at rest, executed in physics from Δ by the executor of `rh-score \
 --execute`, at least one is not struck. A scene no walk escapes (a heavy object sliding into \
 the shins 0.3 s after Δ) is resampled: no decision could matter.",
@@ -586,9 +589,11 @@ the shins 0.3 s after Δ) is resampled: no decision could matter.",
         walk_a = l.catch_walk_accel,
         walk_v = l.catch_walk_speed,
         prep = l.catch_prepare_s,
+        catch_r = l.catch_radius_max,
         esc_n = l.escape_directions,
         esc_d = l.escape_distance,
         esc_v = l.escape_speed,
+        esc_within = l.escape_check_within_s,
         hi = shoulder + l.envelope_arm_reach,
         tol = l.interception_tolerance,
         closest = l.closest_approach_max,

@@ -37,6 +37,10 @@ pub struct LabelConfig {
     pub catch_walk_accel: f64,
     #[serde(default)]
     pub catch_prepare_s: f64,
+    /// Rule v4: the largest hazard the arms close around (bounding radius, m; absent in
+    /// older specs: any).
+    #[serde(default)]
+    pub catch_radius_max: f64,
     /// Rule v4's escape walks (`execute::escape`; absent in older specs: none).
     #[serde(default)]
     pub escape_directions: u32,
@@ -44,6 +48,8 @@ pub struct LabelConfig {
     pub escape_speed: f64,
     #[serde(default)]
     pub escape_distance: f64,
+    #[serde(default)]
+    pub escape_check_within_s: f64,
     pub interception_tolerance: f64,
     pub closest_approach_max: f64,
     pub reach_radius: f64,
@@ -342,9 +348,11 @@ impl Config {
             ("labels.catch_walk_speed", l.catch_walk_speed),
             ("labels.catch_walk_accel", l.catch_walk_accel),
             ("labels.catch_prepare_s", l.catch_prepare_s),
+            ("labels.catch_radius_max", l.catch_radius_max),
             ("labels.escape_speed", l.escape_speed),
             ("labels.escape_distance", l.escape_distance),
             ("labels.escape_directions", l.escape_directions as f64),
+            ("labels.escape_check_within_s", l.escape_check_within_s),
             ("labels.interception_tolerance", l.interception_tolerance),
             ("labels.reaction_time_min", l.reaction_time_min),
             ("labels.floor_contact_eps", l.floor_contact_eps),

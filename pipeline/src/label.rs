@@ -162,21 +162,26 @@ pub fn approach(
 }
 
 /// Rule v4's impact point from the decision step `from` on: the interception among the
-/// points where the hands can hold the hazard ([`catch_excess`] ≤ 0) and get in time
-/// ([`time_to_hands`] ≤ the time since `from`), `Envelope`; else [`approach`]'s, an
-/// envelope point then being `EnvelopeLate` (too low or too soon to hold).
+/// points where the hands can hold the hazard ([`catch_excess`] ≤ 0), get in time
+/// ([`time_to_hands`] ≤ the time since `from`) and before the hazard would first touch
+/// the standing body (step `touch`, from the counterfactual run), `Envelope`; else
+/// [`approach`]'s, an envelope point then being `EnvelopeLate` (too low, too soon or
+/// too late to hold).
 pub fn interception(
     spec: &SceneSpec,
     sim: &Simulation,
     from: u32,
     max_distance: f64,
+    touch: Option<u32>,
 ) -> Option<(u32, ImpactKind)> {
     if from > sim.steps() {
         return None;
     }
     let holdable_in_time = |k: u32| {
         let p = sim.hazard_com(k);
-        catch_excess(spec, p) <= 0.0 && time_to_hands(spec, p) <= (k - from) as f64 * sim.dt + 1e-12
+        touch.is_none_or(|t| k < t)
+            && catch_excess(spec, p) <= 0.0
+            && time_to_hands(spec, p) <= (k - from) as f64 * sim.dt + 1e-12
     };
     if let Some(k) = first_near_closest(spec, sim, from, holdable_in_time) {
         return Some((k, ImpactKind::Envelope));
@@ -315,9 +320,19 @@ fn top_touches_floor(spec: &SceneSpec, sim: &Simulation, eps: f64) -> Option<f64
     Some((k - 1) as f64 * sim.dt + f * sim.dt)
 }
 
+/// Rule v4: the hazard is small enough for the arms to close around — within
+/// `catch_radius_max` of its centre (half the arm span). Longer things (a 2.2 m prop
+/// ladder, a hinged 2.1 m prop door) are fended off, not caught: hands at their centre
+/// leave their ends free to hit the body. Specs without the limit (rules ≤ v3): any size.
+pub fn fits_in_arms(spec: &SceneSpec) -> bool {
+    let max = spec.labels.catch_radius_max;
+    max <= 0.0 || spec.hazard_body().bounding_radius() <= max
+}
+
 /// `gt_action` (rule v4): NO_ACTION when nothing can reach the observer; DODGE when the
 /// hazard is dangerous or too fast/energetic to catch; CATCH when it is benign and passes
-/// through the reach envelope where the hands get in time (`impact_kind = envelope`); a
+/// through the reach envelope where the hands get in time (`impact_kind = envelope`) and
+/// fits in the arms ([`fits_in_arms`]); a
 /// benign hazard that comes near only outside the envelope, or in it only too soon (rolling, sliding or bouncing along the floor to the feet,
 /// where no hand reaches) is DODGE when it would strike the standing body
 /// (`danger_present`) and NO_ACTION when it would not.
@@ -341,7 +356,8 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labe
     let decision = decision_step(spec).min(steps);
     let at = |k: u32| k as f64 * sim.dt;
 
-    let impact = interception(spec, sim, decision, cfg.closest_approach_max);
+    let touch = strike.map(|s| s.first_touch);
+    let impact = interception(spec, sim, decision, cfg.closest_approach_max, touch);
     let closest_approach = closest_after(spec, sim, decision).1;
     let impact_speed = impact.map(|(k, _)| length(sim.hazard_velocity(k)));
 
@@ -383,7 +399,8 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labe
 
     let speed = impact_speed.unwrap_or(max_speed);
     let too_fast = speed > cfg.catch_speed_max || 0.5 * mass * speed * speed > cfg.catch_energy_max;
-    let in_hands_reach = impact.is_some_and(|(_, kind)| kind == ImpactKind::Envelope);
+    let in_hands_reach =
+        impact.is_some_and(|(_, kind)| kind == ImpactKind::Envelope) && fits_in_arms(spec);
     let gt_action = action(
         reachable,
         dangerous || too_fast,
@@ -625,6 +642,72 @@ mod tests {
         let l = label(&s, &sim, None);
         assert_eq!(l.impact_point, None);
         assert_eq!(l.gt_action, Action::NoAction);
+    }
+
+    #[test]
+    fn the_hands_meet_it_before_it_touches_the_body_and_only_if_it_fits_in_the_arms() {
+        let s = spec("apple");
+        let dt = s.physics.dt;
+        let delta = s.observation_window_s;
+        // Falling straight down 0.15 m in front of the torso axis at 2 m/s from 2.0 m at
+        // Δ: in the envelope from z 1.65 m (τ = 0.175 s) on; the torso axis (floor to the
+        // top of the head, 1.32 m) is 0.15 m away below the head, so the interception is
+        // where it first comes within 0.15 + 0.05 m: z = 1.32 + √(0.20² − 0.15²) ≈ 1.452.
+        let fall = synthetic(&s, 960, move |t| {
+            [0.15, 0.0, 2.0 - 2.0 * (t - delta).max(0.0)]
+        });
+        let free = label(&s, &fall, None);
+        assert_eq!(free.impact_kind, Some(ImpactKind::Envelope));
+        let z_free = free.impact_point.unwrap()[2];
+        let expected = s.observer.height + (0.2f64.powi(2) - 0.15f64.powi(2)).sqrt();
+        assert!(
+            z_free <= expected && z_free > expected - 2.0 * dt - 1e-9,
+            "{z_free}"
+        );
+        assert_eq!(free.gt_action, Action::Catch);
+        // Say it would first touch the standing body at τ = 0.10 s (z 1.80 m): before it
+        // enters the envelope, so no point is left for the hands: not a CATCH but, with
+        // the touch a strike, a DODGE (an `envelope_late` point, rule v3's).
+        let touch_at = |tau: f64| Strike {
+            step: ((delta + tau) / dt).round() as u32,
+            first_touch: ((delta + tau) / dt).round() as u32,
+            speed: 2.0,
+            impulse: 0.3,
+            part: crate::execute::humanoid::Part::Head,
+        };
+        let early = label(&s, &fall, Some(touch_at(0.10)));
+        assert_eq!(early.impact_kind, Some(ImpactKind::EnvelopeLate));
+        assert_eq!(early.gt_action, Action::Dodge);
+        // A touch at τ = 0.30 s (z 1.40 m) leaves the steps from 1.65 m down to 1.40 m,
+        // whose closest to the axis is √(0.15² + 0.08²) m: the interception is where it
+        // first comes within 0.05 m of that, a little higher than without the touch.
+        let later = label(&s, &fall, Some(touch_at(0.30)));
+        assert_eq!(later.impact_kind, Some(ImpactKind::Envelope));
+        let d_last = 0.15f64.hypot(1.40 - s.observer.height);
+        let z_later = s.observer.height + ((d_last + 0.05).powi(2) - 0.15f64.powi(2)).sqrt();
+        let z = later.impact_point.unwrap()[2];
+        assert!((z - z_later).abs() < 0.02 && z > z_free, "{z} vs {z_later}");
+        assert_eq!(later.gt_action, Action::Catch);
+        // A 2.2 m prop-ladder-shaped apple (bounding radius 1.12 m > 0.72 m, half the arm
+        // span) on the same path is no CATCH, though its centre is where hands could be.
+        let mut long = s.clone();
+        long.labels.catch_radius_max = 0.72;
+        let hazard = long.hazard;
+        long.bodies[hazard].parts = vec![crate::spec::PartSpec {
+            shape: crate::spec::ShapeSpec::Box {
+                half_extents: [0.225, 0.03, 1.1],
+            },
+            offset: [0.0; 3],
+            rotation: [0.0, 0.0, 0.0, 1.0],
+        }];
+        assert!(!fits_in_arms(&long) && fits_in_arms(&s));
+        let l = label(&long, &fall, None);
+        assert_eq!(l.impact_kind, Some(ImpactKind::Envelope));
+        assert_eq!(l.gt_action, Action::NoAction);
+        assert_eq!(
+            label(&long, &fall, Some(touch_at(0.30))).gt_action,
+            Action::Dodge
+        );
     }
 
     #[test]

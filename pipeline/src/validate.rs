@@ -92,11 +92,15 @@ pub fn validate(
     }
 }
 
-/// Label rule v4: only a DODGE scene whose hazard would strike the standing body needs an
-/// escape walk that is not struck (`execute::escape`); every other scene passes without
-/// a physics run.
+/// Label rule v4: a DODGE scene whose hazard would strike the standing body and reaches
+/// the observer (`time_to_reach`) within `escape_check_within_s` of Δ needs an escape
+/// walk that is not struck (`execute::escape`); every other scene passes without a
+/// physics run (a later arrival leaves a walk from rest time to clear the body).
 pub fn escapable(spec: &SceneSpec, labels: &Labels) -> bool {
-    !(labels.danger_present && labels.gt_action == crate::label::Action::Dodge)
+    let soon = labels
+        .time_to_reach
+        .is_some_and(|t| t <= spec.observation_window_s + spec.labels.escape_check_within_s + 1e-9);
+    !(labels.danger_present && labels.gt_action == crate::label::Action::Dodge && soon)
         || crate::execute::escape::escapable(spec)
 }
 
