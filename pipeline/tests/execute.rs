@@ -182,13 +182,14 @@ fn cupped_hands() -> ExecPlan {
     }
 }
 
-#[test]
-fn a_slab_flung_at_the_resting_forearm_strikes_label_and_freeze_alike() {
-    // A 1.5 kg slab flies sideways (no gravity) at 3 m/s into the left forearm of the
-    // body standing at rest, arriving 0.35 s after the decision moment. Rule v3: the
-    // forearm is part of the standing body, so it is a strike (≈ 4.5 N·s, under the
-    // 6 N·s a *reaching* hand would need); the executor's freeze plan is the same body
-    // and the same test, so it is struck on the same part.
+/// A thrown-object scene (gym, tennis ball) without gravity, its hazard replaced by a box
+/// slab of `half` extents and `mass` kg at `position`, turned with the observer and flying
+/// at `velocity` from t = 0 without spin or bounce.
+fn flung_slab(
+    half: [f64; 3],
+    mass: f64,
+    place: impl FnOnce(&rh_pipeline::spec::SceneSpec) -> ([f64; 3], [f64; 3]),
+) -> rh_pipeline::spec::SceneSpec {
     let catalog = Catalog::embedded().unwrap();
     let config = Config::embedded().unwrap();
     let selection = Selection {
@@ -199,22 +200,41 @@ fn a_slab_flung_at_the_resting_forearm_strikes_label_and_freeze_alike() {
         planner: None,
     };
     let mut spec = randomize(&selection, &SceneKey::new(5, 0, 0), &catalog, &config).unwrap();
-    let o = &spec.observer;
-    let g = Geometry::of(o);
-    let forearm = g.link_poses(&g.rest_pose([o.x, o.y, o.yaw]))[Part::LeftForearm as usize];
-    let left = [-o.yaw.sin(), o.yaw.cos(), 0.0];
-    let (speed, half) = (3.0, [0.04, 0.01, 0.03]);
-    let t_hit = spec.observation_window_s + 0.35;
-    let d = speed * t_hit + half[1] + 0.035;
+    let (position, velocity) = place(&spec);
+    let yaw = spec.observer.yaw;
     spec.physics.gravity = [0.0; 3];
     let h = &mut spec.bodies[0];
     h.parts[0].shape = ShapeSpec::Box { half_extents: half };
-    h.mass = 1.5;
-    h.position = [0, 1, 2].map(|i| forearm.position[i] + d * left[i]);
-    h.rotation = [0.0, 0.0, (o.yaw / 2.0).sin(), (o.yaw / 2.0).cos()];
-    h.linvel = left.map(|c| -speed * c);
+    h.mass = mass;
+    h.position = position;
+    h.rotation = [0.0, 0.0, (yaw / 2.0).sin(), (yaw / 2.0).cos()];
+    h.linvel = velocity;
     h.angvel = [0.0; 3];
     h.restitution = 0.0;
+    spec
+}
+
+#[test]
+fn a_slab_flung_at_the_resting_forearm_strikes_label_and_freeze_alike() {
+    // A 1.5 kg slab flies sideways (no gravity) at 3 m/s into the left forearm of the
+    // body standing at rest, arriving 0.35 s after the decision moment. Rule v3: the
+    // forearm is part of the standing body, so it is a strike (≈ 4.5 N·s, under the
+    // 6 N·s a *reaching* hand would need); the executor's freeze plan is the same body
+    // and the same test, so it is struck on the same part.
+    let (speed, half) = (3.0, [0.04, 0.01, 0.03]);
+    let mut t_hit = 0.0;
+    let spec = flung_slab(half, 1.5, |spec| {
+        let o = &spec.observer;
+        let g = Geometry::of(o);
+        let forearm = g.link_poses(&g.rest_pose([o.x, o.y, o.yaw]))[Part::LeftForearm as usize];
+        let left = [-o.yaw.sin(), o.yaw.cos(), 0.0];
+        t_hit = spec.observation_window_s + 0.35;
+        let d = speed * t_hit + half[1] + 0.035;
+        (
+            [0, 1, 2].map(|i| forearm.position[i] + d * left[i]),
+            left.map(|c| -speed * c),
+        )
+    });
 
     let cf = simulate(&spec, counterfactual_options(&spec));
     let s = cf.strike.expect("the slab meets the forearm");
@@ -295,31 +315,17 @@ fn a_ball_that_misses_the_hands_reaches_the_floor_and_is_missed() {
 /// A 3 kg slab 0.60 m wide and tall flying level (no gravity) at 4 m/s at the torso of the
 /// standing observer from straight ahead, arriving `after` s after the decision moment.
 fn slab_at_the_torso(after: f64) -> rh_pipeline::spec::SceneSpec {
-    let catalog = Catalog::embedded().unwrap();
-    let config = Config::embedded().unwrap();
-    let selection = Selection {
-        family: "thrown_object".into(),
-        object_id: "tennis_ball".into(),
-        room_id: "gym".into(),
-        description: None,
-        planner: None,
-    };
-    let mut spec = randomize(&selection, &SceneKey::new(5, 0, 0), &catalog, &config).unwrap();
-    let o = spec.observer.clone();
-    let ahead = [o.yaw.cos(), o.yaw.sin(), 0.0];
     let (speed, half) = (4.0, [0.05, 0.30, 0.30]);
-    // The torso box's front is 0.09 m ahead of the axis; the palms at rest 0.16 m.
-    let d = speed * (spec.observation_window_s + after) + half[0] + 0.16;
-    spec.physics.gravity = [0.0; 3];
-    let h = &mut spec.bodies[0];
-    h.parts[0].shape = ShapeSpec::Box { half_extents: half };
-    h.mass = 3.0;
-    h.position = [o.x + d * ahead[0], o.y + d * ahead[1], o.pelvis_z + 0.25];
-    h.rotation = [0.0, 0.0, (o.yaw / 2.0).sin(), (o.yaw / 2.0).cos()];
-    h.linvel = ahead.map(|c| -speed * c);
-    h.angvel = [0.0; 3];
-    h.restitution = 0.0;
-    spec
+    flung_slab(half, 3.0, |spec| {
+        let o = &spec.observer;
+        let ahead = [o.yaw.cos(), o.yaw.sin(), 0.0];
+        // The torso box's front is 0.09 m ahead of the axis; the palms at rest 0.16 m.
+        let d = speed * (spec.observation_window_s + after) + half[0] + 0.16;
+        (
+            [o.x + d * ahead[0], o.y + d * ahead[1], o.pelvis_z + 0.25],
+            ahead.map(|c| -speed * c),
+        )
+    })
 }
 
 #[test]
