@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end test of dataset/slurm_build.sbatch on a real, one-node Slurm cluster on
+# End-to-end test of cluster/slurm_build.sbatch on a real, one-node Slurm cluster on
 # localhost (called by tests/tests/slurm_cluster.rs; runs alone as well):
 #
 #   bash scripts/slurm_cluster_test.sh [BIN_DIR]      # BIN_DIR holds rh-pipeline [target/release]
@@ -7,7 +7,7 @@
 # 1. starts munged (a generated key), slurmctld and slurmd from a generated slurm.conf;
 #    every state, spool, log, pid and socket file lives in one temp dir, the ports are free
 #    ones on 127.0.0.1;
-# 2. submits the project's own dataset/slurm_build.sbatch, unchanged, as a 4-task job array
+# 2. submits the project's own cluster/slurm_build.sbatch, unchanged, as a 4-task job array
 #    of a label-only build (RH_N scenes), cancels task 0 (`scancel`) once it has finished
 #    some but not all of its scene groups, lets the other tasks finish, resubmits task 0
 #    and checks that it says it resumed;
@@ -162,7 +162,7 @@ cd "$T/work"
 export RH_N="$N" RH_SEED="$SEED" RH_SHARDS=4 RH_SHARD_DIR="$T/work/shards"
 export RH_PIPELINE="$bin_dir/rh-pipeline" RH_BUILD_ARGS="--no-render"
 # Only the resources are scaled down to this machine (the file asks for 8 CPUs and 8 GB).
-submit() { sbatch --parsable --array="$1" --cpus-per-task=1 --mem=256M --time=10:00 "$repo/dataset/slurm_build.sbatch"; }
+submit() { sbatch --parsable --array="$1" --cpus-per-task=1 --mem=256M --time=10:00 "$repo/cluster/slurm_build.sbatch"; }
 job="$(submit 0-3)"
 echo "slurm e2e: submitted array job $job (tasks 0-3, $N scenes, seed $SEED)"
 

@@ -13,7 +13,9 @@
 
 pub mod action;
 pub mod columns;
+pub mod execution;
 pub mod families;
+pub mod fsio;
 pub mod layout;
 
 #[cfg(feature = "arrow")]

@@ -302,14 +302,7 @@ fn file_name(p: &Path) -> String {
         .unwrap_or_else(|| "file".into())
 }
 
-/// Writes `bytes` to a temporary sibling, then renames it onto `path`.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let parent = path.parent().expect("a file has a parent");
-    std::fs::create_dir_all(parent)?;
-    let tmp = parent.join(format!(".{}.{}.tmp", file_name(path), std::process::id()));
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(&tmp, path)
-}
+pub use rh_contract::fsio::write_atomic;
 
 #[cfg(unix)]
 fn symlink(target: &Path, link: &Path) -> std::io::Result<()> {

@@ -348,16 +348,12 @@ pub fn copy_snapshot(snapshot: &Path, out: &Path) -> std::io::Result<usize> {
                 stack.push(path);
                 continue;
             }
-            let dest = out.join(rel);
-            let parent = dest.parent().expect("a file has a parent");
-            std::fs::create_dir_all(parent)?;
-            let tmp = parent.join(format!(
-                ".{}.{}.tmp",
-                dest.file_name().and_then(|n| n.to_str()).unwrap_or("file"),
-                std::process::id()
-            ));
-            std::fs::copy(&path, &tmp)?;
-            std::fs::rename(&tmp, &dest)?;
+            let dest = rh_contract::fsio::Unsynced::at(&out.join(rel))?;
+            if let Err(e) = std::fs::copy(&path, dest.temp()) {
+                dest.discard();
+                return Err(e);
+            }
+            dest.commit()?;
             count += 1;
         }
     }

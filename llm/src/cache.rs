@@ -71,13 +71,8 @@ impl Cache {
 
     /// Stores an answer; failures are reported to the caller, who may ignore them.
     pub fn put(&self, key: &str, reply: &Reply) -> std::io::Result<()> {
-        let path = self.path(key);
-        let dir = path.parent().expect("entry has a parent");
-        std::fs::create_dir_all(dir)?;
-        let tmp = dir.join(format!(".{key}.{}.tmp", std::process::id()));
         let mut stored = reply.clone();
         stored.cached = false;
-        std::fs::write(&tmp, serde_json::to_vec(&stored)?)?;
-        std::fs::rename(&tmp, &path)
+        rh_contract::fsio::write_atomic(&self.path(key), &serde_json::to_vec(&stored)?)
     }
 }

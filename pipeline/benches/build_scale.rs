@@ -10,9 +10,9 @@
 
 use rayon::prelude::*;
 use rh_catalog::Catalog;
-use rh_pipeline::config::Config;
-use rh_pipeline::scene::produce_group;
-use rh_pipeline::selection::plan_group;
+use rh_scenes::config::Config;
+use rh_scenes::driver::produce_group;
+use rh_scenes::selection::plan_group;
 use std::process::Command;
 use std::time::Instant;
 

@@ -18,16 +18,18 @@
 //! writes the same bytes: finished and fresh groups reach the final table by the same
 //! path (their records). The directory is locked (`flock`) while a build runs in it.
 
-use crate::card;
-use crate::config::Config;
-use crate::dataset;
-use crate::families;
-use crate::integrity::{self, FileSums};
-use crate::manifest::{Manifest, MANIFEST_FILE};
-pub use crate::records::FamilyRejections;
-use crate::records::{gather_rejections, group_files, load_record, reopen_if_damaged};
-pub use crate::records::{record_path, WORK_DIR};
-use crate::scene::{run_group, GroupError, RenderStage};
+use rh_dataset::card;
+use rh_scenes::config::Config;
+use rh_dataset::table;
+use rh_scenes::families;
+use rh_dataset::finalize::{finalize, RowSink};
+pub use rh_dataset::finalize::BuildError;
+use rh_dataset::integrity;
+use rh_dataset::manifest::{Manifest, MANIFEST_FILE};
+pub use rh_dataset::records::FamilyRejections;
+use rh_dataset::records::{gather_rejections, group_files, load_record, reopen_if_damaged};
+pub use rh_dataset::records::{record_path, WORK_DIR};
+use rh_scenes::driver::{run_group, GroupError, RenderStage};
 use arrow::array::RecordBatch;
 use rayon::prelude::*;
 use rh_catalog::Catalog;
@@ -45,7 +47,7 @@ pub struct BuildOptions {
     pub families: Vec<String>,
     /// Planned selections (from descriptions): group `g` takes `selections[g mod len]`
     /// instead of the embedded round-robin planner.
-    pub selections: Option<Vec<crate::spec::Selection>>,
+    pub selections: Option<Vec<rh_physics::spec::Selection>>,
     pub jobs: usize,
     /// `(i, N)`: build only the groups `g` with `g mod N == i`.
     pub shard: (u64, u64),
@@ -53,16 +55,6 @@ pub struct BuildOptions {
     /// Also write the observation frames' instance-id and depth PNGs (needs `render`).
     pub masks: bool,
     pub progress: bool,
-}
-
-#[derive(Debug, thiserror::Error)]
-pub enum BuildError {
-    /// Bad arguments or unusable output directory (exit 2).
-    #[error("{0}")]
-    Input(String),
-    /// A failure of this program (exit 1).
-    #[error("internal error: {0}")]
-    Internal(String),
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -125,7 +117,7 @@ pub fn check_options(
         if families::get(f).is_none() {
             return Err(BuildError::Input(format!(
                 "family '{f}' is not implemented in this build (implemented: {})",
-                crate::randomize::implemented_families()
+                rh_scenes::randomize::implemented_families()
             )));
         }
         if config.speed_bands(f).is_none() {
@@ -203,7 +195,7 @@ fn internal(path: &Path, e: impl std::fmt::Display) -> BuildError {
 /// while a few threads wait on the disk (fsync is I/O wait, not CPU: done inline it took
 /// 10-30% of a label-only build on a busy disk). At most `SYNC_BACKLOG` groups wait.
 struct Syncer {
-    tx: Option<std::sync::mpsc::SyncSender<Vec<crate::fsio::Unsynced>>>,
+    tx: Option<std::sync::mpsc::SyncSender<Vec<rh_contract::fsio::Unsynced>>>,
     threads: Vec<std::thread::JoinHandle<Result<(), BuildError>>>,
 }
 
@@ -212,7 +204,7 @@ const SYNC_BACKLOG: usize = 32;
 
 impl Syncer {
     fn start() -> Syncer {
-        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<crate::fsio::Unsynced>>(SYNC_BACKLOG);
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<rh_contract::fsio::Unsynced>>(SYNC_BACKLOG);
         let rx = std::sync::Arc::new(std::sync::Mutex::new(rx));
         let threads = (0..SYNC_THREADS)
             .map(|_| {
@@ -233,7 +225,7 @@ impl Syncer {
         }
     }
 
-    fn submit(&self, files: Vec<crate::fsio::Unsynced>) -> Result<(), BuildError> {
+    fn submit(&self, files: Vec<rh_contract::fsio::Unsynced>) -> Result<(), BuildError> {
         let tx = self.tx.as_ref().expect("open until finish");
         tx.send(files)
             .map_err(|_| BuildError::Internal("the file syncer stopped".into()))
@@ -351,11 +343,11 @@ pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError
                     if present.len() > 5 { ", …" } else { "" }
                 )));
             }
-            dataset::write_atomic(&out.join(MANIFEST_FILE), manifest.to_json().as_bytes())
+            table::write_atomic(&out.join(MANIFEST_FILE), manifest.to_json().as_bytes())
                 .map_err(fail)?;
         }
     }
-    let data = out.join(dataset::data_file_name(
+    let data = out.join(table::data_file_name(
         manifest.shard[0] as usize,
         manifest.shard[1] as usize,
     ));
@@ -381,7 +373,7 @@ fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<Option<Str
     #[cfg(feature = "render")]
     {
         let renderer =
-            crate::render::Renderer::new(crate::render::RenderOptions::from_config(&config.render))
+            rh_render::Renderer::new(rh_render::RenderOptions::from_config(&config.render))
                 .map_err(|e| {
                     BuildError::Input(format!("render stage: {e} (or build with --no-render)"))
                 })?;
@@ -424,8 +416,8 @@ fn finished_build(
             out.display()
         );
     }
-    let data_file = dataset::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
-    let rows = dataset::read_columns(&out.join(&data_file), &dataset::SUMMARY_COLUMNS)
+    let data_file = table::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
+    let rows = table::read_columns(&out.join(&data_file), &table::SUMMARY_COLUMNS)
         .map_err(BuildError::Internal)?;
     let eval = out
         .join(card::EVAL_FILE)
@@ -463,7 +455,7 @@ pub fn build(
     let complete = claim_out_dir(out, &manifest)?;
     remove_stale_temporaries(out);
     interrupt::say_resume_on_interrupt(out);
-    let data_file = dataset::data_file_name(opts.shard.0 as usize, opts.shard.1 as usize);
+    let data_file = table::data_file_name(opts.shard.0 as usize, opts.shard.1 as usize);
     let groups = manifest.groups();
 
     if let Some(summary) = finished_build(out, &manifest, complete, opts.progress)? {
@@ -486,13 +478,13 @@ pub fn build(
 
     // Stage 4 for the DAG driver (`scene::run_group`): a valid scene's videos and frames.
     #[cfg(feature = "render")]
-    let render_opts = crate::render::RenderOptions {
+    let render_opts = rh_render::RenderOptions {
         masks: opts.masks,
-        ..crate::render::RenderOptions::from_config(&config.render)
+        ..rh_render::RenderOptions::from_config(&config.render)
     };
     #[cfg(feature = "render")]
-    let render_stage = |r: &crate::scene::SceneResult| {
-        crate::render::render_stage(r, catalog, &render_opts, out)
+    let render_stage = |r: &rh_scenes::driver::SceneResult| {
+        rh_render::render_stage(r, catalog, &render_opts, out)
             .map_err(|e| format!("render {}: {e}", r.spec.scene_id))
     };
     #[cfg(feature = "render")]
@@ -547,11 +539,11 @@ pub fn build(
     // at a time, so memory does not grow with --n.
     let records = |f: &mut RowSink| -> Result<(), BuildError> {
         for &g in &groups {
-            f(dataset::read_batch(&record_path(out, g)).map_err(BuildError::Internal)?)?;
+            f(table::read_batch(&record_path(out, g)).map_err(BuildError::Internal)?)?;
         }
         Ok(())
     };
-    let sums = crate::records::gather_sums(out, &groups).map_err(BuildError::Internal)?;
+    let sums = rh_dataset::records::gather_sums(out, &groups).map_err(BuildError::Internal)?;
     let rejections = gather_rejections(out, &groups);
     let (rows, eval) = finalize(out, &manifest, &records, sums)?;
     // Retire the records in one atomic step (a rename), then delete them: a crash in
@@ -565,103 +557,6 @@ pub fn build(
     Ok(summary)
 }
 
-/// Receives a dataset's rows, a batch at a time.
-pub type RowSink<'a> = dyn FnMut(RecordBatch) -> Result<(), BuildError> + 'a;
-
-/// Feeds every row of a dataset, in scene-index order, to the sink; may be called more
-/// than once and must give the same rows each time.
-pub type RowSource<'a> = dyn Fn(&mut RowSink) -> Result<(), BuildError> + 'a;
-
-/// Writes the dataset's final files from its rows (in scene-index order, streamed from
-/// `rows`): the data Parquet (row group by row group), the eval subset (whole builds; a
-/// second pass over the rows picks it), and the card. Memory stays flat in the number of
-/// rows but for `dataset::SUMMARY_COLUMNS`, which it returns (every row, those columns)
-/// with the eval subset's size. Then it writes `build.json` again, now with the SHA-256
-/// of every file (`sums`: the groups' specs and media, plus the files written here).
-pub fn finalize(
-    out: &Path,
-    manifest: &Manifest,
-    rows: &RowSource,
-    mut sums: FileSums,
-) -> Result<(RecordBatch, Option<usize>), BuildError> {
-    let data_file = dataset::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
-    let data_path = out.join(&data_file);
-    let mut data = dataset::ParquetStream::create(&data_path).map_err(BuildError::Internal)?;
-    let summary_schema = dataset::project(
-        &RecordBatch::new_empty(std::sync::Arc::new(dataset::schema())),
-        &dataset::SUMMARY_COLUMNS,
-    )
-    .schema();
-    let compact = |parts: &[RecordBatch]| {
-        arrow::compute::concat_batches(&summary_schema, parts)
-            .map_err(|e| BuildError::Internal(e.to_string()))
-    };
-    let mut summary: Vec<RecordBatch> = Vec::new();
-    rows(&mut |batch| {
-        data.write(&batch).map_err(BuildError::Internal)?;
-        summary.push(dataset::project(&batch, &dataset::SUMMARY_COLUMNS));
-        if summary.len() >= 256 {
-            summary = vec![compact(&summary)?];
-        }
-        Ok(())
-    })?;
-    data.finish().map_err(BuildError::Internal)?;
-    let data_sum = integrity::sha256_file(&data_path).map_err(|e| internal(&data_path, e))?;
-    sums.insert(data_file.clone(), data_sum);
-    let summary = compact(&summary)?;
-    let eval = if manifest.is_whole() {
-        let (indices, counts) = card::eval_selection(&summary);
-        let subset = take_streamed(rows, &indices)?;
-        let path = out.join(card::EVAL_FILE);
-        let bytes = dataset::parquet_bytes(&subset);
-        dataset::write_atomic(&path, &bytes).map_err(|e| internal(&path, e))?;
-        sums.insert(card::EVAL_FILE.to_string(), integrity::sha256_bytes(&bytes));
-        Some(counts)
-    } else {
-        None
-    };
-    let readme = card::render(&card::CardInput {
-        manifest,
-        rows: &summary,
-        data_files: std::slice::from_ref(&data_file),
-        eval: eval.as_ref(),
-    });
-    let path = out.join("README.md");
-    dataset::write_atomic(&path, readme.as_bytes()).map_err(|e| internal(&path, e))?;
-    sums.insert(
-        "README.md".to_string(),
-        integrity::sha256_bytes(readme.as_bytes()),
-    );
-    let finished = Manifest {
-        files: Some(sums),
-        ..manifest.clone()
-    };
-    let path = out.join(MANIFEST_FILE);
-    dataset::write_atomic(&path, finished.to_json().as_bytes()).map_err(|e| internal(&path, e))?;
-    Ok((summary, eval.map(|c| c.values().sum())))
-}
-
-/// The rows at `indices` (ascending positions in the whole table) of a streamed table.
-fn take_streamed(rows: &RowSource, indices: &[u32]) -> Result<RecordBatch, BuildError> {
-    let mut parts = Vec::new();
-    let (mut offset, mut next) = (0usize, 0usize);
-    rows(&mut |batch| {
-        let end = offset + batch.num_rows();
-        let local: Vec<u32> = indices[next..]
-            .iter()
-            .take_while(|&&i| (i as usize) < end)
-            .map(|&i| i - offset as u32)
-            .collect();
-        next += local.len();
-        if !local.is_empty() {
-            parts.push(dataset::take_rows(&batch, &local));
-        }
-        offset = end;
-        Ok(())
-    })?;
-    dataset::concat(&parts).map_err(BuildError::Internal)
-}
-
 fn summarize(
     out: &Path,
     rows: &RecordBatch,
@@ -670,10 +565,10 @@ fn summarize(
     computed_groups: usize,
     eval_scenes: Option<usize>,
 ) -> BuildSummary {
-    let ids = dataset::string_column(rows, "scene_id");
-    let valid = dataset::bool_column(rows, "valid");
-    let family = dataset::string_column(rows, "family");
-    let action = dataset::string_column(rows, "gt_action");
+    let ids = table::string_column(rows, "scene_id");
+    let valid = table::bool_column(rows, "valid");
+    let family = table::string_column(rows, "family");
+    let action = table::string_column(rows, "gt_action");
     let mut summary = BuildSummary {
         out: out.display().to_string(),
         scenes: rows.num_rows(),

@@ -2,9 +2,9 @@
 //! usage (with a message naming what is wrong), 1 internal failure.
 
 use crate::build::{build, BuildError, BuildOptions};
-use crate::config::Config;
-use crate::selection::{LexiconPlanner, Planner};
-use crate::verify::{verify, verify_fast};
+use rh_scenes::config::Config;
+use rh_scenes::selection::{LexiconPlanner, Planner};
+use rh_dataset::verify::{verify, verify_fast};
 use clap::{Parser, Subcommand};
 use rh_catalog::Catalog;
 use std::path::{Path, PathBuf};
@@ -236,13 +236,13 @@ fn plan_descriptions(
     descriptions: &[String],
     path: &std::path::Path,
     build_seed: u64,
-) -> Result<Vec<crate::spec::Selection>, Failure> {
+) -> Result<Vec<rh_physics::spec::Selection>, Failure> {
     descriptions
         .iter()
         .enumerate()
         .map(|(i, d)| {
             planner
-                .plan(d, crate::seeds::group_seed(build_seed, i as u64))
+                .plan(d, rh_physics::seeds::group_seed(build_seed, i as u64))
                 .map_err(|e| input(format!("{}: description {}: {e}", path.display(), i + 1)))
         })
         .collect()
@@ -318,8 +318,8 @@ fn sheet(dir: &Path, out: &Path, json: bool) -> Result<(), Failure> {
             dir.display()
         )));
     }
-    let sheet = crate::render::contact_sheet(dir, out).map_err(|e| match e {
-        crate::render::RenderError::Io(m) => input(m),
+    let sheet = rh_render::contact_sheet(dir, out).map_err(|e| match e {
+        rh_render::RenderError::Io(m) => input(m),
         other => Failure {
             code: 1,
             message: other.to_string(),
@@ -519,14 +519,14 @@ fn balance(
     }
     let families = families.unwrap_or_default();
     for f in &families {
-        if crate::families::get(f).is_none() {
+        if rh_scenes::families::get(f).is_none() {
             return Err(input(format!(
                 "unknown or unimplemented family '{f}' (implemented: {})",
-                crate::randomize::implemented_families()
+                rh_scenes::randomize::implemented_families()
             )));
         }
     }
-    let rows = crate::balance::label_balance(
+    let rows = rh_scenes::balance::label_balance(
         catalog,
         config,
         seed.unwrap_or(config.build.seed),
@@ -540,7 +540,7 @@ fn balance(
     if json {
         print_json(&rows);
     } else {
-        print!("{}", crate::balance::format_table(&rows));
+        print!("{}", rh_scenes::balance::format_table(&rows));
     }
     Ok(())
 }
@@ -549,7 +549,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
     // Commands that need neither the catalog nor the configuration.
     match &cli.command {
         Command::Merge { out, shards, json } => {
-            let summary = crate::merge::merge(out, shards).map_err(build_failure)?;
+            let summary = rh_dataset::merge::merge(out, shards).map_err(build_failure)?;
             if *json {
                 print_json(&summary);
             } else {

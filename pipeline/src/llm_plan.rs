@@ -11,8 +11,8 @@
 //! description text is stored too. Given its selections a build stays seed-pure, and with
 //! the cache a rebuild from the same descriptions makes no request.
 
-use crate::selection::{LexiconPlanner, PlanError, Planner};
-use crate::spec::{PlannerRecord, Selection};
+use rh_scenes::selection::{LexiconPlanner, PlanError, Planner};
+use rh_physics::spec::{PlannerRecord, Selection};
 use rh_catalog::Catalog;
 use serde::Deserialize;
 use serde_json::{json, Value};
@@ -60,10 +60,10 @@ fn validate(catalog: &Catalog, answer: &str) -> Result<(String, String, String),
             .ok_or_else(|| format!("field \"{k}\" is missing or not a string"))
     };
     let (family, object_id, room_id) = (field("family")?, field("object_id")?, field("room_id")?);
-    if crate::families::get(&family).is_none() {
+    if rh_scenes::families::get(&family).is_none() {
         return Err(format!(
             "family \"{family}\" does not exist; choose one of: {}",
-            crate::randomize::implemented_families()
+            rh_scenes::randomize::implemented_families()
         ));
     }
     let object = catalog.object(&object_id).ok_or_else(|| {
@@ -163,7 +163,7 @@ impl<'a> LlmPlanner<'a> {
     }
 
     fn system_text(&self) -> String {
-        let families = crate::families::all()
+        let families = rh_scenes::families::all()
             .iter()
             .map(|f| format!("- {}", f.name()))
             .collect::<Vec<_>>()

@@ -8,7 +8,7 @@
 //! decision, the replay ms per scene, and what the paper's 2,138 decisions would take on
 //! this machine's cores (decisions run in parallel with rayon in `rh-score`).
 
-use rh_pipeline::execute::{replay, ExecConfig, ExecKeyframe, ExecPlan};
+use rh_physics::execute::{replay, ExecConfig, ExecKeyframe, ExecPlan};
 use std::time::Instant;
 
 fn plans() -> Vec<(&'static str, ExecPlan)> {
@@ -52,7 +52,7 @@ fn main() {
         .find_map(|a| a.parse().ok())
         .unwrap_or(17);
     let catalog = rh_catalog::Catalog::embedded().expect("catalog");
-    let config = rh_pipeline::config::Config::embedded().expect("config");
+    let config = rh_scenes::config::Config::embedded().expect("config");
     let families: Vec<String> = rh_contract::FAMILIES
         .iter()
         .map(|f| f.to_string())
@@ -61,8 +61,8 @@ fn main() {
     for g in 0..groups {
         // One group per family in turn.
         let fam = vec![families[(g as usize) % families.len()].clone()];
-        let sel = rh_pipeline::selection::plan_group(&catalog, &fam, 7, g).expect("plan");
-        let scenes = rh_pipeline::scene::produce_group(&sel, 7, g * 4, 4, &catalog, &config)
+        let sel = rh_scenes::selection::plan_group(&catalog, &fam, 7, g).expect("plan");
+        let scenes = rh_scenes::driver::produce_group(&sel, 7, g * 4, 4, &catalog, &config)
             .expect("produce");
         specs.extend(scenes.into_iter().map(|r| r.spec));
     }

@@ -208,7 +208,7 @@ fn options(dir: &Path, port: u16, out: &Path) -> PredictOptions {
 fn print_stages(proto: &Path) {
     let cfg = PromptConfig::load(None).unwrap();
     let im = &cfg.images;
-    let sub = rh_score::predict::prompt::subsampling(&im.chroma_subsampling).unwrap();
+    let sub = rh_score::predict::config::subsampling(&im.chroma_subsampling).unwrap();
     let mut sum = [0.0; 3];
     let mut n = 0usize;
     for pass in 0..21 {

@@ -14,12 +14,13 @@
 use crate::config::Config;
 use crate::dataset::{Dataset, Scene};
 use crate::oracle::{oracle_plan, OracleHints};
+use crate::plan_json::freeze_template;
+use crate::plan_json::{kf, plan, rest_kf};
 use crate::types::Action;
 use anyhow::Result;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use serde_json::{json, Value};
-use std::f64::consts::PI;
+use serde_json::Value;
 use std::io::Write;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -45,13 +46,7 @@ impl BaselineKind {
     }
 }
 
-fn kf(t: f64, left: [f64; 3], right: [f64; 3]) -> Value {
-    json!({"t": t, "left_hand": left, "right_hand": right, "knee_bend": 0.0})
-}
 
-fn rest_kf(t: f64, cfg: &Config) -> Value {
-    kf(t, cfg.body.rest_left, cfg.body.rest_right)
-}
 
 /// Hazard direction on the floor in the observer's body frame (default: straight ahead).
 fn hazard_dir_body(scene: &Scene) -> [f64; 2] {
@@ -66,16 +61,6 @@ fn hazard_dir_body(scene: &Scene) -> [f64; 2] {
     [(c * dx + s * dy) / n, (-s * dx + c * dy) / n]
 }
 
-/// A plan in the SPEC §9 schema (confidence 1).
-pub(crate) fn plan(intent: &str, cmd: [f64; 3], dur: f64, keyframes: Vec<Value>) -> Value {
-    json!({
-        "intent": intent,
-        "confidence": 1.0,
-        "walking_cmd": cmd,
-        "walking_duration": dur,
-        "keyframes": keyframes,
-    })
-}
 
 /// Arms forward, no walking.
 pub fn catch_template() -> Value {
@@ -83,7 +68,7 @@ pub fn catch_template() -> Value {
         "Reach out with both hands and catch the object.",
         [0.0; 3],
         0.0,
-        vec![kf(0.3, [0.45, 0.15, 0.10], [0.45, -0.15, 0.10])],
+        vec![kf(0.3, [0.45, 0.15, 0.10], [0.45, -0.15, 0.10], 0.0)],
     )
 }
 
@@ -99,42 +84,8 @@ pub fn dodge_template(scene: &Scene, cfg: &Config, dist: f64, dur: f64) -> Value
     )
 }
 
-/// No walking, hands at rest.
-pub fn freeze_template(cfg: &Config) -> Value {
-    plan(
-        "Stay still; no action is needed.",
-        [0.0; 3],
-        0.0,
-        vec![rest_kf(0.25, cfg)],
-    )
-}
 
-pub(crate) fn wrap_angle(a: f64) -> f64 {
-    let mut a = (a + PI).rem_euclid(2.0 * PI) - PI;
-    if a <= -PI {
-        a += 2.0 * PI;
-    }
-    a
-}
 
-/// Body-frame walking command `[vx, vy, w]` that takes the base from `start` to the world
-/// position `goal` with final heading `yaw1` in `dur` seconds (constant twist).
-pub fn solve_walk(start: [f64; 3], goal: [f64; 2], yaw1: f64, dur: f64) -> [f64; 3] {
-    let [x0, y0, th0] = start;
-    let dth = wrap_angle(yaw1 - th0);
-    let (dx, dy) = (goal[0] - x0, goal[1] - y0);
-    if dth.abs() < 1e-12 {
-        let (s, c) = th0.sin_cos();
-        return [(c * dx + s * dy) / dur, (-s * dx + c * dy) / dur, 0.0];
-    }
-    let w = dth / dur;
-    let (s0, c0) = th0.sin_cos();
-    let (s1, c1) = (th0 + dth).sin_cos();
-    let a = (s1 - s0) / w;
-    let b = (c1 - c0) / w;
-    let det = a * a + b * b;
-    [(a * dx - b * dy) / det, (b * dx + a * dy) / det, w]
-}
 
 /// The plan a baseline writes for one scene (the oracle without its optional hints).
 pub fn baseline_plan(
@@ -189,7 +140,7 @@ fn random_plan(scene: &Scene, seed: u64, cfg: &Config) -> Value {
                 "Catch it.",
                 [u[0] * step / dur, u[1] * step / dur, 0.0],
                 dur,
-                vec![kf(dur, [x, y + 0.1, z], [x, y - 0.1, z])],
+                vec![kf(dur, [x, y + 0.1, z], [x, y - 0.1, z], 0.0)],
             )
         }
         1 => {
@@ -269,6 +220,7 @@ pub fn write_baseline(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
     use crate::aia::AiaMatcher;
     use crate::fixture::{dataset_of, synth_rows};
     use crate::metrics::score_decision;

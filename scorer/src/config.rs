@@ -19,8 +19,8 @@ pub struct Config {
     pub aia: AiaConfig,
     /// `[execution]`: the physics executor's limits and outcome thresholds (`--execute`);
     /// the embedded default's when a config file has none.
-    #[serde(default = "rh_pipeline::execute::ExecConfig::embedded_default")]
-    pub execution: rh_pipeline::execute::ExecConfig,
+    #[serde(default = "rh_contract::execution::ExecConfig::embedded_default")]
+    pub execution: rh_contract::execution::ExecConfig,
     /// `[execution_video]`: how `--execute-videos` draws the executions (the embedded
     /// default's when a config file has none).
     #[serde(default = "ExecVideoConfig::embedded_default")]

@@ -7,12 +7,7 @@
 use crate::types::FastMap;
 use crate::types::{Action, InputError};
 use anyhow::Result;
-use arrow::array::{
-    Array, ArrayRef, BooleanArray, FixedSizeListArray, Float64Array, ListArray, RecordBatch,
-    StringArray,
-};
-use arrow::datatypes::DataType;
-use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+use arrow::array::RecordBatch;
 use rh_contract::columns::col;
 use std::path::{Path, PathBuf};
 
@@ -164,36 +159,18 @@ impl Dataset {
     }
 }
 
-/// The `.parquet` files directly in `folder`, in name order (the order every reader of a
-/// dataset uses). An unreadable folder is an input error naming it.
+/// The `.parquet` files of a folder, in name order (`rh_dataset::read`).
 pub fn parquet_files(folder: &Path) -> Result<Vec<PathBuf>, InputError> {
-    let rd = std::fs::read_dir(folder)
-        .map_err(|e| InputError(format!("cannot read {}: {e}", folder.display())))?;
-    let mut files: Vec<PathBuf> = rd
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
-        .collect();
-    files.sort();
-    Ok(files)
+    rh_dataset::read::parquet_files(folder).map_err(InputError)
 }
 
-/// A record-batch reader over one Parquet file; a file that cannot be opened or is not
-/// Parquet is an input error naming it.
+/// A record-batch reader over one Parquet file (`rh_dataset::read`); a file that cannot
+/// be opened or is not Parquet is an input error naming it.
 pub fn open_parquet(
     file: &Path,
     batch_size: usize,
 ) -> Result<parquet::arrow::arrow_reader::ParquetRecordBatchReader, InputError> {
-    let f = std::fs::File::open(file)
-        .map_err(|e| InputError(format!("cannot open {}: {e}", file.display())))?;
-    ParquetRecordBatchReaderBuilder::try_new(f)
-        .and_then(|b| b.with_batch_size(batch_size).build())
-        .map_err(|e| {
-            InputError(format!(
-                "{} is not a readable Parquet file: {e}",
-                file.display()
-            ))
-        })
+    rh_dataset::read::open_parquet(file, batch_size).map_err(InputError)
 }
 
 /// One scene as read from a row (or made by a fixture), before interning.
@@ -220,125 +197,20 @@ fn bad(file: &Path, column: &str, what: impl std::fmt::Display) -> anyhow::Error
     InputError(format!("{}: column `{column}` {what}", file.display())).into()
 }
 
-fn column<'a>(batch: &'a RecordBatch, file: &Path, name: &str) -> Result<&'a ArrayRef> {
-    batch
-        .column_by_name(name)
-        .ok_or_else(|| bad(file, name, "is missing (required by rh-score)"))
-}
-
 fn strings(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Option<String>>> {
-    let col = column(batch, file, name)?;
-    let col = match col.data_type() {
-        DataType::Utf8 => col.clone(),
-        DataType::LargeUtf8 | DataType::Utf8View => {
-            arrow::compute::cast(col, &DataType::Utf8).map_err(|e| bad(file, name, e))?
-        }
-        other => return Err(bad(file, name, format!("has type {other}, expected Utf8"))),
-    };
-    let arr = col
-        .as_any()
-        .downcast_ref::<StringArray>()
-        .ok_or_else(|| bad(file, name, "is not a string array"))?;
-    Ok((0..arr.len())
-        .map(|i| (!arr.is_null(i)).then(|| arr.value(i).to_string()))
-        .collect())
+    Ok(rh_dataset::read::strings(batch, file, name).map_err(InputError)?)
 }
 
 fn required_strings(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<String>> {
-    strings(batch, file, name)?
-        .into_iter()
-        .enumerate()
-        .map(|(i, v)| v.ok_or_else(|| bad(file, name, format!("is null in row {i}"))))
-        .collect()
+    Ok(rh_dataset::read::required_strings(batch, file, name).map_err(InputError)?)
 }
 
 fn bools(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<bool>> {
-    let col = column(batch, file, name)?;
-    let arr = col.as_any().downcast_ref::<BooleanArray>().ok_or_else(|| {
-        bad(
-            file,
-            name,
-            format!("has type {}, expected Boolean", col.data_type()),
-        )
-    })?;
-    (0..arr.len())
-        .map(|i| {
-            if arr.is_null(i) {
-                Err(bad(file, name, format!("is null in row {i}")))
-            } else {
-                Ok(arr.value(i))
-            }
-        })
-        .collect()
+    Ok(rh_dataset::read::bools(batch, file, name).map_err(InputError)?)
 }
 
-/// A column of 3-vectors: FixedSizeList<Float64, 3> (or List<Float64> of length 3).
 fn vec3s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Option<[f64; 3]>>> {
-    let col = column(batch, file, name)?;
-    let expected = "expected FixedSizeList<Float64, 3>";
-    let mut out = Vec::with_capacity(col.len());
-    if let Some(arr) = col.as_any().downcast_ref::<FixedSizeListArray>() {
-        if arr.value_length() != 3 {
-            return Err(bad(
-                file,
-                name,
-                format!("has type {}, {expected}", col.data_type()),
-            ));
-        }
-        let values = arr
-            .values()
-            .as_any()
-            .downcast_ref::<Float64Array>()
-            .ok_or_else(|| {
-                bad(
-                    file,
-                    name,
-                    format!("has type {}, {expected}", col.data_type()),
-                )
-            })?;
-        for i in 0..arr.len() {
-            if arr.is_null(i) {
-                out.push(None);
-            } else {
-                let o = i * 3;
-                out.push(Some([
-                    values.value(o),
-                    values.value(o + 1),
-                    values.value(o + 2),
-                ]));
-            }
-        }
-    } else if let Some(arr) = col.as_any().downcast_ref::<ListArray>() {
-        for i in 0..arr.len() {
-            if arr.is_null(i) {
-                out.push(None);
-                continue;
-            }
-            let v = arr.value(i);
-            let v = v.as_any().downcast_ref::<Float64Array>().ok_or_else(|| {
-                bad(
-                    file,
-                    name,
-                    format!("has type {}, {expected}", col.data_type()),
-                )
-            })?;
-            if v.len() != 3 {
-                return Err(bad(
-                    file,
-                    name,
-                    format!("row {i} has {} values, expected 3", v.len()),
-                ));
-            }
-            out.push(Some([v.value(0), v.value(1), v.value(2)]));
-        }
-    } else {
-        return Err(bad(
-            file,
-            name,
-            format!("has type {}, {expected}", col.data_type()),
-        ));
-    }
-    Ok(out)
+    Ok(rh_dataset::read::vec3s(batch, file, name).map_err(InputError)?)
 }
 
 fn read_parquet(file: &Path) -> Result<Vec<SceneInput>> {

@@ -14,6 +14,7 @@ use arrow::array::{
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rh_contract::columns::col;
+use rh_contract::fsio::write_atomic;
 use rh_contract::layout::{data_file_name, spec_path};
 use std::f64::consts::PI;
 use std::path::Path;
@@ -339,11 +340,9 @@ pub fn write_dataset(dir: &Path, rows: &[FixtureRow], drop: &[&str]) -> Result<(
         .filter(|(n, _)| !drop.contains(n))
         .collect();
     let batch = RecordBatch::try_from_iter(cols).context("building fixture batch")?;
+    // The dataset's one table writer (its Parquet settings), written atomically.
     let path = dir.join(data_file_name(0, 1));
-    let file = std::fs::File::create(&path)?;
-    let mut w = parquet::arrow::ArrowWriter::try_new(file, batch.schema(), None)?;
-    w.write(&batch)?;
-    w.close()?;
+    write_atomic(&path, &rh_dataset::table::parquet_bytes(&batch))?;
     for r in rows {
         let spec = serde_json::json!({
             "schema_version": 1,
@@ -352,9 +351,9 @@ pub fn write_dataset(dir: &Path, rows: &[FixtureRow], drop: &[&str]) -> Result<(
             "family": r.scene.family,
             "observer_pose": r.scene.observer_pose,
         });
-        std::fs::write(
-            dir.join("specs").join(format!("{}.json", r.scene.scene_id)),
-            serde_json::to_vec_pretty(&spec)?,
+        write_atomic(
+            &dir.join(spec_path(&r.scene.scene_id)),
+            &serde_json::to_vec_pretty(&spec)?,
         )?;
     }
     Ok(())

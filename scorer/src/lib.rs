@@ -42,11 +42,11 @@ pub mod layout;
 pub mod metrics;
 pub mod oracle;
 pub mod plan;
+pub mod plan_json;
+#[cfg(feature = "predict")]
 pub mod predict;
 pub mod preds;
 pub mod tables;
-/// The old name of [`tables`], kept so that code written against `render` still builds.
-pub use tables as render;
 pub mod report;
 pub mod rule;
 pub mod score;

@@ -23,13 +23,13 @@
 //!   would be struck, the first of the label's escape walks that is not replaces it.
 //! * **NO_ACTION** — stand still, hands at rest.
 
-use crate::baseline::{plan, solve_walk};
+use crate::plan_json::{kf, plan, solve_walk, wrap_angle};
 use crate::config::Config;
 use crate::dataset::{open_parquet, parquet_files, read_replay_keys, Dataset, Scene};
 use crate::types::Action;
 use anyhow::Result;
 use arrow::array::{Array, FixedSizeListArray, Float32Array, Float64Array, ListArray};
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::collections::BTreeMap;
 
 /// CATCH stance: the impact point this far ahead of the pelvis when the arm allows (m).
@@ -62,9 +62,6 @@ pub struct OracleHints {
     pub dodge: Option<Value>,
 }
 
-fn kf(t: f64, left: [f64; 3], right: [f64; 3], knee: f64) -> Value {
-    json!({"t": t, "left_hand": left, "right_hand": right, "knee_bend": knee})
-}
 
 /// Largest forward distance of the mean hand at body height `zb` above the pelvis that
 /// the arms reach (negative when no forward distance does).
@@ -106,7 +103,7 @@ pub fn catch(scene: &Scene, cfg: &Config) -> Value {
         yaw1 = dy.atan2(dx);
         hand = [a, 0.0];
     }
-    let dth = crate::baseline::wrap_angle(yaw1 - th0);
+    let dth = wrap_angle(yaw1 - th0);
     let dist = (goal[0] - x0).hypot(goal[1] - y0);
     let mut dur = (dist / CATCH_SPEED).max(dth.abs() / 3.0).max(0.1);
     let mut cmd = solve_walk(scene.observer_pose, goal, th0 + dth, dur);
@@ -195,7 +192,7 @@ pub fn oracle_plan(scene: &Scene, hints: Option<&OracleHints>, cfg: &Config) -> 
     match scene.gt_action {
         Action::Catch => catch(scene, cfg),
         Action::Dodge => dodge(scene, hints, cfg),
-        Action::NoAction => crate::baseline::freeze_template(cfg),
+        Action::NoAction => crate::plan_json::freeze_template(cfg),
     }
 }
 
@@ -203,8 +200,17 @@ pub fn oracle_plan(scene: &Scene, hints: Option<&OracleHints>, cfg: &Config) -> 
 /// ([`physics_dodges`]).
 pub fn load_hints(ds: &Dataset, cfg: &Config) -> Result<BTreeMap<String, OracleHints>> {
     let mut hints = read_hints(ds)?;
+    #[cfg(feature = "execute")]
     for (id, plan) in physics_dodges(ds, &hints, cfg) {
         hints.entry(id).or_default().dodge = Some(plan);
+    }
+    #[cfg(not(feature = "execute"))]
+    if ds.dir.join("specs").is_dir() {
+        let _ = cfg;
+        return Err(crate::types::InputError(
+            "the oracle checks its dodges in physics, but this rh-score was built without the `execute` feature; rebuild with default features".into(),
+        )
+        .into());
     }
     Ok(hints)
 }
@@ -212,16 +218,17 @@ pub fn load_hints(ds: &Dataset, cfg: &Config) -> Result<BTreeMap<String, OracleH
 /// DODGE plans checked in physics with `--execute`'s executor (`cfg.execution`): for every
 /// valid DODGE scene whose spec replays (checked against the dataset's hash), the
 /// heuristic dodge is executed; when it is struck, the first escape walk that is not
-/// (`rh_pipeline::execute::escape`, the walks of the label's validator
+/// (`rh_physics::execute::escape`, the walks of the label's validator
 /// `valid_escapable`, so one exists in every valid scene of rule v4 that would strike)
 /// replaces it. Scenes without specs, or where nothing escapes, keep the heuristic.
+#[cfg(feature = "execute")]
 pub fn physics_dodges(
     ds: &Dataset,
     hints: &BTreeMap<String, OracleHints>,
     cfg: &Config,
 ) -> BTreeMap<String, Value> {
     use rayon::prelude::*;
-    use rh_pipeline::execute::escape::{escape_plans, first_unstruck};
+    use rh_physics::execute::escape::{escape_plans, first_unstruck};
     let Ok(keys) = read_replay_keys(&ds.dir) else {
         return BTreeMap::new();
     };
@@ -249,7 +256,8 @@ pub fn physics_dodges(
 }
 
 /// An escape walk as a plan line's `plan` (numbers unchanged through JSON).
-fn escape_json(p: &rh_pipeline::execute::ExecPlan) -> Value {
+#[cfg(feature = "execute")]
+fn escape_json(p: &rh_contract::execution::ExecPlan) -> Value {
     let keyframes = p
         .keyframes
         .iter()

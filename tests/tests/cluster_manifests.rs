@@ -1,4 +1,4 @@
-//! `dataset/k8s_build_job.yaml`, checked offline: it parses, validates against the
+//! `cluster/k8s_build_job.yaml`, checked offline: it parses, validates against the
 //! Kubernetes Job schema (the `kubernetes-validate` package from PyPI, installed by
 //! `scripts/setup.sh`, with its bundled schemas; strict: unknown fields are errors), and
 //! the fields the docs rely on hold: an Indexed Job whose completions, parallelism and
@@ -16,7 +16,7 @@ fn manifest() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .unwrap()
-        .join("dataset/k8s_build_job.yaml")
+        .join("cluster/k8s_build_job.yaml")
 }
 
 #[test]

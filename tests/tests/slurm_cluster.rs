@@ -1,6 +1,6 @@
 //! The Slurm path, run for real: `scripts/slurm_cluster_test.sh` starts a one-node Slurm
 //! cluster on localhost (munged, slurmctld, slurmd; everything in a temp dir, free ports),
-//! submits `dataset/slurm_build.sbatch` unchanged as a 4-task job array of a label-only
+//! submits `cluster/slurm_build.sbatch` unchanged as a 4-task job array of a label-only
 //! build, cancels one task mid-way with `scancel`, resubmits it (it must say it resumed),
 //! merges the shards and compares the result with a single build, file by file.
 //!

@@ -135,6 +135,7 @@ enum Cmd {
     /// canonical prompt (configs/prompt.toml) and write preds.jsonl. Resumes: run it again
     /// with the same arguments after a crash, a kill or --max-cost and it does only what is
     /// missing.
+    #[cfg(feature = "predict")]
     Predict(Box<PredictArgs>),
     /// Write a synthetic dataset with the rh-pipeline column contract (tests).
     #[command(hide = true)]
@@ -151,6 +152,7 @@ enum Cmd {
     },
 }
 
+#[cfg(feature = "predict")]
 #[derive(clap::Args, Debug)]
 struct PredictArgs {
     /// Dataset directory (data/*.parquet + frames/) or Hub dataset id owner/name[@revision].
@@ -234,6 +236,7 @@ struct PredictArgs {
     quiet: bool,
 }
 
+#[cfg(feature = "predict")]
 fn predict(a: PredictArgs) -> Result<()> {
     use rh_score::predict::config::{Generation, PredictConfig, Price, PromptConfig};
     let cfg = PredictConfig::load(a.config.as_deref())?;
@@ -423,6 +426,12 @@ fn score(cli: Cli) -> Result<()> {
         )
         .into());
     }
+    if cli.execute && !cfg!(feature = "execute") {
+        return Err(InputError(
+            "--execute: this rh-score was built without the `execute` feature (no simulator); build it with default features (cargo build --release -p rh-score)".into(),
+        )
+        .into());
+    }
     if cli.execute_videos.is_some() && !cfg!(feature = "videos") {
         return Err(InputError(
             "--execute-videos: this rh-score was built without the `videos` feature (no renderer); build it with default features (cargo build --release -p rh-score)".into(),
@@ -553,6 +562,7 @@ struct Videos<'a> {
     progress: bool,
 }
 
+#[cfg(feature = "execute")]
 fn execute(
     scoring: &mut Scoring,
     ds: &Dataset,
@@ -601,12 +611,23 @@ fn execute(
     ))
 }
 
+#[cfg(not(feature = "execute"))]
+fn execute(
+    _: &mut Scoring,
+    _: &Dataset,
+    _: &Config,
+    _: Option<&Path>,
+    _: Option<Videos>,
+) -> Result<rh_score::execution::ExecutionReport> {
+    unreachable!("--execute is refused before scoring in a build without `execute`")
+}
+
 /// Draws the execution videos (`--execute-videos`) and says what was written.
 #[cfg(feature = "videos")]
 fn write_videos(
     ds: &Dataset,
     pending: &[rh_score::execution::Pending],
-    outcomes: &[Option<rh_pipeline::execute::Outcome>],
+    outcomes: &[Option<rh_contract::execution::Outcome>],
     names: &[String],
     cfg: &Config,
     v: Videos,
@@ -644,7 +665,7 @@ fn write_videos(
 fn write_videos(
     _: &Dataset,
     _: &[rh_score::execution::Pending],
-    _: &[Option<rh_pipeline::execute::Outcome>],
+    _: &[Option<rh_contract::execution::Outcome>],
     _: &[String],
     _: &Config,
     _: Videos,
@@ -688,6 +709,7 @@ fn run(cli: Cli) -> Result<()> {
                 r => r,
             }
         }
+        #[cfg(feature = "predict")]
         Some(Cmd::Predict(a)) => predict(*a),
         Some(Cmd::MakeFixture { out, n, seed, drop }) => {
             let rows = rh_score::fixture::synth_rows(n, seed);

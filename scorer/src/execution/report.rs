@@ -6,7 +6,7 @@
 use super::{Pending, RunStats};
 use crate::dataset::Dataset;
 use crate::types::Action;
-use rh_pipeline::execute::{ExecConfig, Outcome, OutcomeKind, EXECUTOR_VERSION};
+use rh_contract::execution::{ExecConfig, Outcome, OutcomeKind, EXECUTOR_VERSION};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt::Write;

@@ -1,5 +1,5 @@
 //! `--execute-videos DIR` (SPEC §12, issue 14 item 4): every executed decision drawn by
-//! the dataset's renderer (`rh_pipeline::render::Renderer::render_executions`) from an
+//! the dataset's renderer (`rh_render::Renderer::render_executions`) from an
 //! outside camera and from the humanoid's ego camera, and for one scene all models'
 //! executions tiled side by side ("one scene, N brains"):
 //!
@@ -19,10 +19,10 @@ use crate::config::ExecVideoConfig;
 use crate::dataset::{read_replay_keys, Dataset};
 use crate::types::InputError;
 use anyhow::{anyhow, bail, Result};
-use rh_pipeline::execute::{ExecConfig, ExecFrame, Outcome};
-use rh_pipeline::render::encode::EncodeSettings;
-use rh_pipeline::render::{ExecTrack, ExecVideoOptions, RenderOptions, Renderer};
-use rh_pipeline::simulate::{simulate, SimOptions};
+use rh_physics::execute::{ExecConfig, ExecFrame, Outcome};
+use rh_render::encode::EncodeSettings;
+use rh_render::{ExecTrack, ExecVideoOptions, RenderOptions, Renderer};
+use rh_physics::simulate::{simulate, SimOptions};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -217,11 +217,7 @@ pub fn write_videos(
     bar.finish_and_clear();
     let text = serde_json::to_string_pretty(&index)? + "\n";
     let path = req.dir.join("index.json");
-    let tmp = req
-        .dir
-        .join(format!(".index.json.{}.tmp", std::process::id()));
-    std::fs::write(&tmp, text)
-        .and_then(|_| std::fs::rename(&tmp, &path))
+    rh_contract::fsio::write_atomic(&path, text.as_bytes())
         .map_err(|e| anyhow!("cannot write {}: {e}", path.display()))?;
     Ok(index)
 }

@@ -17,7 +17,7 @@
 //! Each page stays small whatever the dataset's size: the browser lists 50 scenes a page
 //! from the index (about 25 bytes per scene plus 3 per model), and a scene page loads only
 //! its own file. The planned hands are projected in the page from the spec's stored camera
-//! with the pinhole model of `rh_pipeline::cameras::View` (same basis, same normalised
+//! with the pinhole model of `rh_scenes::view::View` (same basis, same normalised
 //! coordinates).
 //!
 //! Execution (`--execute`, SPEC §12): the leaderboard rows carry each model's outcome

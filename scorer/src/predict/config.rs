@@ -87,7 +87,7 @@ impl PromptConfig {
         if !(1..=100).contains(&cfg.images.jpeg_quality) {
             return Err(bad("[images] jpeg_quality must be 1-100".into()));
         }
-        if super::prompt::subsampling(&cfg.images.chroma_subsampling).is_none() {
+        if subsampling(&cfg.images.chroma_subsampling).is_none() {
             return Err(bad(
                 "[images] chroma_subsampling must be \"4:2:0\" or \"4:4:4\"".into(),
             ));
@@ -140,6 +140,15 @@ impl Price {
     pub fn cost(&self, usage: rh_llm::Usage) -> f64 {
         (usage.prompt_tokens as f64 * self.input + usage.completion_tokens as f64 * self.output)
             / 1e6
+    }
+}
+
+/// Chroma subsampling of the prompt's JPEGs (`[images] chroma_subsampling`).
+pub fn subsampling(name: &str) -> Option<turbojpeg::Subsamp> {
+    match name {
+        "4:2:0" => Some(turbojpeg::Subsamp::Sub2x2),
+        "4:4:4" => Some(turbojpeg::Subsamp::None),
+        _ => None,
     }
 }
 

@@ -116,19 +116,13 @@ pub fn prepare(path: &Path, model: &str, retry_errors: bool) -> Result<Existing>
 }
 
 fn rewrite(path: &Path, lines: &[&[u8]]) -> Result<()> {
-    let tmp: PathBuf = {
-        let mut name = path.file_name().unwrap_or_default().to_os_string();
-        name.push(".rewrite.tmp");
-        path.with_file_name(name)
-    };
-    let io = |e: std::io::Error| InputError(format!("cannot rewrite {}: {e}", path.display()));
-    let mut f = std::fs::File::create(&tmp).map_err(io)?;
+    let mut text = Vec::new();
     for l in lines {
-        f.write_all(l).map_err(io)?;
-        f.write_all(b"\n").map_err(io)?;
+        text.extend_from_slice(l);
+        text.push(b'\n');
     }
-    f.sync_all().map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)?;
+    rh_contract::fsio::write_atomic(path, &text)
+        .map_err(|e| InputError(format!("cannot rewrite {}: {e}", path.display())))?;
     Ok(())
 }
 

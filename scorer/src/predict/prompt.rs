@@ -4,7 +4,7 @@
 //! dataset's PNGs `frames/<id>/<cam>_t<t>.png`, scaled down to `max_side` and re-encoded
 //! as JPEG, sent as base64 data URLs.
 
-use super::config::PromptConfig;
+use super::config::{subsampling, PromptConfig};
 use base64::Engine;
 use serde_json::{json, Value};
 use std::path::Path;
@@ -124,15 +124,6 @@ fn scale_down(sc: &mut Scratch, (w, h): (u32, u32), max_side: u32) -> Result<(u3
         .resize(&src, &mut dst, &opts)
         .map_err(|e| format!("cannot scale frame: {e}"))?;
     Ok((nw, nh))
-}
-
-/// Chroma subsampling of the prompt's JPEGs (`[images] chroma_subsampling`).
-pub fn subsampling(name: &str) -> Option<turbojpeg::Subsamp> {
-    match name {
-        "4:2:0" => Some(turbojpeg::Subsamp::Sub2x2),
-        "4:4:4" => Some(turbojpeg::Subsamp::None),
-        _ => None,
-    }
 }
 
 thread_local! {

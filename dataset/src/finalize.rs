@@ -1,0 +1,121 @@
+//! A dataset's final files from its rows: the data Parquet, the eval subset, the card
+//! and the finished `build.json` with every file's SHA-256. Shared by `build` (rows from
+//! the group records) and `merge` (rows from the shards).
+
+use crate::manifest::{Manifest, MANIFEST_FILE};
+use crate::integrity::{self, FileSums};
+use crate::{card, table};
+use arrow::array::RecordBatch;
+use std::path::Path;
+
+#[derive(Debug, thiserror::Error)]
+pub enum BuildError {
+    /// Bad arguments or unusable output directory (exit 2).
+    #[error("{0}")]
+    Input(String),
+    /// A failure of this program (exit 1).
+    #[error("internal error: {0}")]
+    Internal(String),
+}
+
+pub(crate) fn internal(path: &Path, e: impl std::fmt::Display) -> BuildError {
+    BuildError::Internal(format!("{}: {e}", path.display()))
+}
+
+/// Receives a dataset's rows, a batch at a time.
+pub type RowSink<'a> = dyn FnMut(RecordBatch) -> Result<(), BuildError> + 'a;
+
+/// Feeds every row of a dataset, in scene-index order, to the sink; may be called more
+/// than once and must give the same rows each time.
+pub type RowSource<'a> = dyn Fn(&mut RowSink) -> Result<(), BuildError> + 'a;
+
+/// Writes the dataset's final files from its rows (in scene-index order, streamed from
+/// `rows`): the data Parquet (row group by row group), the eval subset (whole builds; a
+/// second pass over the rows picks it), and the card. Memory stays flat in the number of
+/// rows but for `table::SUMMARY_COLUMNS`, which it returns (every row, those columns)
+/// with the eval subset's size. Then it writes `build.json` again, now with the SHA-256
+/// of every file (`sums`: the groups' specs and media, plus the files written here).
+pub fn finalize(
+    out: &Path,
+    manifest: &Manifest,
+    rows: &RowSource,
+    mut sums: FileSums,
+) -> Result<(RecordBatch, Option<usize>), BuildError> {
+    let data_file = table::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
+    let data_path = out.join(&data_file);
+    let mut data = table::ParquetStream::create(&data_path).map_err(BuildError::Internal)?;
+    let summary_schema = table::project(
+        &RecordBatch::new_empty(std::sync::Arc::new(table::schema())),
+        &table::SUMMARY_COLUMNS,
+    )
+    .schema();
+    let compact = |parts: &[RecordBatch]| {
+        arrow::compute::concat_batches(&summary_schema, parts)
+            .map_err(|e| BuildError::Internal(e.to_string()))
+    };
+    let mut summary: Vec<RecordBatch> = Vec::new();
+    rows(&mut |batch| {
+        data.write(&batch).map_err(BuildError::Internal)?;
+        summary.push(table::project(&batch, &table::SUMMARY_COLUMNS));
+        if summary.len() >= 256 {
+            summary = vec![compact(&summary)?];
+        }
+        Ok(())
+    })?;
+    data.finish().map_err(BuildError::Internal)?;
+    let data_sum = integrity::sha256_file(&data_path).map_err(|e| internal(&data_path, e))?;
+    sums.insert(data_file.clone(), data_sum);
+    let summary = compact(&summary)?;
+    let eval = if manifest.is_whole() {
+        let (indices, counts) = card::eval_selection(&summary);
+        let subset = take_streamed(rows, &indices)?;
+        let path = out.join(card::EVAL_FILE);
+        let bytes = table::parquet_bytes(&subset);
+        table::write_atomic(&path, &bytes).map_err(|e| internal(&path, e))?;
+        sums.insert(card::EVAL_FILE.to_string(), integrity::sha256_bytes(&bytes));
+        Some(counts)
+    } else {
+        None
+    };
+    let readme = card::text(&card::CardInput {
+        manifest,
+        rows: &summary,
+        data_files: std::slice::from_ref(&data_file),
+        eval: eval.as_ref(),
+    });
+    let path = out.join("README.md");
+    table::write_atomic(&path, readme.as_bytes()).map_err(|e| internal(&path, e))?;
+    sums.insert(
+        "README.md".to_string(),
+        integrity::sha256_bytes(readme.as_bytes()),
+    );
+    let finished = Manifest {
+        files: Some(sums),
+        ..manifest.clone()
+    };
+    let path = out.join(MANIFEST_FILE);
+    table::write_atomic(&path, finished.to_json().as_bytes()).map_err(|e| internal(&path, e))?;
+    Ok((summary, eval.map(|c| c.values().sum())))
+}
+
+/// The rows at `indices` (ascending positions in the whole table) of a streamed table.
+fn take_streamed(rows: &RowSource, indices: &[u32]) -> Result<RecordBatch, BuildError> {
+    let mut parts = Vec::new();
+    let (mut offset, mut next) = (0usize, 0usize);
+    rows(&mut |batch| {
+        let end = offset + batch.num_rows();
+        let local: Vec<u32> = indices[next..]
+            .iter()
+            .take_while(|&&i| (i as usize) < end)
+            .map(|&i| i - offset as u32)
+            .collect();
+        next += local.len();
+        if !local.is_empty() {
+            parts.push(table::take_rows(&batch, &local));
+        }
+        offset = end;
+        Ok(())
+    })?;
+    table::concat(&parts).map_err(BuildError::Internal)
+}
+

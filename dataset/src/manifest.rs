@@ -1,0 +1,225 @@
+//! `build.json`: the manifest every build (and every shard, and every merge) writes into
+//! its output directory before any other file. It names what the directory holds — the
+//! build seed, scene count, families, shard, render flag, and the exact configuration and
+//! catalog — so that a restarted build can tell its own half-finished work from another
+//! build's, and `rh-pipeline merge` can check that shards belong together.
+
+use rh_scenes::config::Config;
+use rh_catalog::Catalog;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::path::Path;
+
+pub const MANIFEST_FILE: &str = "build.json";
+pub const FORMAT: &str = "rh-build/1";
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Manifest {
+    /// Manifest format version.
+    pub format: String,
+    /// `rh-pipeline` version that wrote the build.
+    pub rh_pipeline_version: String,
+    /// Build seed.
+    pub seed: u64,
+    /// Scenes in the whole (unsharded) build.
+    pub n: u64,
+    /// Families, in the order groups are assigned to them.
+    pub families: Vec<String>,
+    /// `[i, N]`: this directory holds shard i of N (`[0, 1]`: the whole build).
+    pub shard: [u64; 2],
+    /// Whether videos and frames were requested.
+    pub render: bool,
+    /// Whether the observation frames' mask and depth PNGs were requested (`--masks`;
+    /// absent when not, so manifests without masks read as before).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub masks: bool,
+    /// SHA-256 of the configuration below, as JSON.
+    pub config_sha256: String,
+    /// SHA-256 of the catalog (objects and rooms) the scenes were drawn from.
+    pub catalog_sha256: String,
+    /// The whole build configuration (label thresholds included).
+    pub config: serde_json::Value,
+    /// SHA-256 of every file the build wrote (this one aside), by path: written when the
+    /// build is finished (`finalize::finalize`); absent while it runs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub files: Option<crate::integrity::FileSums>,
+    /// The planned selections of a build from descriptions (`--descriptions`), one per
+    /// description with its planner record; group g takes selection g mod len.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub selections: Option<Vec<rh_physics::spec::Selection>>,
+}
+
+fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// A fingerprint of a configuration (also used to tell the embedded default apart).
+pub fn config_sha256(config: &Config) -> String {
+    sha256_hex(
+        serde_json::to_string(config)
+            .expect("config serializes")
+            .as_bytes(),
+    )
+}
+
+/// A fingerprint of a catalog's validated content.
+pub fn catalog_sha256(catalog: &Catalog) -> String {
+    sha256_hex(format!("{:?}\n{:?}", catalog.objects, catalog.rooms).as_bytes())
+}
+
+impl Manifest {
+    pub fn new(
+        seed: u64,
+        n: u64,
+        families: &[String],
+        shard: (u64, u64),
+        render: bool,
+        catalog: &Catalog,
+        config: &Config,
+    ) -> Manifest {
+        Manifest {
+            format: FORMAT.to_string(),
+            rh_pipeline_version: env!("CARGO_PKG_VERSION").to_string(),
+            seed,
+            n,
+            families: families.to_vec(),
+            shard: [shard.0, shard.1],
+            render,
+            masks: false,
+            config_sha256: config_sha256(config),
+            catalog_sha256: catalog_sha256(catalog),
+            config: serde_json::to_value(config).expect("config serializes"),
+            files: None,
+            selections: None,
+        }
+    }
+
+    /// Scene groups of the whole build (four speed bands each; the last may be partial).
+    pub fn n_groups(&self) -> u64 {
+        self.n.div_ceil(4)
+    }
+
+    /// The groups this directory holds: `g mod N == i`.
+    pub fn groups(&self) -> Vec<u64> {
+        (0..self.n_groups())
+            .filter(|g| g % self.shard[1] == self.shard[0])
+            .collect()
+    }
+
+    /// Scenes in group `g` (4, or fewer for the last group).
+    pub fn group_size(&self, g: u64) -> u64 {
+        (self.n - g * 4).min(4)
+    }
+
+    pub fn is_whole(&self) -> bool {
+        self.shard == [0, 1]
+    }
+
+    /// The same build, unsharded (what a merge of its shards is).
+    pub fn whole(&self) -> Manifest {
+        Manifest {
+            shard: [0, 1],
+            files: None,
+            ..self.clone()
+        }
+    }
+
+    /// The label thresholds of the build.
+    pub fn labels(&self) -> Option<rh_physics::spec::LabelConfig> {
+        serde_json::from_value(self.config.get("labels")?.clone()).ok()
+    }
+
+    /// The configuration the build ran with.
+    pub fn build_config(&self) -> Result<Config, String> {
+        serde_json::from_value(self.config.clone())
+            .map_err(|e| format!("{MANIFEST_FILE}: its configuration cannot be read: {e}"))
+    }
+
+    /// Names the fields in which `other` differs from `self` (empty when equal; the
+    /// file checksums are not part of a build's identity).
+    pub fn differences(&self, other: &Manifest) -> Vec<String> {
+        let mut d = Vec::new();
+        let mut cmp = |name: &str, a: String, b: String| {
+            if a != b {
+                d.push(format!("{name} {a} vs {b}"));
+            }
+        };
+        cmp("format", self.format.clone(), other.format.clone());
+        cmp(
+            "rh-pipeline version",
+            self.rh_pipeline_version.clone(),
+            other.rh_pipeline_version.clone(),
+        );
+        cmp("seed", self.seed.to_string(), other.seed.to_string());
+        cmp(
+            "planned selections (--descriptions)",
+            serde_json::to_string(&self.selections).unwrap_or_default(),
+            serde_json::to_string(&other.selections).unwrap_or_default(),
+        );
+        cmp("n", self.n.to_string(), other.n.to_string());
+        cmp(
+            "families",
+            self.families.join(","),
+            other.families.join(","),
+        );
+        cmp(
+            "shard",
+            format!("{}/{}", self.shard[0], self.shard[1]),
+            format!("{}/{}", other.shard[0], other.shard[1]),
+        );
+        cmp("render", self.render.to_string(), other.render.to_string());
+        cmp("masks", self.masks.to_string(), other.masks.to_string());
+        if self.config_sha256 != other.config_sha256 || self.config != other.config {
+            d.push("configuration".into());
+        }
+        if self.catalog_sha256 != other.catalog_sha256 {
+            d.push("catalog".into());
+        }
+        d
+    }
+
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("manifest serializes") + "\n"
+    }
+
+    /// Reads `DIR/build.json`; `Ok(None)` when there is none.
+    pub fn read(dir: &Path) -> Result<Option<Manifest>, String> {
+        let path = dir.join(MANIFEST_FILE);
+        let text = match std::fs::read_to_string(&path) {
+            Ok(t) => t,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(format!("cannot read {}: {e}", path.display())),
+        };
+        serde_json::from_str(&text).map(Some).map_err(|e| {
+            format!(
+                "{} is not an rh-pipeline build manifest: {e}",
+                path.display()
+            )
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn manifest_round_trips_and_names_differences() {
+        let catalog = Catalog::embedded().unwrap();
+        let config = Config::embedded().unwrap();
+        let fams = vec!["object_drop".to_string()];
+        let a = Manifest::new(7, 10, &fams, (1, 3), false, &catalog, &config);
+        let back: Manifest = serde_json::from_str(&a.to_json()).unwrap();
+        assert_eq!(a, back);
+        assert_eq!(a.groups(), vec![1]);
+        assert_eq!(a.group_size(2), 2);
+        assert_eq!(a.labels().unwrap(), config.labels);
+        let b = Manifest::new(8, 10, &fams, (1, 3), false, &catalog, &config);
+        assert_eq!(a.differences(&b), vec!["seed 7 vs 8".to_string()]);
+        assert!(a.whole().is_whole());
+    }
+}

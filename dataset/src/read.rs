@@ -1,0 +1,135 @@
+//! Reading the scene table: the one place that lists a dataset's Parquet files, opens
+//! them, and turns columns into values. Every error names the file and the column
+//! (`FILE: column `NAME` …`), so callers pass the message on as an input error.
+//! Used by the dataset's own tools (`verify`, `merge`, resume) and by `rh-score`.
+
+use arrow::array::{
+    Array, ArrayRef, BooleanArray, FixedSizeListArray, Float64Array, ListArray, RecordBatch,
+    StringArray, UInt64Array,
+};
+use arrow::datatypes::DataType;
+use parquet::arrow::arrow_reader::{ParquetRecordBatchReader, ParquetRecordBatchReaderBuilder};
+use std::path::{Path, PathBuf};
+
+/// The `.parquet` files of a folder, in name order.
+pub fn parquet_files(folder: &Path) -> Result<Vec<PathBuf>, String> {
+    let rd =
+        std::fs::read_dir(folder).map_err(|e| format!("cannot read {}: {e}", folder.display()))?;
+    let mut files: Vec<PathBuf> = rd
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
+/// A record-batch reader over one Parquet file.
+pub fn open_parquet(file: &Path, batch_size: usize) -> Result<ParquetRecordBatchReader, String> {
+    let f = std::fs::File::open(file).map_err(|e| format!("cannot open {}: {e}", file.display()))?;
+    ParquetRecordBatchReaderBuilder::try_new(f)
+        .and_then(|b| b.with_batch_size(batch_size).build())
+        .map_err(|e| format!("{} is not a readable Parquet file: {e}", file.display()))
+}
+
+fn bad(file: &Path, column: &str, what: impl std::fmt::Display) -> String {
+    format!("{}: column `{column}` {what}", file.display())
+}
+
+/// A column by name.
+pub fn column<'a>(batch: &'a RecordBatch, file: &Path, name: &str) -> Result<&'a ArrayRef, String> {
+    batch
+        .column_by_name(name)
+        .ok_or_else(|| bad(file, name, "is missing"))
+}
+
+/// A string column (Utf8, LargeUtf8 or Utf8View), nulls as `None`.
+pub fn strings(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Option<String>>, String> {
+    let col = column(batch, file, name)?;
+    let col = match col.data_type() {
+        DataType::Utf8 => col.clone(),
+        DataType::LargeUtf8 | DataType::Utf8View => {
+            arrow::compute::cast(col, &DataType::Utf8).map_err(|e| bad(file, name, e))?
+        }
+        other => return Err(bad(file, name, format!("has type {other}, expected Utf8"))),
+    };
+    let arr = col
+        .as_any()
+        .downcast_ref::<StringArray>()
+        .ok_or_else(|| bad(file, name, "is not a string array"))?;
+    Ok((0..arr.len())
+        .map(|i| (!arr.is_null(i)).then(|| arr.value(i).to_string()))
+        .collect())
+}
+
+/// A string column without nulls.
+pub fn required_strings(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<String>, String> {
+    strings(batch, file, name)?
+        .into_iter()
+        .enumerate()
+        .map(|(i, v)| v.ok_or_else(|| bad(file, name, format!("is null in row {i}"))))
+        .collect()
+}
+
+/// A Boolean column without nulls.
+pub fn bools(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<bool>, String> {
+    let col = column(batch, file, name)?;
+    let arr = col.as_any().downcast_ref::<BooleanArray>().ok_or_else(|| {
+        bad(file, name, format!("has type {}, expected Boolean", col.data_type()))
+    })?;
+    (0..arr.len())
+        .map(|i| match arr.is_null(i) {
+            true => Err(bad(file, name, format!("is null in row {i}"))),
+            false => Ok(arr.value(i)),
+        })
+        .collect()
+}
+
+/// A UInt64 column without nulls.
+pub fn u64s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<u64>, String> {
+    let col = column(batch, file, name)?;
+    let arr = col.as_any().downcast_ref::<UInt64Array>().ok_or_else(|| {
+        bad(file, name, format!("has type {}, expected UInt64", col.data_type()))
+    })?;
+    (0..arr.len())
+        .map(|i| match arr.is_null(i) {
+            true => Err(bad(file, name, format!("is null in row {i}"))),
+            false => Ok(arr.value(i)),
+        })
+        .collect()
+}
+
+/// A column of 3-vectors: FixedSizeList<Float64, 3> (or List<Float64> of length 3).
+pub fn vec3s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Option<[f64; 3]>>, String> {
+    let col = column(batch, file, name)?;
+    let wrong = || bad(file, name, format!("has type {}, expected FixedSizeList<Float64, 3>", col.data_type()));
+    let mut out = Vec::with_capacity(col.len());
+    if let Some(arr) = col.as_any().downcast_ref::<FixedSizeListArray>() {
+        if arr.value_length() != 3 {
+            return Err(wrong());
+        }
+        let values = arr.values().as_any().downcast_ref::<Float64Array>().ok_or_else(wrong)?;
+        for i in 0..arr.len() {
+            out.push((!arr.is_null(i)).then(|| {
+                let o = i * 3;
+                [values.value(o), values.value(o + 1), values.value(o + 2)]
+            }));
+        }
+    } else if let Some(arr) = col.as_any().downcast_ref::<ListArray>() {
+        for i in 0..arr.len() {
+            if arr.is_null(i) {
+                out.push(None);
+                continue;
+            }
+            let v = arr.value(i);
+            let v = v.as_any().downcast_ref::<Float64Array>().ok_or_else(wrong)?;
+            if v.len() != 3 {
+                return Err(bad(file, name, format!("row {i} has {} values, expected 3", v.len())));
+            }
+            out.push(Some([v.value(0), v.value(1), v.value(2)]));
+        }
+    } else {
+        return Err(wrong());
+    }
+    Ok(out)
+}

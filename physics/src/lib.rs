@@ -1,0 +1,20 @@
+//! ReactHuman physics: everything that decides what happens in a scene.
+//!
+//! * [`spec`] — `SceneSpec`, the JSON document that fully determines a scene (with the
+//!   label rule's thresholds it was labelled under, `LabelConfig`);
+//! * [`simulate`] — the deterministic rapier world built from a spec (dt 1/240,
+//!   enhanced determinism) and its per-step state hash;
+//! * [`body`] — the humanoid observer's links (pure geometry);
+//! * [`strike`] — the strike test shared by the label's counterfactual and the executor;
+//! * [`execute`] — replay to the decision moment and execution of a plan by the humanoid;
+//! * [`seeds`] — the named `rand_chacha` sub-streams.
+//!
+//! Module graph (`A → B`: A uses B): `execute → simulate → body, strike → spec`;
+//! `seeds` and `spec` use nothing in the crate.
+
+pub mod body;
+pub mod execute;
+pub mod seeds;
+pub mod simulate;
+pub mod spec;
+pub mod strike;

@@ -1,0 +1,145 @@
+//! Render throughput at the paper spec: three cameras at 1280×720 / 60 fps over the
+//! observation window plus the full-event video, per scene, on this machine, rendered
+//! the way `build` renders them (one renderer per worker thread, `--jobs` workers).
+//!
+//! `cargo bench -p rh-pipeline --bench render_throughput [-- N]` (N scenes, default 8,
+//! taken round-robin over the families). Environment overrides: `RH_BENCH_JOBS`
+//! (workers; default: all cores), `RH_BENCH_PRESET`, `RH_BENCH_THREADS` (x264 threads
+//! per video), `RH_BENCH_MSAA` (samples on any adapter; default: the
+//! configuration's `msaa`, or `msaa_cpu` on a CPU rasterizer), `RH_BENCH_FXAA` (0 or 1:
+//! the post-process anti-aliasing pass; default: the configuration's `fxaa`).
+//!
+//! Prints each scene's own time and the figure that matters for a build: wall-clock
+//! seconds per scene with every worker busy.
+//!
+//! `RH_BENCH_MASKS=1` also writes the mask and depth PNGs (as `build --masks`). The
+//! instance-id pass alone (`Renderer::measure_hazard`: the five observation frames of
+//! the three cameras), which every rendered scene runs, is timed last.
+
+use rayon::prelude::*;
+use rh_catalog::Catalog;
+use rh_scenes::config::Config;
+use rh_render::{with_thread_renderer, RenderOptions};
+use rh_scenes::driver::produce_group;
+use rh_scenes::selection::plan_group;
+use rh_physics::simulate::{simulate, SimOptions};
+use std::time::Instant;
+
+fn env_parse<T: std::str::FromStr>(name: &str) -> Option<T> {
+    std::env::var(name).ok().and_then(|v| v.parse().ok())
+}
+
+fn main() {
+    let n: usize = std::env::args()
+        .skip(1)
+        .find_map(|a| a.parse().ok())
+        .unwrap_or(8);
+    let catalog = Catalog::embedded().unwrap();
+    let mut config = Config::embedded().unwrap();
+    if let Ok(p) = std::env::var("RH_BENCH_PRESET") {
+        config.render.preset = p;
+    }
+    if let Some(t) = env_parse("RH_BENCH_THREADS") {
+        config.render.encoder_threads = t;
+    }
+    if let Some(m) = env_parse("RH_BENCH_MSAA") {
+        config.render.msaa = m;
+        config.render.msaa_cpu = m;
+    }
+    if let Some(f) = env_parse::<u8>("RH_BENCH_FXAA") {
+        config.render.fxaa = f != 0;
+    }
+    let jobs: usize = env_parse("RH_BENCH_JOBS").unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let families = config.build.families.clone();
+    let mut scenes = Vec::new();
+    let mut g = 0u64;
+    while scenes.len() < n && g < 10 * n as u64 {
+        let selection = plan_group(&catalog, &families, 5, g).unwrap();
+        let r = produce_group(&selection, 5, g * 4, 1, &catalog, &config).unwrap();
+        g += 1;
+        let spec = r[0].spec.clone();
+        if spec.cameras.is_empty() {
+            continue;
+        }
+        let sim = simulate(&spec, SimOptions::default());
+        scenes.push((spec, sim));
+    }
+    let opts = RenderOptions {
+        masks: std::env::var_os("RH_BENCH_MASKS").is_some(),
+        ..RenderOptions::from_config(&config.render)
+    };
+    let dir = std::env::temp_dir().join(format!("rh-render-bench-{}", std::process::id()));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs)
+        .build()
+        .unwrap();
+    // Open each worker's device before timing (once per build, not per scene).
+    let t = Instant::now();
+    let adapters: Vec<(String, u32)> = pool.broadcast(|_| {
+        with_thread_renderer(&opts, |r| (r.adapter_name().to_string(), r.samples()))
+            .expect("a Vulkan adapter")
+    });
+    let setup = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let times: Vec<(f64, String)> = pool.install(|| {
+        scenes
+            .par_iter()
+            .map(|(spec, sim)| {
+                let t = Instant::now();
+                let r = with_thread_renderer(&opts, |r| r.render_scene(spec, sim, &catalog, &dir))
+                    .unwrap()
+                    .unwrap();
+                let s = t.elapsed().as_secs_f64();
+                let line = format!(
+                    "{} {:<16} {:.2} s ({} window frames x3 at {}x{}, {} full-event frames at {}x{}/{} fps)",
+                    spec.scene_id,
+                    spec.family,
+                    s,
+                    r.frame_steps.len(),
+                    spec.video.width,
+                    spec.video.height,
+                    r.full_event_steps.len(),
+                    opts.full_width,
+                    opts.full_height,
+                    opts.full_fps
+                );
+                (s, line)
+            })
+            .collect()
+    });
+    let wall = t.elapsed().as_secs_f64();
+    let _ = std::fs::remove_dir_all(&dir);
+    // The id pass alone, one scene after another on this thread.
+    let t = Instant::now();
+    for (spec, sim) in &scenes {
+        with_thread_renderer(&opts, |r| r.measure_hazard(spec, sim, &catalog))
+            .unwrap()
+            .unwrap();
+    }
+    let id_pass = t.elapsed().as_secs_f64() / scenes.len().max(1) as f64;
+    for (_, line) in &times {
+        println!("{line}");
+    }
+    let count = times.len().max(1) as f64;
+    println!(
+        "render_throughput: {:.2} s/scene wall-clock over {} scenes with {jobs} workers \
+         (each scene {:.2} s on average; adapter {}, device setup {:.2} s, preset {}, msaa {}, fxaa {}, x264 threads {})",
+        wall / count,
+        times.len(),
+        times.iter().map(|(s, _)| s).sum::<f64>() / count,
+        adapters[0].0,
+        setup,
+        opts.encode.preset,
+        adapters[0].1,
+        opts.fxaa,
+        opts.encode.threads
+    );
+    println!(
+        "render_throughput: masks {}; instance-id pass alone {id_pass:.3} s/scene on one worker",
+        opts.masks
+    );
+}

@@ -1,0 +1,175 @@
+//! Measured visibility and the dense labels of the observation frames: the instance-id
+//! pass (`gpu::IdPass`) at each `FRAME_TIMES` frame of every camera gives the hazard's
+//! visible pixels and its unoccluded fraction ([`HazardVisibility`]), and with
+//! `RenderOptions::masks` the 16-bit instance-id and depth PNGs
+//! (`masks/<scene_id>/<cam>_t….png`, `depth/<scene_id>/<cam>_t….png`).
+//!
+//! The id pass draws exactly what the lit frame draws (the same static ranges per camera:
+//! the ego camera leaves out the observer's body, as in its video), at the same physics
+//! steps, with one sample per pixel and no lighting.
+
+use super::camera::view_proj;
+use super::geometry::SceneGeometry;
+use super::gpu::{IdImage, IdPass, IdView};
+use super::{RenderError, Renderer, FRAME_TIMES};
+use rh_scenes::driver::HazardVisibility;
+use rh_physics::simulate::Simulation;
+use rh_physics::spec::{CameraSpec, SceneSpec};
+use rh_catalog::Catalog;
+use rh_contract::layout::{depth_path, instance, mask_path};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// What the id pass gave for one scene.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Observed {
+    /// Camera name → the hazard in its observation frames.
+    pub visibility: BTreeMap<String, HazardVisibility>,
+    /// Camera name → mask files, `FRAME_TIMES` order (empty unless masks were asked for).
+    pub masks: BTreeMap<String, Vec<String>>,
+    /// Camera name → depth files, likewise.
+    pub depth: BTreeMap<String, Vec<String>>,
+}
+
+/// A 16-bit grey PNG to write.
+pub(super) struct Png16 {
+    path: PathBuf,
+    width: u32,
+    height: u32,
+    pixels: Vec<u16>,
+}
+
+impl Renderer {
+    /// The hazard's visible pixels and unoccluded fraction in every spec camera at the
+    /// observation frames (the id pass only: no videos, no files).
+    pub fn measure_hazard(
+        &mut self,
+        spec: &SceneSpec,
+        sim: &Simulation,
+        catalog: &Catalog,
+    ) -> Result<BTreeMap<String, HazardVisibility>, RenderError> {
+        let scene = SceneGeometry::build(spec, sim, catalog);
+        self.gpu
+            .reserve(scene.statics.len() + scene.max_dynamic + 1024);
+        self.gpu.set_static(&scene.statics);
+        let cams: Vec<&CameraSpec> = spec.cameras.iter().collect();
+        let (observed, _) = self.observe(spec, sim, &scene, &cams, None)?;
+        Ok(observed.visibility)
+    }
+
+    /// Runs the id pass at each observation time for `cams` over the scene already
+    /// uploaded (`set_static`). With `masks_root`, also returns the mask and depth PNGs
+    /// to write under it (paths relative to it in `Observed`).
+    pub(super) fn observe(
+        &mut self,
+        spec: &SceneSpec,
+        sim: &Simulation,
+        scene: &SceneGeometry,
+        cams: &[&CameraSpec],
+        masks_root: Option<&Path>,
+    ) -> Result<(Observed, Vec<Png16>), RenderError> {
+        let pass = match &mut self.ids {
+            Some(p) => p,
+            None => self.ids.insert(IdPass::new(&self.gpu)),
+        };
+        let hazard = instance::body(spec.hazard);
+        let steps = spec.observation_frame_steps(sim.steps());
+        let last = steps.len() as u32 - 1;
+        let mut counts: Vec<Vec<(u32, u32)>> = vec![Vec::new(); cams.len()];
+        let mut observed = Observed::default();
+        let mut pngs = Vec::new();
+        for &t in &FRAME_TIMES {
+            let k = ((t * spec.video.fps as f64).round() as u32).min(last);
+            let dynamic = scene.dynamic_at(sim, steps[k as usize], false);
+            let dyn_range = self.gpu.set_dynamic(&dynamic)?;
+            let dyn_ids = scene.dynamic_ids(&dyn_range);
+            let views: Vec<IdView> = cams
+                .iter()
+                .enumerate()
+                .map(|(slot, cam)| {
+                    let mut ranges = scene.id_ranges_for(cam);
+                    ranges.extend(dyn_ids.iter().cloned());
+                    let alone = ranges
+                        .iter()
+                        .filter(|(_, id)| *id == hazard)
+                        .map(|(r, _)| r.clone())
+                        .collect();
+                    IdView {
+                        slot,
+                        width: cam.width,
+                        height: cam.height,
+                        view_proj: view_proj(cam),
+                        cam_pos: cam.position.map(|c| c as f32),
+                        ranges,
+                        alone,
+                    }
+                })
+                .collect();
+            let images = self.gpu.draw_ids(pass, &views)?;
+            for (ci, (img, cam)) in images.into_iter().zip(cams).enumerate() {
+                let visible = img.ids.iter().filter(|&&id| id == hazard).count() as u32;
+                counts[ci].push((visible, img.covered));
+                if let Some(root) = masks_root {
+                    pngs.extend(mask_pngs(&mut observed, root, &spec.scene_id, cam, t, img));
+                }
+            }
+        }
+        for (cam, c) in cams.iter().zip(&counts) {
+            observed
+                .visibility
+                .insert(cam.name.clone(), HazardVisibility::from_counts(c));
+        }
+        Ok((observed, pngs))
+    }
+}
+
+/// Records one frame's mask and depth files in `observed` and returns them to write.
+fn mask_pngs(
+    observed: &mut Observed,
+    root: &Path,
+    scene_id: &str,
+    cam: &CameraSpec,
+    t: f64,
+    img: IdImage,
+) -> [Png16; 2] {
+    let (m, d) = (
+        mask_path(scene_id, &cam.name, t),
+        depth_path(scene_id, &cam.name, t),
+    );
+    let png = |rel: &str, pixels| Png16 {
+        path: root.join(rel),
+        width: img.width,
+        height: img.height,
+        pixels,
+    };
+    let pngs = [png(&m, img.ids), png(&d, img.depth_mm)];
+    observed.masks.entry(cam.name.clone()).or_default().push(m);
+    observed.depth.entry(cam.name.clone()).or_default().push(d);
+    pngs
+}
+
+/// Writes the PNGs on a thread of their own (while the lit frames render); join it for
+/// the first error.
+pub(super) fn write_pngs(pngs: Vec<Png16>) -> std::thread::JoinHandle<Result<(), String>> {
+    std::thread::spawn(move || pngs.iter().try_for_each(write_png16))
+}
+
+/// A 16-bit greyscale PNG, written atomically.
+fn write_png16(p: &Png16) -> Result<(), String> {
+    use image::ImageEncoder;
+    let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", p.path.display());
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new_with_quality(
+        &mut bytes,
+        image::codecs::png::CompressionType::Fast,
+        image::codecs::png::FilterType::Sub,
+    )
+    .write_image(
+        bytemuck::cast_slice(&p.pixels),
+        p.width,
+        p.height,
+        image::ExtendedColorType::L16,
+    )
+    .map_err(|e| fail(&e))?;
+    rh_contract::fsio::write_atomic(&p.path, &bytes).map_err(|e| fail(&e))
+}

@@ -1,0 +1,448 @@
+//! The renderer: one scene's observation videos, frames and full-event video
+//! ([`Renderer::render_scene`]), single frames and hazard masks.
+
+use super::camera::full_event_camera;
+use super::encode::{self, VideoJob};
+use super::geometry::{FixedView, SceneGeometry};
+use super::gpu::{Gpu, OverlayJob, ViewJob};
+use super::regions::bounds;
+use super::{RenderError, RenderOptions, RenderedScene, Shading, CAMERAS, FRAME_TIMES, FULL_EVENT};
+use rh_scenes::driver::{full_event_simulation, SceneMedia, SceneResult};
+use rh_physics::simulate::{simulate, SimOptions, Simulation};
+use rh_physics::spec::{CameraSpec, SceneSpec};
+use rh_catalog::Catalog;
+use rh_contract::layout::{frame_path, video_path};
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// The wgpu device and pipelines; create one per worker thread and reuse it.
+pub struct Renderer {
+    pub(super) gpu: Gpu,
+    opts: RenderOptions,
+    /// The instance-id pass (`measure`), built on first use.
+    pub(super) ids: Option<super::gpu::IdPass>,
+}
+
+thread_local! {
+    static THREAD_RENDERER: RefCell<Option<Renderer>> = const { RefCell::new(None) };
+}
+
+/// Runs `f` with this thread's renderer, creating it on first use (so a rayon worker
+/// keeps one device for all its scenes).
+pub fn with_thread_renderer<R>(
+    opts: &RenderOptions,
+    f: impl FnOnce(&mut Renderer) -> R,
+) -> Result<R, RenderError> {
+    THREAD_RENDERER.with(|cell| {
+        let mut slot = cell.borrow_mut();
+        if slot.is_none() {
+            *slot = Some(Renderer::new(opts.clone())?);
+        }
+        let r = slot.as_mut().unwrap();
+        r.opts = opts.clone();
+        Ok(f(r))
+    })
+}
+
+impl Renderer {
+    /// Opens the GPU (a clear `RenderError::NoAdapter` when there is none) and checks
+    /// that FFmpeg has an H.264 encoder.
+    pub fn new(opts: RenderOptions) -> Result<Renderer, RenderError> {
+        encode::init().map_err(RenderError::Encode)?;
+        let gpu = Gpu::new(opts.msaa, opts.msaa_cpu, opts.fxaa)?;
+        Ok(Renderer {
+            gpu,
+            opts,
+            ids: None,
+        })
+    }
+
+    pub fn adapter_name(&self) -> &str {
+        &self.gpu.adapter_name
+    }
+
+    /// MSAA samples per pixel in use.
+    pub fn samples(&self) -> u32 {
+        self.gpu.samples()
+    }
+
+    pub fn options(&self) -> &RenderOptions {
+        &self.opts
+    }
+
+    /// Renders one scene's videos and observation frames under `out_dir` (the dataset
+    /// root). See the module docs for the files.
+    pub fn render_scene(
+        &mut self,
+        spec: &SceneSpec,
+        sim: &Simulation,
+        catalog: &Catalog,
+        out_dir: &Path,
+    ) -> Result<RenderedScene, RenderError> {
+        let id = &spec.scene_id;
+        let cams = observation_cameras(spec)?;
+        let scene = SceneGeometry::build(spec, sim, catalog);
+        self.gpu
+            .reserve(scene.statics.len() + scene.max_dynamic + 1024);
+        self.gpu.set_static(&scene.statics);
+        // The full-event video shows the counterfactual run (the observer as a body),
+        // the observation videos the plain run (`scene::full_event_simulation`).
+        let counterfactual = full_event_simulation(spec, sim);
+        let full_sim = counterfactual.as_ref().unwrap_or(sim);
+        // The cameras stand still within a scene: the room, furniture and observer are
+        // drawn once per view and every frame starts from that image.
+        let full_cam =
+            full_event_camera(spec, full_sim, self.opts.full_width, self.opts.full_height);
+        let mut all_cams = cams.clone();
+        all_cams.push(&full_cam);
+        let static_views: Vec<ViewJob> = all_cams
+            .iter()
+            .enumerate()
+            .map(|(slot, cam)| scene.view_job(slot, cam, Shading::Lit, scene.ranges_for(cam), 0..0))
+            .collect();
+        self.gpu
+            .cache_static(scene.light_vp, &scene.static_casters(), &static_views)?;
+        // What each view needs per frame that does not change within the scene.
+        let fixed_views: Vec<FixedView> = all_cams
+            .iter()
+            .enumerate()
+            .map(|(slot, cam)| scene.fixed_view(slot, cam))
+            .collect();
+        let (window_views, full_view) = fixed_views.split_at(cams.len());
+        // The id pass at the observation frames: measured visibility, and the mask and
+        // depth PNGs (written on their own thread while the frames below render).
+        let masks_root = self.opts.masks.then_some(out_dir);
+        let (observed, pngs) = self.observe(spec, sim, &scene, &cams, masks_root)?;
+        let mask_thread = super::measure::write_pngs(pngs);
+
+        let fps = spec.video.fps;
+        let frame_steps = spec.observation_frame_steps(sim.steps());
+        let frames = frame_steps.len() as u32 - 1;
+        let png_frames: Vec<(u32, f64)> = FRAME_TIMES
+            .iter()
+            .map(|&t| (((t * fps as f64).round() as u32).min(frames), t))
+            .collect();
+
+        let (videos, jobs) = self.spawn_videos(&cams, id, fps, out_dir);
+        let mut frame_files = vec![String::new(); cams.len() * FRAME_TIMES.len()];
+        let (png_tx, png_thread) = png_writer();
+
+        let debug = std::env::var_os("RH_RENDER_DEBUG").is_some();
+        let t_start = std::time::Instant::now();
+        let mut t_draw = 0.0;
+        let mut result = Ok(());
+        for (k, &step) in frame_steps.iter().enumerate() {
+            let t = std::time::Instant::now();
+            let images = self.draw_overlay_step(&scene, sim, step, window_views)?;
+            t_draw += t.elapsed().as_secs_f64();
+            for (ci, (img, job)) in images.into_iter().zip(&jobs).enumerate() {
+                for (ti, &(pk, t)) in png_frames.iter().enumerate() {
+                    if pk as usize == k {
+                        let rel = frame_path(id, &cams[ci].name, t);
+                        let _ = png_tx.send((
+                            out_dir.join(&rel),
+                            cams[ci].width,
+                            cams[ci].height,
+                            img.clone(),
+                        ));
+                        frame_files[ci * FRAME_TIMES.len() + ti] = rel;
+                    }
+                }
+                if !job.send(img) {
+                    result = Err(());
+                }
+            }
+            if result.is_err() {
+                break;
+            }
+        }
+
+        // Full-event video: the whole (counterfactual) simulation from outside.
+        let full_fps = self.opts.full_fps.max(1);
+        let full_event_steps = full_event_steps(full_sim, full_fps);
+        let full_rel = video_path(FULL_EVENT, id);
+        let full_job = VideoJob::spawn(
+            out_dir.join(&full_rel),
+            full_cam.width,
+            full_cam.height,
+            full_fps,
+            self.opts.encode.clone(),
+            self.gpu.frames.clone(),
+        );
+        if result.is_ok() {
+            for &step in &full_event_steps {
+                let mut images = self.draw_overlay_step(&scene, full_sim, step, full_view)?;
+                if !full_job.send(images.pop().unwrap()) {
+                    break;
+                }
+            }
+        }
+        drop(png_tx);
+        if debug {
+            eprintln!(
+                "render {id}: {} static + {} dynamic vertices; window draw {:.2} s, all frames {:.2} s",
+                scene.statics.len(),
+                scene.max_dynamic,
+                t_draw,
+                t_start.elapsed().as_secs_f64()
+            );
+        }
+        let mut errors = Vec::new();
+        for (job, cam) in jobs.into_iter().zip(&cams) {
+            finish_video(job, &cam.name, frame_steps.len(), &mut errors);
+        }
+        finish_video(full_job, "full", full_event_steps.len(), &mut errors);
+        for thread in [png_thread, mask_thread] {
+            match thread.join() {
+                Ok(Ok(())) => {}
+                Ok(Err(e)) => errors.push(e),
+                Err(_) => errors.push("PNG writer panicked".into()),
+            }
+        }
+        if !errors.is_empty() {
+            return Err(RenderError::Encode(format!(
+                "scene {id}: {}",
+                errors.join("; ")
+            )));
+        }
+        Ok(RenderedScene {
+            videos,
+            full_event: full_rel,
+            frames: frame_files,
+            frame_steps,
+            fps,
+            full_event_steps,
+            full_event_fps: full_fps,
+            observed,
+        })
+    }
+
+    /// Starts one encoder per observation camera: `videos/<cam>/<scene_id>.mp4`.
+    fn spawn_videos(
+        &self,
+        cams: &[&CameraSpec],
+        id: &str,
+        fps: u32,
+        out_dir: &Path,
+    ) -> (BTreeMap<String, String>, Vec<VideoJob>) {
+        let mut videos = BTreeMap::new();
+        let mut jobs = Vec::new();
+        for cam in cams {
+            let rel = video_path(&cam.name, id);
+            jobs.push(VideoJob::spawn(
+                out_dir.join(&rel),
+                cam.width,
+                cam.height,
+                fps,
+                self.opts.encode.clone(),
+                self.gpu.frames.clone(),
+            ));
+            videos.insert(cam.name.clone(), rel);
+        }
+        (videos, jobs)
+    }
+
+    /// Renders the given cameras at one physics step (RGBA8 sRGB images, no files).
+    pub fn render_frame(
+        &mut self,
+        spec: &SceneSpec,
+        sim: &Simulation,
+        catalog: &Catalog,
+        cameras: &[CameraSpec],
+        step: u32,
+        shading: Shading,
+    ) -> Result<Vec<image::RgbaImage>, RenderError> {
+        let scene = SceneGeometry::build(spec, sim, catalog);
+        self.gpu
+            .reserve(scene.statics.len() + scene.max_dynamic + 1024);
+        self.gpu.set_static(&scene.statics);
+        let cams: Vec<&CameraSpec> = cameras.iter().collect();
+        let images = self.draw_step(&scene, sim, step.min(sim.steps()), &cams, shading)?;
+        Ok(images
+            .into_iter()
+            .zip(cameras)
+            .map(|(img, c)| image::RgbaImage::from_raw(c.width, c.height, img).unwrap())
+            .collect())
+    }
+
+    /// Visible hazard pixels per spec camera at `step` (from the exact `HazardMask`
+    /// rendering): 0 means the hazard is hidden (behind furniture, say) even if its
+    /// centre projects inside the frame. A basis for an occlusion-aware framing check.
+    pub fn hazard_pixels(
+        &mut self,
+        spec: &SceneSpec,
+        sim: &Simulation,
+        catalog: &Catalog,
+        step: u32,
+    ) -> Result<Vec<(String, usize)>, RenderError> {
+        let images =
+            self.render_frame(spec, sim, catalog, &spec.cameras, step, Shading::HazardMask)?;
+        Ok(spec
+            .cameras
+            .iter()
+            .zip(images)
+            .map(|(cam, img)| {
+                let n = img
+                    .pixels()
+                    .filter(|p| p[0] > 247 && p[1] < 8 && p[2] > 247)
+                    .count();
+                (cam.name.clone(), n)
+            })
+            .collect())
+    }
+
+    /// The whole scene at one step, drawn from scratch (diagnostics and single frames).
+    fn draw_step(
+        &mut self,
+        scene: &SceneGeometry,
+        sim: &Simulation,
+        step: u32,
+        cams: &[&CameraSpec],
+        shading: Shading,
+    ) -> Result<Vec<Vec<u8>>, RenderError> {
+        let dynamic = scene.dynamic_at(sim, step, shading == Shading::HazardMask);
+        let dyn_range = self.gpu.set_dynamic(&dynamic)?;
+        let views: Vec<ViewJob> = cams
+            .iter()
+            .enumerate()
+            .map(|(slot, cam)| {
+                scene.view_job(slot, cam, shading, scene.ranges_for(cam), dyn_range.clone())
+            })
+            .collect();
+        let mut casters = scene.static_casters();
+        casters.push(dyn_range);
+        self.gpu.draw(scene.light_vp, &casters, &views)
+    }
+
+    /// The same pixels as `draw_step` with `Shading::Lit`, drawn over the views cached
+    /// in `render_scene`: only the moving bodies and the static surfaces their shadows
+    /// can reach are drawn.
+    fn draw_overlay_step(
+        &mut self,
+        scene: &SceneGeometry,
+        sim: &Simulation,
+        step: u32,
+        views: &[FixedView],
+    ) -> Result<Vec<Vec<u8>>, RenderError> {
+        let dynamic = scene.dynamic_at(sim, step, false);
+        let dyn_range = self.gpu.set_dynamic(&dynamic)?;
+        let moving = bounds(&dynamic);
+        let jobs: Vec<OverlayJob> = views
+            .iter()
+            .map(|v| {
+                let redraw = moving
+                    .map(|m| scene.shadow_redraws(v, m))
+                    .unwrap_or_default();
+                let changed = moving.and_then(|m| scene.changed_rect(v, m, &redraw));
+                OverlayJob {
+                    slot: v.slot,
+                    uniforms: v.uniforms,
+                    redraw,
+                    dynamic: dyn_range.clone(),
+                    changed,
+                }
+            })
+            .collect();
+        self.gpu
+            .draw_overlay(scene.light_vp, std::slice::from_ref(&dyn_range), &jobs)
+    }
+}
+
+/// Stage 4 for the DAG driver (`scene::run_group`): renders a valid scene's videos and
+/// frames into `out` with this thread's renderer. Invalid scenes are not rendered (their
+/// video columns stay null). The simulation is run again from the spec (milliseconds,
+/// and identical by construction) rather than kept per group.
+pub fn render_stage(
+    r: &SceneResult,
+    catalog: &Catalog,
+    opts: &RenderOptions,
+    out: &Path,
+) -> Result<Option<SceneMedia>, RenderError> {
+    if !r.verdicts.all() || r.spec.cameras.is_empty() {
+        return Ok(None);
+    }
+    let sim = simulate(&r.spec, SimOptions::default());
+    let rendered = with_thread_renderer(opts, |renderer| {
+        renderer.render_scene(&r.spec, &sim, catalog, out)
+    })
+    .and_then(|x| x)?;
+    Ok(Some(SceneMedia {
+        videos: rendered.videos,
+        full_event: rendered.full_event,
+        visibility: rendered.observed.visibility,
+        masks: rendered.observed.masks,
+        depth: rendered.observed.depth,
+    }))
+}
+
+/// The spec's observation cameras in `CAMERAS` order (an error names a missing one).
+fn observation_cameras(spec: &SceneSpec) -> Result<Vec<&CameraSpec>, RenderError> {
+    CAMERAS
+        .iter()
+        .map(|name| {
+            spec.cameras
+                .iter()
+                .find(|c| c.name == *name)
+                .ok_or_else(|| {
+                    RenderError::Scene(
+                        spec.scene_id.clone(),
+                        format!("no '{name}' camera in the spec"),
+                    )
+                })
+        })
+        .collect()
+}
+
+/// Full-event frame `j` shows physics step `round(j / fps / dt)` (at most the last).
+fn full_event_steps(sim: &Simulation, full_fps: u32) -> Vec<u32> {
+    let duration = sim.steps() as f64 * sim.dt;
+    let full_frames = (duration * full_fps as f64 + 1e-9).floor() as u32;
+    (0..=full_frames)
+        .map(|j| ((j as f64 / full_fps as f64 / sim.dt).round() as u32).min(sim.steps()))
+        .collect()
+}
+
+/// Waits for an encoder and notes an error unless it wrote exactly `frames` frames.
+fn finish_video(job: VideoJob, name: &str, frames: usize, errors: &mut Vec<String>) {
+    match job.finish() {
+        Ok(n) if n as usize == frames => {}
+        Ok(n) => errors.push(format!("{name}: {n} frames written")),
+        Err(e) => errors.push(format!("{name}: {e}")),
+    }
+}
+
+/// A PNG frame to write: (path, width, height, RGBA).
+type PngJob = (PathBuf, u32, u32, Vec<u8>);
+
+/// A thread that writes the PNG frames sent to it (join it for the first error).
+fn png_writer() -> (
+    std::sync::mpsc::Sender<PngJob>,
+    std::thread::JoinHandle<Result<(), String>>,
+) {
+    let (tx, rx) = std::sync::mpsc::channel::<PngJob>();
+    let thread = std::thread::spawn(move || -> Result<(), String> {
+        for (path, w, h, rgba) in rx {
+            write_png(&path, w, h, &rgba)?;
+        }
+        Ok(())
+    });
+    (tx, thread)
+}
+
+fn write_png(path: &Path, w: u32, h: u32, rgba: &[u8]) -> Result<(), String> {
+    use image::ImageEncoder;
+    let rgb: Vec<u8> = rgba
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new_with_quality(
+        &mut bytes,
+        image::codecs::png::CompressionType::Fast,
+        image::codecs::png::FilterType::Sub,
+    )
+    .write_image(&rgb, w, h, image::ExtendedColorType::Rgb8)
+    .map_err(|e| format!("{}: {e}", path.display()))?;
+    rh_contract::fsio::write_atomic(path, &bytes).map_err(|e| format!("{}: {e}", path.display()))
+}

@@ -1,0 +1,490 @@
+//! Build configuration (`configs/*.toml`): every policy number of the pipeline.
+//!
+//! The default configuration is compiled in, so `rh-pipeline build` needs no files;
+//! `--config FILE` loads another one (its `labels` path is relative to that file).
+
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use rh_physics::spec::{LabelConfig, LABELS_TOML};
+
+const DEFAULT_TOML: &str = include_str!("../../configs/default.toml");
+
+#[derive(Debug, thiserror::Error)]
+#[error("{location}: {message}")]
+pub struct ConfigError {
+    pub location: String,
+    pub message: String,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BuildSection {
+    pub seed: u64,
+    pub families: Vec<String>,
+    pub far_observer_share: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhysicsConfig {
+    pub dt: f64,
+    pub min_duration_s: f64,
+    pub horizon_s: f64,
+    pub settle_speed: f64,
+    pub settle_time_s: f64,
+    pub solver_iterations: usize,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObservationConfig {
+    pub window_s: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObserverConfig {
+    pub height: f64,
+    pub pelvis_z: f64,
+    pub shoulder_z: f64,
+    pub arm_reach: f64,
+    pub torso_radius: f64,
+    pub max_walk_speed: f64,
+}
+
+fn default_visible_px_min() -> u32 {
+    64
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ValidatorConfig {
+    pub max_attempts: u32,
+    pub penetration_tolerance: f64,
+    pub energy_gain_relative: f64,
+    pub energy_gain_absolute: f64,
+    pub tunnel_tolerance: f64,
+    /// Hazard pixels the renderer's instance-id pass must count in every model-input
+    /// frame (the measured check of the visibility rule: test `render_visibility`).
+    #[serde(default = "default_visible_px_min")]
+    pub visible_px_min: u32,
+    pub frame_margin: f64,
+    pub frame_check_until_within: f64,
+    /// The widest vertical field of view a camera may be given (rad); a camera draw
+    /// that would need more is redrawn.
+    #[serde(default = "default_max_fov_y")]
+    pub max_fov_y: f64,
+    /// Visibility rule (`visibility`): the share of the hazard's sample points that must
+    /// be in the image and in sight of every camera at every checked frame.
+    #[serde(default = "default_visible_fraction_min")]
+    pub visible_fraction_min: f64,
+    /// Visibility rule: the smallest projected size of the hazard (px at the configured
+    /// resolution, largest side of its projected sample points' box).
+    #[serde(default = "default_visible_size_px_min")]
+    pub visible_size_px_min: f64,
+    /// Visibility rule: widening of the observer's collision capsule for line of sight
+    /// (m), so that it also covers the drawn shoulders and arms.
+    #[serde(default = "default_visibility_observer_margin")]
+    pub visibility_observer_margin: f64,
+    /// Camera placement: the band of projected hazard sizes (px) that a camera's field of
+    /// view aims for — wide enough that the hazard never fills the frame, no wider than
+    /// its path needs.
+    #[serde(default = "default_frame_size_px")]
+    pub frame_size_px: [f64; 2],
+}
+
+fn default_max_fov_y() -> f64 {
+    2.1
+}
+fn default_visible_fraction_min() -> f64 {
+    0.5
+}
+fn default_visible_size_px_min() -> f64 {
+    8.0
+}
+fn default_visibility_observer_margin() -> f64 {
+    0.08
+}
+fn default_frame_size_px() -> [f64; 2] {
+    [24.0, 400.0]
+}
+
+/// Framing policy (from the `[validators]` config), for `cameras::frame`.
+#[derive(Debug, Clone, Copy)]
+pub struct FramingRules {
+    /// Margin kept inside the image border (fraction of the half-size).
+    pub margin: f64,
+    /// Stop checking once the hazard is this close to the observer's torso axis (m).
+    pub until_within: f64,
+    /// The widest vertical field of view a camera may get (rad).
+    pub max_fov_y: f64,
+    /// Least share of the hazard's sample points in the image and in sight.
+    pub visible_fraction: f64,
+    /// Least projected size of the hazard (px).
+    pub min_size_px: f64,
+    /// Widening of the observer's capsule for line of sight (m).
+    pub observer_margin: f64,
+    /// Band of projected hazard sizes (px) that placement aims for.
+    pub size_band_px: [f64; 2],
+}
+
+impl ValidatorConfig {
+    pub fn framing(&self) -> FramingRules {
+        FramingRules {
+            margin: self.frame_margin,
+            until_within: self.frame_check_until_within,
+            max_fov_y: self.max_fov_y,
+            visible_fraction: self.visible_fraction_min,
+            min_size_px: self.visible_size_px_min,
+            observer_margin: self.visibility_observer_margin,
+            size_band_px: self.frame_size_px,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderConfig {
+    pub width: u32,
+    pub height: u32,
+    pub fps: u32,
+    /// Size and frame rate of the full-event video (for people, not model input).
+    #[serde(default = "default_full_width")]
+    pub full_width: u32,
+    #[serde(default = "default_full_height")]
+    pub full_height: u32,
+    #[serde(default = "default_full_fps")]
+    pub full_fps: u32,
+    /// libx264 preset and constant rate factor.
+    #[serde(default = "default_preset")]
+    pub preset: String,
+    #[serde(default = "default_crf")]
+    pub crf: u32,
+    /// libx264 threads per video (0 = automatic).
+    #[serde(default = "default_encoder_threads")]
+    pub encoder_threads: u32,
+    /// MSAA samples (4 or 1) on a hardware GPU.
+    #[serde(default = "default_msaa")]
+    pub msaa: u32,
+    /// MSAA samples (4 or 1) on a CPU rasterizer (Mesa's lavapipe), where 4 samples
+    /// cost about 3× the time.
+    #[serde(default = "default_msaa_cpu")]
+    pub msaa_cpu: u32,
+    /// FXAA-style post-process anti-aliasing where MSAA is off (a CPU rasterizer).
+    #[serde(default = "default_fxaa")]
+    pub fxaa: bool,
+}
+
+fn default_fxaa() -> bool {
+    true
+}
+
+fn default_msaa_cpu() -> u32 {
+    1
+}
+
+fn default_full_width() -> u32 {
+    640
+}
+fn default_full_height() -> u32 {
+    360
+}
+fn default_full_fps() -> u32 {
+    30
+}
+fn default_preset() -> String {
+    "veryfast".into()
+}
+fn default_crf() -> u32 {
+    20
+}
+fn default_encoder_threads() -> u32 {
+    1
+}
+fn default_msaa() -> u32 {
+    4
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawConfig {
+    labels: PathBuf,
+    build: BuildSection,
+    physics: PhysicsConfig,
+    observation: ObservationConfig,
+    observer: ObserverConfig,
+    validators: ValidatorConfig,
+    render: RenderConfig,
+    speed_bands: BTreeMap<String, [f64; 4]>,
+}
+
+/// The whole, validated build configuration (`Deserialize` reads back the copy a build
+/// manifest stores).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Config {
+    pub build: BuildSection,
+    pub physics: PhysicsConfig,
+    pub observation: ObservationConfig,
+    pub observer: ObserverConfig,
+    pub validators: ValidatorConfig,
+    pub render: RenderConfig,
+    pub speed_bands: BTreeMap<String, [f64; 4]>,
+    pub labels: LabelConfig,
+    /// Where the configuration came from (for messages; not part of its content).
+    #[serde(skip)]
+    pub source: String,
+}
+
+impl Config {
+    /// The configuration compiled into the binary (`configs/default.toml`).
+    pub fn embedded() -> Result<Config, ConfigError> {
+        let raw: RawConfig = parse("configs/default.toml", DEFAULT_TOML)?;
+        let labels: LabelConfig = parse("configs/labels.toml", LABELS_TOML)?;
+        Config::assemble("configs/default.toml", raw, labels)
+    }
+
+    /// Loads a configuration file and the labels file it names.
+    pub fn load(path: &Path) -> Result<Config, ConfigError> {
+        let name = path.display().to_string();
+        let text = read(path)?;
+        let raw: RawConfig = parse(&name, &text)?;
+        let labels_path = path.parent().unwrap_or(Path::new(".")).join(&raw.labels);
+        let labels_text = read(&labels_path)?;
+        let labels: LabelConfig = parse(&labels_path.display().to_string(), &labels_text)?;
+        Config::assemble(&name, raw, labels)
+    }
+
+    fn assemble(name: &str, raw: RawConfig, labels: LabelConfig) -> Result<Config, ConfigError> {
+        let config = Config {
+            build: raw.build,
+            physics: raw.physics,
+            observation: raw.observation,
+            observer: raw.observer,
+            validators: raw.validators,
+            render: raw.render,
+            speed_bands: raw.speed_bands,
+            labels,
+            source: name.to_string(),
+        };
+        config.validate(name)?;
+        Ok(config)
+    }
+
+    fn validate(&self, name: &str) -> Result<(), ConfigError> {
+        let fail = |field: &str, message: String| ConfigError {
+            location: format!("{name}: field '{field}'"),
+            message,
+        };
+        let positive = |field: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(fail(field, format!("must be a positive number (got {v})")))
+            }
+        };
+        positive("physics.dt", self.physics.dt)?;
+        positive("physics.horizon_s", self.physics.horizon_s)?;
+        positive("physics.min_duration_s", self.physics.min_duration_s)?;
+        positive("observation.window_s", self.observation.window_s)?;
+        let l = &self.labels;
+        for (field, v) in [
+            (
+                "labels.envelope_shoulder_offset",
+                l.envelope_shoulder_offset,
+            ),
+            ("labels.envelope_step", l.envelope_step),
+            ("labels.envelope_arm_reach", l.envelope_arm_reach),
+            ("labels.envelope_crouch", l.envelope_crouch),
+            ("labels.envelope_min_height", l.envelope_min_height),
+            ("labels.catch_walk_speed", l.catch_walk_speed),
+            ("labels.catch_walk_accel", l.catch_walk_accel),
+            ("labels.catch_prepare_s", l.catch_prepare_s),
+            ("labels.catch_radius_max", l.catch_radius_max),
+            ("labels.escape_speed", l.escape_speed),
+            ("labels.escape_distance", l.escape_distance),
+            ("labels.escape_directions", l.escape_directions as f64),
+            ("labels.escape_check_within_s", l.escape_check_within_s),
+            ("labels.interception_tolerance", l.interception_tolerance),
+            ("labels.reaction_time_min", l.reaction_time_min),
+            ("labels.floor_contact_eps", l.floor_contact_eps),
+            ("labels.strike_speed_min", l.strike_speed_min),
+            ("labels.strike_impulse_min", l.strike_impulse_min),
+            ("labels.strike_impulse_heavy", l.strike_impulse_heavy),
+            ("labels.strike_window_s", l.strike_window_s),
+        ] {
+            positive(field, v)?;
+        }
+        positive("labels.reach_radius", self.labels.reach_radius)?;
+        positive(
+            "labels.closest_approach_max",
+            self.labels.closest_approach_max,
+        )?;
+        positive("labels.heavy_mass_kg", self.labels.heavy_mass_kg)?;
+        positive("labels.heavy_momentum", self.labels.heavy_momentum)?;
+        positive("labels.catch_speed_max", self.labels.catch_speed_max)?;
+        positive("labels.catch_energy_max", self.labels.catch_energy_max)?;
+        positive("observer.torso_radius", self.observer.torso_radius)?;
+        if self.physics.horizon_s < self.physics.min_duration_s {
+            return Err(fail(
+                "physics.horizon_s",
+                "must be at least physics.min_duration_s".into(),
+            ));
+        }
+        if self.physics.min_duration_s < self.observation.window_s {
+            return Err(fail(
+                "physics.min_duration_s",
+                "must cover the observation window".into(),
+            ));
+        }
+        let v = &self.validators;
+        if !(0.0..=1.0).contains(&v.visible_fraction_min) {
+            return Err(fail(
+                "validators.visible_fraction_min",
+                "must be within [0, 1]".into(),
+            ));
+        }
+        if !(v.visibility_observer_margin >= 0.0) {
+            return Err(fail(
+                "validators.visibility_observer_margin",
+                "must not be negative".into(),
+            ));
+        }
+        let [lo, hi] = v.frame_size_px;
+        if !(v.visible_size_px_min >= 0.0 && lo >= v.visible_size_px_min && hi > lo) {
+            return Err(fail(
+                "validators.frame_size_px",
+                "needs visible_size_px_min <= min < max".into(),
+            ));
+        }
+        if self.validators.max_attempts == 0 {
+            return Err(fail("validators.max_attempts", "must be at least 1".into()));
+        }
+        if self.labels.reach_radius > self.labels.closest_approach_max {
+            return Err(fail(
+                "labels.reach_radius",
+                "must not exceed labels.closest_approach_max (a reachable hazard needs an impact point)".into(),
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.build.far_observer_share) {
+            return Err(fail(
+                "build.far_observer_share",
+                "must be within [0, 1]".into(),
+            ));
+        }
+        if self.render.width == 0 || self.render.height == 0 || self.render.fps == 0 {
+            return Err(fail(
+                "render",
+                "width, height and fps must be positive".into(),
+            ));
+        }
+        for family in &self.build.families {
+            if !rh_contract::FAMILIES.contains(&family.as_str()) {
+                return Err(fail("build.families", format!("unknown family '{family}'")));
+            }
+        }
+        for (family, bands) in &self.speed_bands {
+            if !rh_contract::FAMILIES.contains(&family.as_str()) {
+                return Err(fail("speed_bands", format!("unknown family '{family}'")));
+            }
+            if bands.iter().any(|v| !v.is_finite() || *v < 0.0) {
+                return Err(fail(
+                    &format!("speed_bands.{family}"),
+                    "must be four finite, non-negative numbers".into(),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The family's speed parameter in the four bands (slow, normal, fast, very fast).
+    pub fn speed_bands(&self, family: &str) -> Option<&[f64; 4]> {
+        self.speed_bands.get(family)
+    }
+}
+
+fn read(path: &Path) -> Result<String, ConfigError> {
+    std::fs::read_to_string(path).map_err(|e| ConfigError {
+        location: path.display().to_string(),
+        message: format!("cannot read: {e}"),
+    })
+}
+
+fn parse<T: serde::de::DeserializeOwned>(name: &str, text: &str) -> Result<T, ConfigError> {
+    toml::from_str(text).map_err(|e| {
+        let location = match e.span() {
+            Some(span) => {
+                // 1-based: the newlines before the span's start, plus one.
+                let line = text.as_bytes()[..span.start.min(text.len())]
+                    .iter()
+                    .filter(|&&b| b == b'\n')
+                    .count()
+                    + 1;
+                format!("{name}:{line}")
+            }
+            None => name.to_string(),
+        };
+        ConfigError {
+            location,
+            message: e.message().to_string(),
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn embedded_config_is_valid() {
+        let c = Config::embedded().unwrap();
+        assert!((c.physics.dt - 1.0 / 240.0).abs() < 1e-15);
+        assert_eq!(c.labels.rule_version, "v4");
+        for f in &c.build.families {
+            assert!(
+                c.speed_bands(f).is_some(),
+                "default family {f} has no speed bands"
+            );
+        }
+    }
+
+    #[test]
+    fn malformed_config_names_file_and_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.toml");
+        std::fs::write(&path, DEFAULT_TOML.replace("seed = 0", "seed = \"zero\"")).unwrap();
+        std::fs::write(dir.path().join("labels.toml"), LABELS_TOML).unwrap();
+        let err = Config::load(&path).unwrap_err().to_string();
+        assert!(err.contains("bad.toml:"), "{err}");
+        assert!(err.contains("\"zero\""), "{err}");
+        // The exact line: a value at the start of a line and one after a blank line.
+        for (text, line) in [
+            ("labels = \"l.toml\"\n[build]\nseed = \"zero\"\n", 3),
+            (
+                "labels = \"l.toml\"\n\n[build]\nseed = 0\nfamilies = 7\n",
+                5,
+            ),
+            ("labels = 3\n", 1),
+        ] {
+            let err = parse::<RawConfig>("x.toml", text).unwrap_err().to_string();
+            assert!(
+                err.starts_with(&format!("x.toml:{line}:")),
+                "{text:?}: {err}"
+            );
+        }
+    }
+
+    #[test]
+    fn semantic_errors_name_the_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.toml");
+        std::fs::write(
+            &path,
+            DEFAULT_TOML.replace("horizon_s = 4.0", "horizon_s = -1.0"),
+        )
+        .unwrap();
+        std::fs::write(dir.path().join("labels.toml"), LABELS_TOML).unwrap();
+        let err = Config::load(&path).unwrap_err().to_string();
+        assert!(err.contains("physics.horizon_s"), "{err}");
+    }
+}

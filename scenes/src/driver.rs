@@ -1,0 +1,294 @@
+//! The DAG driver: one scene group through every stage, in order —
+//! plan → randomize → simulate → frame cameras → (counterfactual) simulate → label →
+//! validate → render — with attempt-indexed resampling when any band fails a validator.
+//! [`run_group`] is the one place the stages are chained; `build` runs groups in
+//! parallel and writes what it returns.
+
+use crate::cameras;
+use crate::config::Config;
+use crate::families;
+use crate::label::{label, Labels};
+use crate::randomize::{randomize, RandomizeError, SceneKey};
+use crate::selection::plan_group;
+use rh_physics::simulate::{simulate, SimOptions, Simulation};
+use rh_physics::spec::{SceneSpec, Selection};
+use crate::validate::{validate, Verdicts, VALIDATOR_COLUMNS};
+use rh_catalog::Catalog;
+
+/// Everything the dataset needs about one finished scene.
+#[derive(Debug, Clone)]
+pub struct SceneResult {
+    pub spec: SceneSpec,
+    pub labels: Labels,
+    pub verdicts: Verdicts,
+    pub state_hash: String,
+    /// The state hash of steps 0..=Δ (`Simulation::state_hash_through`).
+    pub decision_state_hash: String,
+    /// The hazard's centre of mass at each video frame: `[t, x, y, z]` until the scene ends.
+    pub trajectory: Vec<[f32; 4]>,
+    pub steps: u32,
+    /// What the render stage wrote (`None` until rendered, and for unrendered scenes).
+    pub media: Option<SceneMedia>,
+}
+
+/// A rendered scene's files, relative to the dataset root.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneMedia {
+    /// Camera name → `videos/<cam>/<scene_id>.mp4`.
+    pub videos: std::collections::BTreeMap<String, String>,
+    /// `videos/full/<scene_id>.mp4`.
+    pub full_event: String,
+    /// Camera name → the hazard measured in its observation frames (instance-id pass).
+    pub visibility: std::collections::BTreeMap<String, HazardVisibility>,
+    /// Camera name → `masks/<scene_id>/<cam>_t….png` at `FRAME_TIMES` (empty without
+    /// `build --masks`).
+    pub masks: std::collections::BTreeMap<String, Vec<String>>,
+    /// Camera name → `depth/<scene_id>/<cam>_t….png` at `FRAME_TIMES` (likewise).
+    pub depth: std::collections::BTreeMap<String, Vec<String>>,
+}
+
+/// The hazard as one camera's observation frames show it (one entry per `FRAME_TIMES`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct HazardVisibility {
+    /// Pixels of the image whose instance id is the hazard's.
+    pub visible_px: Vec<u32>,
+    /// `visible_px` over the pixels the hazard covers drawn alone (0 when it covers none).
+    pub unoccluded: Vec<f64>,
+}
+
+impl HazardVisibility {
+    /// From per-time (visible, covered-alone) pixel counts.
+    pub fn from_counts(counts: &[(u32, u32)]) -> HazardVisibility {
+        HazardVisibility {
+            visible_px: counts.iter().map(|&(v, _)| v).collect(),
+            unoccluded: counts
+                .iter()
+                .map(|&(v, c)| if c == 0 { 0.0 } else { v as f64 / c as f64 })
+                .collect(),
+        }
+    }
+}
+
+/// Stage 4 (render) as the DAG driver sees it: writes a labelled scene's videos and
+/// frames and says where (`None`: not rendered, e.g. an invalid scene). Kept behind this
+/// signature so the driver needs no GPU code (`render` is a cargo feature).
+pub type RenderStage<'a> = dyn Fn(&SceneResult) -> Result<Option<SceneMedia>, String> + Sync + 'a;
+
+/// Why a group could not be produced.
+#[derive(Debug)]
+pub enum GroupError {
+    /// Planning or sampling failed on the build's inputs (families, catalog).
+    Input(String),
+    /// The render stage failed.
+    Render(String),
+}
+
+/// The whole DAG for scene group `g` of a build (`count` speed bands, scenes
+/// `4g … 4g + count − 1`): plan the group's selection, produce its labelled scenes
+/// ([`produce_group_counted`]), then render each (`render`; `None` for a label-only
+/// build). Also returns the group's family and how its attempts went.
+pub fn run_group(
+    catalog: &Catalog,
+    families: &[String],
+    planned: Option<&[Selection]>,
+    seed: u64,
+    g: u64,
+    count: u64,
+    config: &Config,
+    render: Option<&RenderStage>,
+) -> Result<(Vec<SceneResult>, Rejections), GroupError> {
+    // Selections planned from descriptions (`build --descriptions`): group g takes g mod D.
+    let selection = match planned {
+        Some(s) if !s.is_empty() => s[(g % s.len() as u64) as usize].clone(),
+        _ => {
+            plan_group(catalog, families, seed, g).map_err(|e| GroupError::Input(e.to_string()))?
+        }
+    };
+    let (mut results, rejections) =
+        produce_group_counted(&selection, seed, g * 4, count, catalog, config)
+            .map_err(|e| GroupError::Input(e.to_string()))?;
+    if let Some(render) = render {
+        for r in results.iter_mut() {
+            r.media = render(r).map_err(GroupError::Render)?;
+        }
+    }
+    Ok((results, rejections))
+}
+
+/// Simulates one spec (plain and counterfactual), frames its cameras (as a group of
+/// one; a build frames a group's bands together, see `produce_group`), labels and
+/// validates.
+pub fn run_scene(mut spec: SceneSpec, config: &Config) -> SceneResult {
+    let sim = simulate(&spec, SimOptions::default());
+    spec.cameras = cameras::frame(&spec, &sim, &config.validators.framing()).unwrap_or_default();
+    label_scene(spec, sim, config)
+}
+
+/// The stages after framing: the counterfactual run where needed, labels and verdicts
+/// of a simulated spec that carries its cameras.
+pub fn label_scene(spec: SceneSpec, sim: Simulation, config: &Config) -> SceneResult {
+    let family = families::get(&spec.family).expect("randomize only emits implemented families");
+    let strike = if may_touch_observer(&spec, &sim) {
+        simulate(&spec, counterfactual_options(&spec)).strike
+    } else {
+        None
+    };
+    let labels = label(&spec, &sim, strike);
+    let verdicts = validate(&spec, &sim, family, &config.validators, &labels);
+    let trajectory = hazard_trajectory(&spec, &sim);
+    SceneResult {
+        state_hash: sim.state_hash.clone(),
+        decision_state_hash: sim.state_hash_through(spec.decision_step()),
+        steps: sim.steps(),
+        spec,
+        labels,
+        verdicts,
+        trajectory,
+        media: None,
+    }
+}
+
+/// The counterfactual run of SPEC §6: the observer's body (the humanoid standing at
+/// rest, `simulate::observer_links`) as fixed colliders, followed by the strike test.
+pub fn counterfactual_options(_spec: &SceneSpec) -> SimOptions {
+    SimOptions {
+        observer_collider: true,
+        run_past_strike: false,
+    }
+}
+
+/// What the full-event video (`videos/full/<id>.mp4`) shows: the counterfactual of
+/// SPEC §6 — the standing observer as a static collider, what the labels mean — run to
+/// the end of the event rather than stopped after the strike window. `None` when no
+/// body ever comes near the observer: that run is then the plain run (see
+/// [`may_touch_observer`]), which the caller already has. The observation videos and
+/// frames always show the plain run (they end at Δ; in a valid scene nothing reaches the
+/// observer before Δ plus a reaction time). Labels, specs and hashes never depend on this run.
+pub fn full_event_simulation(spec: &SceneSpec, sim: &Simulation) -> Option<Simulation> {
+    may_touch_observer(spec, sim).then(|| {
+        simulate(
+            spec,
+            SimOptions {
+                run_past_strike: true,
+                ..counterfactual_options(spec)
+            },
+        )
+    })
+}
+
+/// Clearance kept beyond the bounding spheres before a body could touch the observer
+/// (covers the solver's speculative-contact distance with a wide margin).
+const OBSERVER_CLEARANCE: f64 = 0.1;
+
+/// Whether any dynamic body ever comes near enough to the observer's body to touch it.
+/// If none does, the counterfactual run (observer as a static collider) is step for step
+/// the plain run — a static collider changes nothing until something touches it — so
+/// it cannot strike and need not be simulated.
+pub fn may_touch_observer(spec: &SceneSpec, sim: &Simulation) -> bool {
+    let o = &spec.observer;
+    // The standing body's links reach this far from its axis (arms, hands).
+    let body = rh_physics::body::Geometry::of(o).rest_extent();
+    sim.dynamic_bodies
+        .iter()
+        .enumerate()
+        .any(|(slot, &body_index)| {
+            let reach = spec.bodies[body_index].bounding_radius()
+                + body.max(o.torso_radius)
+                + OBSERVER_CLEARANCE;
+            (0..=sim.steps())
+                .any(|k| o.torso_axis_distance(sim.state(k, slot).position.map(f64::from)) <= reach)
+        })
+}
+
+fn hazard_trajectory(spec: &SceneSpec, sim: &Simulation) -> Vec<[f32; 4]> {
+    (0..)
+        .map(|frame| (frame, spec.frame_step(frame)))
+        .take_while(|&(_, step)| step <= sim.steps())
+        .map(|(frame, step)| {
+            let p = sim.hazard_com(step);
+            [
+                (frame as f64 / spec.video.fps as f64) as f32,
+                p[0] as f32,
+                p[1] as f32,
+                p[2] as f32,
+            ]
+        })
+        .collect()
+}
+
+/// How a group's attempts went: attempts made, and per validator (in
+/// `validate::VALIDATOR_COLUMNS` order) how many attempts it rejected (an attempt is
+/// rejected when any band fails; it counts once for each validator that failed).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Rejections {
+    pub attempts: u32,
+    pub rejected_by: [u32; VALIDATOR_COLUMNS.len()],
+}
+
+/// Produces scenes `first_index .. first_index + count` (one group, `count` ≤ 4 bands).
+/// Tries attempts 0, 1, … until every band passes every validator; if none does within
+/// `max_attempts`, the last attempt is kept with `valid = false` so the failure is visible.
+pub fn produce_group(
+    selection: &Selection,
+    build_seed: u64,
+    first_index: u64,
+    count: u64,
+    catalog: &Catalog,
+    config: &Config,
+) -> Result<Vec<SceneResult>, RandomizeError> {
+    produce_group_counted(selection, build_seed, first_index, count, catalog, config)
+        .map(|(results, _)| results)
+}
+
+/// `produce_group`, also saying which validators rejected which attempts.
+///
+/// Each attempt simulates every band, frames ONE set of cameras for the group on the
+/// union of the bands' hazard paths (`cameras::frame_group`, from the group's "cameras"
+/// stream), then labels and validates each band with those cameras: the bands differ
+/// only in speed.
+pub fn produce_group_counted(
+    selection: &Selection,
+    build_seed: u64,
+    first_index: u64,
+    count: u64,
+    catalog: &Catalog,
+    config: &Config,
+) -> Result<(Vec<SceneResult>, Rejections), RandomizeError> {
+    let mut results = Vec::new();
+    let mut rejections = Rejections::default();
+    for attempt in 0..config.validators.max_attempts {
+        rejections.attempts += 1;
+        let mut runs = Vec::with_capacity(count as usize);
+        for index in first_index..first_index + count {
+            let spec = randomize(
+                selection,
+                &SceneKey::new(build_seed, index, attempt),
+                catalog,
+                config,
+            )?;
+            // Simulate what the file will say: a JSON round trip is exact (serde_json
+            // float_roundtrip), and this makes "replay equals build" hold by construction.
+            let spec = SceneSpec::from_json(&spec.to_json()).expect("a spec parses back");
+            let sim = simulate(&spec, SimOptions::default());
+            runs.push((spec, sim));
+        }
+        let bands: Vec<(&SceneSpec, &Simulation)> = runs.iter().map(|(s, m)| (s, m)).collect();
+        let framed = cameras::frame_group(&bands, &config.validators.framing()).unwrap_or_default();
+        results = runs
+            .into_iter()
+            .map(|(mut spec, sim)| {
+                spec.cameras = framed.clone();
+                label_scene(spec, sim, config)
+            })
+            .collect();
+        if results.iter().all(|r| r.verdicts.all()) {
+            break;
+        }
+        for (v, count) in rejections.rejected_by.iter_mut().enumerate() {
+            if results.iter().any(|r| !r.verdicts.as_array()[v]) {
+                *count += 1;
+            }
+        }
+    }
+    Ok((results, rejections))
+}

@@ -1,0 +1,816 @@
+//! Event families (SPEC §4): one file per family behind the `Family` trait.
+//!
+//! A family lays out its scene (`sample`) from a seeded stream and the band's speed
+//! value, and says whether its intended event really happened (`event_happened`).
+//! The contract that makes speed bands honest: a sampler draws the same random numbers
+//! in the same order whatever the speed, so the four bands of a group differ only in
+//! the speed parameter and what follows from it physically.
+
+use rh_physics::simulate::Simulation;
+use rh_physics::spec::{
+    quat, BodyKind, BodyRole, BodySpec, JointKind, JointSpec, PartSpec, Quat, SceneSpec, ShapeSpec,
+    Vec3, IDENTITY,
+};
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
+use rh_catalog::{Object, Room, ShapeKind};
+use std::collections::BTreeMap;
+
+pub mod bouncing_object;
+pub mod ceiling_drop;
+pub mod chain_reaction;
+pub mod door_swing;
+pub mod furniture_tip;
+pub mod hanging_fall;
+pub mod ladder_slip;
+pub mod multi_object;
+pub mod object_drop;
+pub mod pendulum_swing;
+pub mod rolling_ball;
+pub mod shelf_slide;
+pub mod sliding_object;
+pub mod stack_collapse;
+pub mod stair_tumble;
+pub mod surface_cascade;
+pub mod thrown_object;
+
+pub use door_swing::hinge_inertia;
+pub use ladder_slip::required_floor_friction;
+
+pub const GRAVITY: f64 = 9.81;
+
+/// What a sampler gets: the true physics of the object, the room, the band's speed.
+pub struct FamilyInput<'a> {
+    pub object: &'a Object,
+    pub room: &'a Room,
+    pub speed: f64,
+    /// The family's speed in each band, slowest first: a sampler may size its layout so
+    /// that even the slowest band's event happens (without the draws depending on `speed`).
+    pub band_speeds: [f64; 4],
+    /// Whether this group's observer stands far from the event (drawn by the randomizer).
+    pub far_observer: bool,
+    pub observer_height: f64,
+}
+
+/// Where the observer stands: on the floor at (x, y), facing `yaw`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObserverPose {
+    pub x: f64,
+    pub y: f64,
+    pub yaw: f64,
+}
+
+/// A family's layout of one scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layout {
+    pub bodies: Vec<BodySpec>,
+    pub joints: Vec<JointSpec>,
+    pub hazard: usize,
+    /// The body the hazard starts on, if any (table, shelf, ramp).
+    pub source_support: Option<usize>,
+    pub observer: ObserverPose,
+    /// Family-specific numbers worth recording (drop height, ramp angle, …).
+    pub params: BTreeMap<String, f64>,
+}
+
+pub trait Family: Sync {
+    fn name(&self) -> &'static str;
+    /// What the speed value means (e.g. `push_speed_mps`).
+    fn speed_parameter(&self) -> &'static str;
+    /// False for families whose pace gravity sets; their bands exist but analyses skip them.
+    fn speed_sweep(&self) -> bool;
+    /// Lays out the scene. Must draw from `rng` identically for every `input.speed`.
+    fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout;
+    /// Whether the family's intended event happened in the simulation.
+    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool;
+}
+
+/// All implemented families, in canonical order.
+pub fn all() -> Vec<&'static dyn Family> {
+    vec![
+        &object_drop::ObjectDrop,
+        &shelf_slide::ShelfSlide,
+        &hanging_fall::HangingFall,
+        &ceiling_drop::CeilingDrop,
+        &sliding_object::SlidingObject,
+        &rolling_ball::RollingBall,
+        &surface_cascade::SurfaceCascade,
+        &furniture_tip::FurnitureTip,
+        &stack_collapse::StackCollapse,
+        &ladder_slip::LadderSlip,
+        &door_swing::DoorSwing,
+        &pendulum_swing::PendulumSwing,
+        &thrown_object::ThrownObject,
+        &bouncing_object::BouncingObject,
+        &stair_tumble::StairTumble,
+        &chain_reaction::ChainReaction,
+        &multi_object::MultiObject,
+    ]
+}
+
+pub fn get(name: &str) -> Option<&'static dyn Family> {
+    all().into_iter().find(|f| f.name() == name)
+}
+
+// ---------------------------------------------------------------------------
+// Shared building blocks for samplers.
+
+/// Converts catalog parts into spec parts.
+pub fn object_parts(object: &Object) -> Vec<PartSpec> {
+    object
+        .parts
+        .iter()
+        .map(|p| PartSpec {
+            shape: match p.shape {
+                ShapeKind::Box => ShapeSpec::Box {
+                    half_extents: [p.size[0] / 2.0, p.size[1] / 2.0, p.size[2] / 2.0],
+                },
+                ShapeKind::Sphere => ShapeSpec::Sphere {
+                    radius: p.size[0] / 2.0,
+                },
+                ShapeKind::Cylinder => ShapeSpec::Cylinder {
+                    half_height: p.size[1] / 2.0,
+                    radius: p.size[0] / 2.0,
+                },
+                ShapeKind::Capsule => ShapeSpec::Capsule {
+                    half_height: (p.size[1] - p.size[0]) / 2.0,
+                    radius: p.size[0] / 2.0,
+                },
+            },
+            offset: p.offset,
+            rotation: IDENTITY,
+        })
+        .collect()
+}
+
+/// The catalog object as the scene's hazard body.
+pub fn hazard_body(
+    object: &Object,
+    position: Vec3,
+    rotation: Quat,
+    linvel: Vec3,
+    angvel: Vec3,
+) -> BodySpec {
+    BodySpec {
+        name: object.id.clone(),
+        role: BodyRole::Hazard,
+        kind: BodyKind::Dynamic,
+        catalog_id: Some(object.id.clone()),
+        parts: object_parts(object),
+        position,
+        rotation,
+        mass: object.mass,
+        friction: object.friction,
+        restitution: object.restitution,
+        linvel,
+        angvel,
+        ccd: true,
+    }
+}
+
+/// A fixed furniture box (table, shelf board, ramp).
+pub fn fixed_box(
+    name: &str,
+    half_extents: Vec3,
+    position: Vec3,
+    rotation: Quat,
+    friction: f64,
+    restitution: f64,
+) -> BodySpec {
+    BodySpec {
+        name: name.to_string(),
+        role: BodyRole::Support,
+        kind: BodyKind::Fixed,
+        catalog_id: None,
+        parts: vec![PartSpec {
+            shape: ShapeSpec::Box { half_extents },
+            offset: [0.0; 3],
+            rotation: IDENTITY,
+        }],
+        position,
+        rotation,
+        mass: 0.0,
+        friction,
+        restitution,
+        linvel: [0.0; 3],
+        angvel: [0.0; 3],
+        ccd: false,
+    }
+}
+
+/// Distance from the object's origin down to its lowest point, unrotated.
+pub fn bottom_offset(object: &Object) -> f64 {
+    object
+        .parts
+        .iter()
+        .map(|p| p.half_extents()[2] - p.offset[2])
+        .fold(0.0, f64::max)
+}
+
+/// Half length of the object's footprint along a horizontal direction at angle `rel`
+/// to its own x axis.
+pub fn footprint_half_length(object: &Object, rel: f64) -> f64 {
+    let h = object.half_extents();
+    h[0] * rel.cos().abs() + h[1] * rel.sin().abs()
+}
+
+pub fn yaw_quat(yaw: f64) -> Quat {
+    quat::from_axis_angle([0.0, 0.0, 1.0], yaw)
+}
+
+pub fn uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
+    if hi <= lo {
+        // Still draw, so the stream's position does not depend on the range.
+        let _: f64 = rng.random();
+        lo
+    } else {
+        rng.random_range(lo..hi)
+    }
+}
+
+/// Unit vector in the floor plane at heading `angle`.
+pub fn heading(angle: f64) -> [f64; 2] {
+    [angle.cos(), angle.sin()]
+}
+
+/// Friction coefficient rapier uses for a pair (the `Average` combine rule).
+pub fn combined_friction(a: f64, b: f64) -> f64 {
+    (a + b) / 2.0
+}
+
+/// The standard observer placement: beyond `landing` along the hazard's floor heading
+/// `dir`, at `near` distance (or `far` distance for far-observer groups), with a
+/// lateral offset, facing back toward `face_point`. Always makes the same draws.
+pub fn observer_beyond(
+    rng: &mut ChaCha8Rng,
+    landing: [f64; 2],
+    dir: [f64; 2],
+    near: (f64, f64),
+    far: (f64, f64),
+    lateral: f64,
+    far_observer: bool,
+    face_point: [f64; 2],
+) -> ObserverPose {
+    let d_near = uniform(rng, near.0, near.1);
+    let d_far = uniform(rng, far.0, far.1);
+    let side = uniform(rng, -lateral, lateral);
+    let d = if far_observer { d_far } else { d_near };
+    let perp = [-dir[1], dir[0]];
+    let x = landing[0] + dir[0] * d + perp[0] * side;
+    let y = landing[1] + dir[1] * d + perp[1] * side;
+    let yaw = (face_point[1] - y).atan2(face_point[0] - x);
+    ObserverPose { x, y, yaw }
+}
+
+/// A sampler's event origin: near the room centre, shifted against the heading so the
+/// event and the observer both fit in the room.
+pub fn event_origin(rng: &mut ChaCha8Rng, room: &Room, dir: [f64; 2], back: f64) -> [f64; 2] {
+    let jitter_x = uniform(rng, -0.3, 0.3);
+    let jitter_y = uniform(rng, -0.3, 0.3);
+    let limit_x = (room.size[0] / 2.0 - 0.8).max(0.0);
+    let limit_y = (room.size[1] / 2.0 - 0.8).max(0.0);
+    [
+        (-dir[0] * back + jitter_x).clamp(-limit_x, limit_x),
+        (-dir[1] * back + jitter_y).clamp(-limit_y, limit_y),
+    ]
+}
+
+/// Distance from the object's origin up to its highest point, unrotated.
+pub fn top_offset(object: &Object) -> f64 {
+    object
+        .parts
+        .iter()
+        .map(|p| p.half_extents()[2] + p.offset[2])
+        .fold(0.0, f64::max)
+}
+
+/// Centre of mass in the object frame: the simulator spreads a body's mass over its
+/// parts by volume, so this is the volume-weighted mean of the part centres.
+pub fn com_offset(object: &Object) -> Vec3 {
+    let total: f64 = object.parts.iter().map(|p| p.volume()).sum();
+    let mut c = [0.0; 3];
+    for p in &object.parts {
+        let w = p.volume() / total;
+        for (k, ck) in c.iter_mut().enumerate() {
+            *ck += w * p.offset[k];
+        }
+    }
+    c
+}
+
+/// Floor-plane point `p + dir * d`.
+pub fn ahead(p: [f64; 2], dir: [f64; 2], d: f64) -> [f64; 2] {
+    [p[0] + dir[0] * d, p[1] + dir[1] * d]
+}
+
+/// The horizontal unit vector 90° counter-clockwise of `dir` (`ẑ × dir`).
+pub fn left_of(dir: [f64; 2]) -> [f64; 2] {
+    [-dir[1], dir[0]]
+}
+
+pub fn cross3(a: Vec3, b: Vec3) -> Vec3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Velocity of the point `p` of a body spinning with `omega` about the fixed point `pivot`.
+pub fn velocity_about(omega: Vec3, pivot: Vec3, p: Vec3) -> Vec3 {
+    cross3(omega, [p[0] - pivot[0], p[1] - pivot[1], p[2] - pivot[2]])
+}
+
+/// A spot on one of the room's four walls: `base` is a point of the wall plane at floor
+/// level and `normal_angle` the heading of the wall's normal into the room.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WallSite {
+    pub normal_angle: f64,
+    pub base: [f64; 2],
+}
+
+/// Draws a wall (uniformly among the four) and a point along it, at least `margin` from
+/// the corners. Always makes two draws.
+pub fn wall_site(rng: &mut ChaCha8Rng, room: &Room, margin: f64) -> WallSite {
+    let side = uniform(rng, 0.0, 4.0).floor().min(3.0) as usize;
+    let t = uniform(rng, -1.0, 1.0);
+    let [hx, hy] = [room.size[0] / 2.0, room.size[1] / 2.0];
+    let (normal_angle, base) = match side {
+        0 => (std::f64::consts::PI, [hx, t * (hy - margin).max(0.0)]),
+        1 => (0.0, [-hx, t * (hy - margin).max(0.0)]),
+        2 => (
+            -std::f64::consts::FRAC_PI_2,
+            [t * (hx - margin).max(0.0), hy],
+        ),
+        _ => (
+            std::f64::consts::FRAC_PI_2,
+            [t * (hx - margin).max(0.0), -hy],
+        ),
+    };
+    WallSite { normal_angle, base }
+}
+
+/// The wall behind a `WallSite` as a fixed slab (0.2 m thick, its face on the wall
+/// plane), `half_width` along the wall, from the floor to `height`.
+pub fn wall_body(site: &WallSite, half_width: f64, height: f64, friction: f64) -> BodySpec {
+    let n = heading(site.normal_angle);
+    fixed_box(
+        "wall",
+        [0.1, half_width, height / 2.0],
+        [
+            site.base[0] - n[0] * 0.1,
+            site.base[1] - n[1] * 0.1,
+            height / 2.0,
+        ],
+        yaw_quat(site.normal_angle),
+        friction,
+        0.1,
+    )
+}
+
+/// How an object rests on a flat surface: its natural pose, except that capsules (which
+/// would balance on a round cap) lie on their side. Returns the rotation in the object
+/// frame, the distance from its origin down to the surface, and its height.
+pub fn resting_pose(object: &Object) -> (Quat, f64, f64) {
+    if object.parts.iter().any(|p| p.shape == ShapeKind::Capsule) {
+        // About x by 90°: a part's y extent becomes vertical (z' = y).
+        let q = quat::from_axis_angle([1.0, 0.0, 0.0], std::f64::consts::FRAC_PI_2);
+        let bottom = object
+            .parts
+            .iter()
+            .map(|p| p.half_extents()[1] - p.offset[1])
+            .fold(0.0, f64::max);
+        let top = object
+            .parts
+            .iter()
+            .map(|p| p.half_extents()[1] + p.offset[1])
+            .fold(0.0, f64::max);
+        (q, bottom, bottom + top)
+    } else {
+        let b = bottom_offset(object);
+        (IDENTITY, b, b + top_offset(object))
+    }
+}
+
+/// A fixed table block from the floor, its local x along `heading_angle`.
+pub fn table_block(
+    name: &str,
+    centre: [f64; 2],
+    half: [f64; 2],
+    height: f64,
+    heading_angle: f64,
+    friction: f64,
+) -> BodySpec {
+    fixed_box(
+        name,
+        [half[0], half[1], height / 2.0],
+        [centre[0], centre[1], height / 2.0],
+        yaw_quat(heading_angle),
+        friction,
+        0.2,
+    )
+}
+
+/// A moving copy of a catalog object that is not the hazard (a neighbour in a stack or a
+/// row): same parts and physics, role `Prop`.
+pub fn prop_copy(
+    object: &Object,
+    name: &str,
+    position: Vec3,
+    rotation: Quat,
+    linvel: Vec3,
+) -> BodySpec {
+    BodySpec {
+        name: name.to_string(),
+        role: BodyRole::Prop,
+        ..hazard_body(object, position, rotation, linvel, [0.0; 3])
+    }
+}
+
+/// A dynamic plain box that is not the hazard (a trigger block).
+#[allow(clippy::too_many_arguments)]
+pub fn prop_box(
+    name: &str,
+    half_extents: Vec3,
+    position: Vec3,
+    rotation: Quat,
+    mass: f64,
+    friction: f64,
+    restitution: f64,
+    linvel: Vec3,
+) -> BodySpec {
+    BodySpec {
+        name: name.to_string(),
+        role: BodyRole::Prop,
+        kind: BodyKind::Dynamic,
+        catalog_id: None,
+        parts: vec![PartSpec {
+            shape: ShapeSpec::Box { half_extents },
+            offset: [0.0; 3],
+            rotation: IDENTITY,
+        }],
+        position,
+        rotation,
+        mass,
+        friction,
+        restitution,
+        linvel,
+        angvel: [0.0; 3],
+        ccd: true,
+    }
+}
+
+/// World z component of a body's local z axis (1 upright, 0 lying on its side).
+pub fn up_z(rotation: [f32; 4]) -> f64 {
+    let [x, y, _, _] = rotation.map(f64::from);
+    1.0 - 2.0 * (x * x + y * y)
+}
+
+/// Index among `sim.dynamic_bodies` of spec body `body`.
+pub fn slot_of(sim: &Simulation, body: usize) -> Option<usize> {
+    sim.dynamic_bodies.iter().position(|&i| i == body)
+}
+
+/// Whether the object rests in its natural pose on a flat face (not on a round cap or
+/// a single sphere, which roll or balance).
+pub fn is_single_sphere(object: &Object) -> bool {
+    object.parts.len() == 1 && object.parts[0].shape == ShapeKind::Sphere
+}
+
+/// The hazard's largest distance from its start position over the run (m).
+pub fn max_displacement(sim: &Simulation) -> f64 {
+    let a = sim.hazard_position(0);
+    (0..=sim.steps())
+        .map(|k| {
+            let b = sim.hazard_position(k);
+            ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Extra distance to shift an event away from its observer's side of the room when the
+/// observer stands far (so that the far observer still stands inside the room). Depends
+/// on the group's `far_observer`, never on the band.
+pub fn far_shift(input: &FamilyInput) -> f64 {
+    if input.far_observer {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+/// The hazard's speed at the end of the run is small and it touched the floor.
+pub fn reached_floor(spec: &SceneSpec, sim: &Simulation) -> bool {
+    sim.time_to_floor_step(spec.labels.floor_contact_eps)
+        .is_some()
+}
+
+/// Shared layout for "pushed off the edge of a horizontal surface" families
+/// (object_drop from a table, shelf_slide from a high shelf, rolling_ball).
+pub struct EdgeLaunch {
+    pub surface_name: &'static str,
+    pub surface_height: f64,
+    pub surface_half: [f64; 2],
+    pub surface_friction: f64,
+    pub heading_angle: f64,
+    /// Distance of the hazard's centre behind the surface edge (m); its front may overhang.
+    pub com_to_edge: f64,
+    /// Lateral position of the hazard along the edge (m, from the edge's centre).
+    pub lateral: f64,
+    /// Yaw of the object relative to the heading (rad).
+    pub relative_yaw: f64,
+    pub origin: [f64; 2],
+    /// A solid block from the floor (table, cabinet) or a thin board (shelf).
+    pub board_thickness: Option<f64>,
+    pub rolling: bool,
+}
+
+impl EdgeLaunch {
+    /// Builds the surface and the hazard on it, moving toward the edge at `speed`.
+    pub fn build(&self, object: &Object, speed: f64) -> (Vec<BodySpec>, [f64; 2], Vec3) {
+        let dir = heading(self.heading_angle);
+        let perp = [-dir[1], dir[0]];
+        let h = self.surface_height;
+        let (thickness, centre_z) = match self.board_thickness {
+            Some(t) => (t, h - t / 2.0),
+            None => (h, h / 2.0),
+        };
+        // The surface's local x axis points along the heading, so its front edge is at
+        // +surface_half[0] from its centre.
+        let surface_centre = [self.origin[0], self.origin[1]];
+        let surface = fixed_box(
+            self.surface_name,
+            [self.surface_half[0], self.surface_half[1], thickness / 2.0],
+            [surface_centre[0], surface_centre[1], centre_z],
+            yaw_quat(self.heading_angle),
+            self.surface_friction,
+            0.2,
+        );
+        let edge = [
+            surface_centre[0] + dir[0] * self.surface_half[0],
+            surface_centre[1] + dir[1] * self.surface_half[0],
+        ];
+        let back = self.com_to_edge;
+        let pos = [
+            edge[0] - dir[0] * back + perp[0] * self.lateral,
+            edge[1] - dir[1] * back + perp[1] * self.lateral,
+            h + bottom_offset(object),
+        ];
+        let linvel = [dir[0] * speed, dir[1] * speed, 0.0];
+        let angvel = if self.rolling {
+            // Rolling without slipping on a +z surface: v + ω × (−r ẑ) = 0 gives
+            // ω = (−v_y, v_x, 0) / r.
+            let r = bottom_offset(object).max(1e-3);
+            [-dir[1] * speed / r, dir[0] * speed / r, 0.0]
+        } else {
+            [0.0; 3]
+        };
+        let hazard = hazard_body(
+            object,
+            pos,
+            yaw_quat(self.heading_angle + self.relative_yaw),
+            linvel,
+            angvel,
+        );
+        (vec![surface, hazard], edge, pos)
+    }
+}
+
+/// A heading along one of the room's four diagonal directions (drawn uniformly), turned by
+/// up to `jitter` rad: the longest straight run the room offers, for hazards that travel
+/// toward the observer from afar. Always makes two draws.
+pub fn diagonal_heading(rng: &mut ChaCha8Rng, room: &Room, jitter: f64) -> f64 {
+    let which = uniform(rng, 0.0, 4.0).floor().min(3.0) as usize;
+    let turn = uniform(rng, -jitter, jitter);
+    let base = room.size[1].atan2(room.size[0]);
+    let pi = std::f64::consts::PI;
+    [base, pi - base, pi + base, -base][which] + turn
+}
+
+/// Length of the longest segment along `dir` through the room's centre that keeps
+/// `margin` from every wall (the room is centred on the origin).
+pub fn room_span(room: &Room, dir: [f64; 2], margin: f64) -> f64 {
+    let half = [
+        (room.size[0] / 2.0 - margin).max(0.0),
+        (room.size[1] / 2.0 - margin).max(0.0),
+    ];
+    (0..2)
+        .map(|k| {
+            if dir[k].abs() < 1e-9 {
+                f64::INFINITY
+            } else {
+                2.0 * half[k] / dir[k].abs()
+            }
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Start of a segment of `length` along `dir` centred in the room, slid along `dir` by a
+/// drawn share of whatever room is left over (`room_span` with `margin`). Always makes
+/// one draw.
+pub fn span_start(
+    rng: &mut ChaCha8Rng,
+    room: &Room,
+    dir: [f64; 2],
+    length: f64,
+    margin: f64,
+) -> [f64; 2] {
+    let slack = (room_span(room, dir, margin) - length).max(0.0);
+    let s = uniform(rng, -0.5, 0.5) * slack - length / 2.0;
+    [dir[0] * s, dir[1] * s]
+}
+
+/// Tilt (rad) of a board on which `object` accelerates down the slope at `accel` (m/s²)
+/// from rest: an object resting on a ball (a single sphere, a kettlebell) rolls without
+/// slipping (`a = 5/7·g·sin β`, a solid ball),
+/// anything else slides against the combined friction `mu` (`a = g (sin β − μ cos β)`).
+/// A slope just steeper than the friction angle makes a slow creep that always goes on.
+pub fn creep_tilt(object: &Object, mu: f64, accel: f64) -> f64 {
+    if rests_on_a_ball(object) {
+        (7.0 * accel / (5.0 * GRAVITY)).clamp(0.0, 1.0).asin()
+    } else {
+        let phi = mu.atan();
+        phi + (accel / (GRAVITY * (1.0 + mu * mu).sqrt()))
+            .clamp(0.0, 1.0)
+            .asin()
+    }
+}
+
+/// Whether the object's lowest point is on a sphere part (it rolls rather than slides).
+pub fn rests_on_a_ball(object: &Object) -> bool {
+    let bottom = bottom_offset(object);
+    object
+        .parts
+        .iter()
+        .any(|p| p.shape == ShapeKind::Sphere && p.half_extents()[2] - p.offset[2] >= bottom - 1e-9)
+}
+
+/// Shared layout for "creeps down a tilted board and off its lower edge" (a tray propped
+/// on a table, a sagging shelf board, a bent ceiling mount plate): a thin fixed board
+/// sloping down along `heading_angle` by `tilt`, and the hazard resting on it, its centre
+/// `com_to_edge` up the slope from the lower edge, moving down the slope at `speed`.
+pub struct TiltedLaunch {
+    pub surface_name: &'static str,
+    /// Centre of the board's lower (front) top edge.
+    pub edge: Vec3,
+    pub heading_angle: f64,
+    pub tilt: f64,
+    /// Half length along the slope and half width of the board (m).
+    pub board_half: [f64; 2],
+    pub thickness: f64,
+    pub friction: f64,
+    pub com_to_edge: f64,
+    /// Offset of the hazard across the slope (m).
+    pub lateral: f64,
+    /// Yaw of the object relative to the heading (rad).
+    pub relative_yaw: f64,
+    /// Laid on its side, its own z axis down the slope (see `lies_on_slope`).
+    pub lying: bool,
+}
+
+/// Whether `object` should lie on its side, its own z axis down a slope of `tilt`: a
+/// capsule (which would roll across the slope) or a tall object that would topple on the
+/// slope (its centre's height times `tan(tilt)` near its narrowest half-width).
+pub fn lies_on_slope(object: &Object, tilt: f64) -> bool {
+    if object.parts.iter().any(|p| p.shape == ShapeKind::Capsule) {
+        return true;
+    }
+    if is_single_sphere(object) || object.parts.len() > 1 {
+        return false;
+    }
+    let h = object.half_extents();
+    h[2] * tilt.tan() > 0.8 * h[0].min(h[1])
+}
+
+/// Distance from the object's origin down to the slope and its half-length along the
+/// slope (relative yaw `rel`), standing or lying (see `TiltedLaunch::lying`).
+pub fn slope_pose_extents(object: &Object, lying: bool, rel: f64) -> (f64, f64) {
+    if lying {
+        // Turned +90° about its own y axis: its +x points down onto the slope.
+        let bottom = object
+            .parts
+            .iter()
+            .map(|p| p.half_extents()[0] + p.offset[0])
+            .fold(0.0, f64::max);
+        (bottom, object.half_extents()[2])
+    } else {
+        (bottom_offset(object), footprint_half_length(object, rel))
+    }
+}
+
+impl TiltedLaunch {
+    /// Unit vector down the slope, and the board's upward normal.
+    pub fn axes(&self) -> (Vec3, Vec3) {
+        let d = heading(self.heading_angle);
+        let (s, c) = self.tilt.sin_cos();
+        ([d[0] * c, d[1] * c, -s], [d[0] * s, d[1] * s, c])
+    }
+
+    /// Height of the board's top at its upper (back) edge.
+    pub fn top_height(&self) -> f64 {
+        self.edge[2] + 2.0 * self.board_half[0] * self.tilt.sin()
+    }
+
+    /// Two rails instead of the board: copies of `board` (built with a rail's half-width)
+    /// `offset` to either side of the slope's centre line, named `<name>_0` and `_1`.
+    /// From below, the hazard's middle is seen between them.
+    pub fn rails(&self, board: &BodySpec, offset: f64) -> [BodySpec; 2] {
+        let side = left_of(heading(self.heading_angle));
+        [-1.0, 1.0].map(|sign| {
+            let mut r = board.clone();
+            r.name = format!("{}_{}", board.name, if sign < 0.0 { 0 } else { 1 });
+            r.position[0] += side[0] * sign * offset;
+            r.position[1] += side[1] * sign * offset;
+            r
+        })
+    }
+
+    /// The board and the hazard on it (`speed` down the slope).
+    pub fn build(&self, object: &Object, speed: f64) -> (BodySpec, BodySpec) {
+        let (down, normal) = self.axes();
+        let dir = heading(self.heading_angle);
+        let side = left_of(dir);
+        let tilt_q = quat::from_axis_angle([side[0], side[1], 0.0], self.tilt);
+        let at = |along: f64, across: f64, up: f64| -> Vec3 {
+            [0, 1, 2].map(|k| {
+                let s = [side[0], side[1], 0.0][k];
+                self.edge[k] - down[k] * along + s * across + normal[k] * up
+            })
+        };
+        let board = fixed_box(
+            self.surface_name,
+            [self.board_half[0], self.board_half[1], self.thickness / 2.0],
+            at(self.board_half[0], 0.0, -self.thickness / 2.0),
+            quat::mul(tilt_q, yaw_quat(self.heading_angle)),
+            self.friction,
+            0.2,
+        );
+        let (bottom, _) = slope_pose_extents(object, self.lying, self.relative_yaw);
+        let position = at(self.com_to_edge, self.lateral, bottom);
+        let mut rotation = quat::mul(tilt_q, yaw_quat(self.heading_angle + self.relative_yaw));
+        if self.lying {
+            let lay = quat::from_axis_angle([0.0, 1.0, 0.0], std::f64::consts::FRAC_PI_2);
+            rotation = quat::mul(rotation, lay);
+        }
+        let linvel = down.map(|c| c * speed);
+        let angvel = if is_single_sphere(object) {
+            // Rolling without slipping down the slope: ω = n × v / r.
+            let r = bottom_offset(object).max(1e-3);
+            cross3(normal, linvel).map(|c| c / r)
+        } else {
+            [0.0; 3]
+        };
+        let hazard = hazard_body(object, position, rotation, linvel, angvel);
+        (board, hazard)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rh_physics::seeds;
+    use rh_catalog::Catalog;
+
+    /// The band contract: layouts of the four bands differ only in velocities.
+    #[test]
+    fn samplers_draw_the_same_layout_at_every_speed() {
+        let catalog = Catalog::embedded().unwrap();
+        for family in all() {
+            let object = catalog.objects_for_family(family.name()).next().unwrap();
+            let room = &catalog.rooms[0];
+            let layouts: Vec<Layout> = [0.3, 2.0]
+                .iter()
+                .map(|&speed| {
+                    let input = FamilyInput {
+                        object,
+                        room,
+                        speed,
+                        band_speeds: [0.3, 0.6, 1.0, 2.0],
+                        far_observer: false,
+                        observer_height: 1.32,
+                    };
+                    family.sample(&input, &mut seeds::stream(11, 0, "placement"))
+                })
+                .collect();
+            // Thrown objects aim with an elevation that follows from the speed.
+            let strip = |l: &Layout| {
+                let mut l = l.clone();
+                for b in &mut l.bodies {
+                    b.linvel = [0.0; 3];
+                    b.angvel = [0.0; 3];
+                }
+                l.params.retain(|k, _| !k.contains("elevation"));
+                // door_swing records the push impulse that gives its door the band's edge
+                // speed (`J = I_hinge·v/w²`): a momentum, like the velocities above.
+                l.params.retain(|k, _| k != "push_impulse_ns");
+                l
+            };
+            assert_eq!(
+                strip(&layouts[0]),
+                strip(&layouts[1]),
+                "{} layout depends on speed",
+                family.name()
+            );
+        }
+    }
+}

@@ -1,0 +1,22 @@
+//! ReactHuman scenes: from a seed to labelled, validated scene specs, without file I/O.
+//!
+//! The stages, each a module with one entry point over plain data:
+//! [`selection::plan_group`] (what a scene group shows) → [`randomize::randomize`]
+//! (its `SceneSpec`, one per speed band) → `rh_physics::simulate` → [`cameras::frame`]
+//! → [`label::label`] (ground truth from the counterfactual run) →
+//! [`validate::validate`] (one verdict per validator column). [`driver::run_group`] chains
+//! them for a group and hands each valid scene to a render stage given as a plain
+//! function. [`config::Config`] is the build policy (`configs/default.toml` +
+//! `configs/labels.toml`); [`families`] holds one file per event family behind one trait.
+
+pub mod balance;
+pub mod cameras;
+pub mod config;
+pub mod driver;
+pub mod families;
+pub mod label;
+pub mod randomize;
+pub mod selection;
+pub mod validate;
+pub mod view;
+pub mod visibility;

@@ -1,0 +1,179 @@
+//! Stage 2 — randomize: a pure function of (selection, seed) to a full `SceneSpec`.
+//!
+//! Every number comes from a named ChaCha8 sub-stream of the group seed at the current
+//! rejection-sampling attempt: "observer" (near or far), "placement" (the family's
+//! geometry and initial conditions), "lighting". Cameras are framed after simulation
+//! (see `cameras`), from their own stream.
+
+use crate::config::Config;
+use crate::families::{self, FamilyInput};
+use rh_physics::seeds;
+use rh_physics::spec::{
+    LightingSpec, ObserverSpec, PhysicsSpec, RoomSpec, SceneSpec, Selection, SpeedBand, VideoSpec,
+    SCHEMA_VERSION,
+};
+use rand::RngExt;
+use rh_catalog::Catalog;
+
+/// Identifies one scene of a build: which group and band, at which attempt.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneKey {
+    pub build_seed: u64,
+    pub scene_index: u64,
+    pub group_index: u64,
+    pub attempt: u32,
+    pub band: SpeedBand,
+}
+
+impl SceneKey {
+    pub fn new(build_seed: u64, scene_index: u64, attempt: u32) -> SceneKey {
+        SceneKey {
+            build_seed,
+            scene_index,
+            group_index: scene_index / 4,
+            attempt,
+            band: SpeedBand::ALL[(scene_index % 4) as usize],
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum RandomizeError {
+    #[error("unknown object '{0}'")]
+    UnknownObject(String),
+    #[error("unknown room '{0}'")]
+    UnknownRoom(String),
+    #[error("family '{family}' is not implemented in this build (implemented: {implemented})")]
+    FamilyNotImplemented { family: String, implemented: String },
+    #[error("the configuration has no speed bands for family '{0}'")]
+    NoSpeedBands(String),
+    #[error("object '{object}' is not listed for family '{family}'")]
+    ObjectNotInFamily { object: String, family: String },
+}
+
+pub fn implemented_families() -> String {
+    families::all()
+        .iter()
+        .map(|f| f.name())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Lays out the scene `key` of the group planned as `selection`.
+pub fn randomize(
+    selection: &Selection,
+    key: &SceneKey,
+    catalog: &Catalog,
+    config: &Config,
+) -> Result<SceneSpec, RandomizeError> {
+    let family =
+        families::get(&selection.family).ok_or_else(|| RandomizeError::FamilyNotImplemented {
+            family: selection.family.clone(),
+            implemented: implemented_families(),
+        })?;
+    let object = catalog
+        .object(&selection.object_id)
+        .ok_or_else(|| RandomizeError::UnknownObject(selection.object_id.clone()))?;
+    if !object.families.contains(&selection.family) {
+        return Err(RandomizeError::ObjectNotInFamily {
+            object: object.id.clone(),
+            family: selection.family.clone(),
+        });
+    }
+    let room = catalog
+        .room(&selection.room_id)
+        .ok_or_else(|| RandomizeError::UnknownRoom(selection.room_id.clone()))?;
+    let bands = config
+        .speed_bands(&selection.family)
+        .ok_or_else(|| RandomizeError::NoSpeedBands(selection.family.clone()))?;
+
+    let seed = seeds::group_seed(key.build_seed, key.group_index);
+    let far_observer =
+        seeds::stream(seed, key.attempt, "observer").random_bool(config.build.far_observer_share);
+    let input = FamilyInput {
+        object,
+        room,
+        speed: bands[key.band.index()],
+        band_speeds: *bands,
+        far_observer,
+        observer_height: config.observer.height,
+    };
+    let layout = family.sample(&input, &mut seeds::stream(seed, key.attempt, "placement"));
+
+    let mut lighting_rng = seeds::stream(seed, key.attempt, "lighting");
+    let elevation: f64 = lighting_rng.random_range(0.6..1.3);
+    let azimuth: f64 = lighting_rng.random_range(0.0..std::f64::consts::TAU);
+    let lighting = LightingSpec {
+        sun_direction: [
+            -elevation.cos() * azimuth.cos(),
+            -elevation.cos() * azimuth.sin(),
+            -elevation.sin(),
+        ],
+        sun_intensity: lighting_rng.random_range(2.5..4.0),
+        ambient: lighting_rng.random_range(0.2..0.4),
+        color_temperature_k: lighting_rng.random_range(3500.0..6500.0),
+    };
+
+    let dt = config.physics.dt;
+    let steps = |seconds: f64| (seconds / dt).round() as u32;
+    let mut family_params = layout.params;
+    family_params.insert("far_observer".into(), if far_observer { 1.0 } else { 0.0 });
+
+    Ok(SceneSpec {
+        schema_version: SCHEMA_VERSION,
+        scene_id: seeds::scene_id(key.build_seed, key.scene_index),
+        group_id: seeds::group_id(key.build_seed, key.group_index),
+        build_seed: key.build_seed,
+        scene_index: key.scene_index,
+        seed,
+        attempt: key.attempt,
+        family: selection.family.clone(),
+        speed_band: key.band,
+        speed_sweep: family.speed_sweep(),
+        speed_parameter: family.speed_parameter().to_string(),
+        speed_value: input.speed,
+        selection: selection.clone(),
+        room: RoomSpec {
+            id: room.id.clone(),
+            size: room.size,
+            ceiling_height: room.ceiling_height,
+            floor_friction: room.floor_friction,
+            floor_restitution: room.floor_restitution,
+            wall_color: room.wall_color.clone(),
+            floor_color: room.floor_color.clone(),
+        },
+        physics: PhysicsSpec {
+            dt,
+            gravity: [0.0, 0.0, -families::GRAVITY],
+            solver_iterations: config.physics.solver_iterations,
+            min_steps: steps(config.physics.min_duration_s),
+            max_steps: steps(config.physics.horizon_s),
+            settle_speed: config.physics.settle_speed,
+            settle_steps: steps(config.physics.settle_time_s).max(1),
+        },
+        bodies: layout.bodies,
+        joints: layout.joints,
+        hazard: layout.hazard,
+        source_support: layout.source_support,
+        hazard_flags: object.hazards.iter().cloned().collect(),
+        observer: ObserverSpec {
+            x: layout.observer.x,
+            y: layout.observer.y,
+            yaw: layout.observer.yaw,
+            height: config.observer.height,
+            pelvis_z: config.observer.pelvis_z,
+            shoulder_z: config.observer.shoulder_z,
+            torso_radius: config.observer.torso_radius,
+        },
+        observation_window_s: config.observation.window_s,
+        video: VideoSpec {
+            width: config.render.width,
+            height: config.render.height,
+            fps: config.render.fps,
+        },
+        cameras: vec![],
+        lighting,
+        family_params,
+        labels: config.labels.clone(),
+    })
+}

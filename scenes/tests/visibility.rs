@@ -1,0 +1,70 @@
+//! The visibility rule over a whole default build (issue 12): the 340 scenes of a
+//! default-seed build (17 families × 4 speed bands × 5 groups) are all valid with it,
+//! every group's four bands share one set of cameras (they differ only in speed), and
+//! visibility is mostly met by camera placement rather than by rejecting layouts.
+
+use rh_catalog::Catalog;
+use rh_scenes::config::Config;
+use rh_scenes::driver::produce_group_counted;
+use rh_scenes::selection::plan_group;
+use rh_scenes::validate::VALIDATOR_COLUMNS;
+use rh_scenes::visibility;
+use std::collections::BTreeMap;
+
+#[test]
+fn a_default_340_scene_build_is_all_valid_and_bands_share_their_cameras() {
+    let catalog = Catalog::embedded().unwrap();
+    let config = Config::embedded().unwrap();
+    let rules = config.validators.framing();
+    let families: Vec<String> = config.build.families.clone();
+    let visible = VALIDATOR_COLUMNS
+        .iter()
+        .position(|c| *c == "valid_visible")
+        .unwrap();
+    let seed = config.build.seed;
+    // family → (attempts, attempts rejected by visibility)
+    let mut per_family: BTreeMap<String, (u32, u32)> = BTreeMap::new();
+    for g in 0..85u64 {
+        let selection = plan_group(&catalog, &families, seed, g).unwrap();
+        let (results, rejections) =
+            produce_group_counted(&selection, seed, g * 4, 4, &catalog, &config).unwrap();
+        assert_eq!(results.len(), 4);
+        let entry = per_family.entry(selection.family.clone()).or_default();
+        entry.0 += rejections.attempts;
+        entry.1 += rejections.rejected_by[visible];
+        let first = &results[0].spec;
+        assert_eq!(first.cameras.len(), 3, "{}", first.scene_id);
+        for r in &results {
+            assert!(
+                r.verdicts.all(),
+                "{} ({}) fails {:?}",
+                r.spec.scene_id,
+                r.spec.family,
+                r.verdicts.failures()
+            );
+            assert_eq!(
+                r.spec.cameras, first.cameras,
+                "{}: the bands of group {} have different cameras",
+                r.spec.scene_id, first.group_id
+            );
+            // The verdict is the rule, measured again on the stored spec.
+            let sim = rh_physics::simulate::simulate(&r.spec, Default::default());
+            let a = visibility::assess(&r.spec, &sim, &rules);
+            assert!(a.passes(&rules), "{}", r.spec.scene_id);
+            let worst = a.worst().unwrap();
+            assert!(worst.fraction >= rules.visible_fraction);
+            assert!(worst.size_px >= rules.min_size_px);
+        }
+    }
+    assert_eq!(per_family.len(), 17);
+    let (attempts, rejected) = per_family
+        .values()
+        .fold((0, 0), |(a, r), (fa, fr)| (a + fa, r + fr));
+    // Placement, not rejection: at most one attempt in five rejected by visibility
+    // overall (the default seed: 13 of 104, shelf_slide's shelf board hiding set-back
+    // objects from the eye and thrown golf balls too small from the room's far side).
+    assert!(
+        rejected * 5 <= attempts,
+        "visibility rejected {rejected} of {attempts} attempts: {per_family:?}"
+    );
+}
