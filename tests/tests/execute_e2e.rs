@@ -152,6 +152,25 @@ fn oracle_plans_catch_and_never_get_struck_dodging() {
     assert_eq!(m["model"], "baseline-oracle");
     assert_eq!(m["all"]["caught"].as_u64().unwrap(), caught as u64);
     assert!(stdout.contains("Disagreements with the labels"), "{stdout}");
+    // The figure docs/execution.md (and so README.md, tests/tests/docs_truths.rs) and the
+    // dataset card state for this build is this measurement.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let docs = std::fs::read_to_string(root.join("docs/execution.md")).unwrap();
+    let card = std::fs::read_to_string(ds.join("README.md")).unwrap();
+    for (name, text, marker) in [
+        (
+            "docs/execution.md",
+            &docs,
+            "its CATCH plans are `caught` on",
+        ),
+        ("the dataset card", &card, "rule-v3 CATCH labels,"),
+    ] {
+        assert_eq!(
+            rh_e2e::n_of_m_after(text, marker),
+            (caught, catch),
+            "{name} states another oracle catch figure than measured ({caught} of {catch}): update it"
+        );
+    }
 }
 
 // Label rule v3 and the executor share one standing body and one strike test, so the
