@@ -1,7 +1,8 @@
 //! Facts stated in more than one document stay the same (issues 24, 25):
 //! the column lists of `README.md` and `docs/dataset.md` against the data contract's
 //! `COLUMNS`, and the oracle's catch figure in `README.md` against `docs/execution.md`
-//! (`execute_e2e.rs` holds that figure to the measurement and to the dataset card).
+//! (`execute_e2e.rs` holds that figure to the measurement and to the dataset card), and
+//! the documents' relative links.
 
 use rh_contract::{CAMERAS, COLUMNS};
 use std::path::Path;
@@ -80,4 +81,74 @@ fn readme_and_docs_state_the_same_oracle_catch_figure() {
         "README says the oracle caught {} of {}, docs/execution.md {} of {}",
         readme.0, readme.1, docs.0, docs.1
     );
+}
+
+/// GitHub's anchor for a heading: lower case, punctuation other than `-` and `_` dropped,
+/// spaces to `-`.
+fn slug(heading: &str) -> String {
+    heading
+        .trim()
+        .to_lowercase()
+        .chars()
+        .filter(|c| c.is_alphanumeric() || matches!(c, '-' | '_' | ' '))
+        .map(|c| if c == ' ' { '-' } else { c })
+        .collect()
+}
+
+/// The anchors of a Markdown file's headings (outside code blocks).
+fn anchors(text: &str) -> Vec<String> {
+    let mut in_code = false;
+    let mut out = Vec::new();
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            in_code = !in_code;
+        } else if !in_code && line.starts_with('#') {
+            out.push(slug(line.trim_start_matches('#')));
+        }
+    }
+    out
+}
+
+/// Every relative link of README.md, ARCHITECTURE.md and docs/*.md names a file that
+/// exists and, with `#anchor`, a heading of it: moving text between documents cannot
+/// leave a link behind.
+#[test]
+fn document_links_resolve() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut files = vec!["README.md".to_string(), "ARCHITECTURE.md".to_string()];
+    for entry in std::fs::read_dir(root.join("docs")).unwrap() {
+        let name = entry.unwrap().file_name().to_string_lossy().to_string();
+        if name.ends_with(".md") {
+            files.push(format!("docs/{name}"));
+        }
+    }
+    let mut broken = Vec::new();
+    let mut links = 0;
+    for file in &files {
+        let text = doc(file);
+        let dir = Path::new(file).parent().unwrap();
+        for part in text.split("](").skip(1) {
+            let target = part.split([')', ' ']).next().unwrap();
+            if target.starts_with("http") || target.is_empty() {
+                continue;
+            }
+            links += 1;
+            let (path, anchor) = target.split_once('#').unwrap_or((target, ""));
+            let resolved = if path.is_empty() {
+                Path::new(file).to_path_buf()
+            } else {
+                dir.join(path)
+            };
+            if !root.join(&resolved).exists() {
+                broken.push(format!("{file}: {target} (no such file)"));
+            } else if !anchor.is_empty() {
+                let text = std::fs::read_to_string(root.join(&resolved)).unwrap();
+                if !anchors(&text).iter().any(|a| a == anchor) {
+                    broken.push(format!("{file}: {target} (no such heading)"));
+                }
+            }
+        }
+    }
+    assert!(links >= 20, "only {links} relative links found");
+    assert!(broken.is_empty(), "broken links:\n{}", broken.join("\n"));
 }
