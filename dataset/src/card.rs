@@ -563,7 +563,7 @@ standing body) and `NO_ACTION` when it is not. Rules v2–v3 called every benign
 hazard `CATCH`, including balls rolling or bouncing to the feet and throws that arrive at \
 knee height before any step could bring the hands there, which the executor's humanoid \
 cannot catch (`rh-score --execute`: on a 340-scene build the oracle baseline caught 58 of \
-146 rule-v3 CATCH labels, 66 of 70 rule-v4 ones).
+146 rule-v3 CATCH labels, 69 of 72 rule-v4 ones).
 * **Escape** (validator `valid_escapable`, rule v4): a `DODGE` scene with danger present whose \
 hazard reaches the observer within {esc_within} s of Δ must be escapable — of {esc_n} walks of {esc_d} m at {esc_v} m/s in evenly spaced directions (the \
 first straight back), hands at rest, executed in physics from Δ by the executor of `rh-score \

@@ -158,3 +158,25 @@ pub fn small_render_config(dir: &Path, width: u32, height: u32, scale_visibility
     std::fs::write(&path, small).unwrap();
     path
 }
+
+/// The figure "N of M" that follows `marker` in a document (line breaks and `**` bold
+/// ignored): for holding a figure stated in prose to the measurement.
+pub fn n_of_m_after(text: &str, marker: &str) -> (u32, u32) {
+    let text = text.replace('\n', " ").replace("**", "");
+    let at = text
+        .find(marker)
+        .unwrap_or_else(|| panic!("the text has no `{marker}`"))
+        + marker.len();
+    let words: Vec<&str> = text[at..].split_whitespace().take(3).collect();
+    assert_eq!(
+        words.get(1),
+        Some(&"of"),
+        "`{marker}` is not followed by `N of M`: {words:?}"
+    );
+    let num = |w: &str| {
+        w.trim_matches(|c: char| !c.is_ascii_digit())
+            .parse()
+            .unwrap_or_else(|_| panic!("`{w}` after `{marker}` is not a number"))
+    };
+    (num(words[0]), num(words[2]))
+}

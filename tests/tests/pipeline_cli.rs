@@ -437,17 +437,18 @@ fn balance_reports_counts_per_action_per_family() {
     );
 }
 
-/// The README's label balance sentence is the output of `rh-pipeline balance` (the one
-/// source): a change to the samplers or labels that moves a count fails here, and the
-/// message gives the sentence to paste.
+/// The label balance sentence of docs/labels.md is the output of `rh-pipeline balance`
+/// (the one source): a change to the samplers or labels that moves a count fails here,
+/// and the message gives the sentence to paste.
 #[test]
-fn readme_label_balance_matches_the_balance_command() {
-    let readme = fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"))
-        .unwrap()
-        .replace('\n', " ");
+fn docs_label_balance_matches_the_balance_command() {
+    let readme =
+        fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/labels.md"))
+            .unwrap()
+            .replace('\n', " ");
     let start = readme
         .find("Label balance of the 17 × 18 subset")
-        .expect("README states the label balance");
+        .expect("docs/labels.md states the label balance");
     let sentence = &readme[start..start + readme[start..].find('.').unwrap()];
     let count = |label: &str| -> u64 {
         let at = sentence
@@ -472,7 +473,7 @@ fn readme_label_balance_matches_the_balance_command() {
     let actual = (sum("catch"), sum("dodge"), sum("no_action"));
     assert_eq!(
         stated, actual,
-        "README says CATCH {}, DODGE {}, NO_ACTION {}; `rh-pipeline balance --seed 0` gives CATCH {}, DODGE {}, NO_ACTION {} — update the README",
+        "docs/labels.md says CATCH {}, DODGE {}, NO_ACTION {}; `rh-pipeline balance --seed 0` gives CATCH {}, DODGE {}, NO_ACTION {} — update docs/labels.md (its table too)",
         stated.0, stated.1, stated.2, actual.0, actual.1, actual.2
     );
 }
