@@ -234,4 +234,3 @@ pub struct Outcome {
     /// at every executed step.
     pub state_hash: String,
 }
-

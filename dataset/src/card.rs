@@ -6,8 +6,8 @@
 //! rows. Everything is a pure function of (manifest, rows): a merged build and a single
 //! build get the same card.
 
-use crate::table;
 use crate::manifest::Manifest;
+use crate::table;
 use arrow::array::{Array, RecordBatch};
 use arrow::datatypes::DataType;
 use std::collections::BTreeMap;

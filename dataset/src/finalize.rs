@@ -2,8 +2,8 @@
 //! and the finished `build.json` with every file's SHA-256. Shared by `build` (rows from
 //! the group records) and `merge` (rows from the shards).
 
-use crate::manifest::{Manifest, MANIFEST_FILE};
 use crate::integrity::{self, FileSums};
+use crate::manifest::{Manifest, MANIFEST_FILE};
 use crate::{card, table};
 use arrow::array::RecordBatch;
 use std::path::Path;
@@ -118,4 +118,3 @@ fn take_streamed(rows: &RowSource, indices: &[u32]) -> Result<RecordBatch, Build
     })?;
     table::concat(&parts).map_err(BuildError::Internal)
 }
-

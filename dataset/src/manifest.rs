@@ -4,8 +4,8 @@
 //! catalog — so that a restarted build can tell its own half-finished work from another
 //! build's, and `rh-pipeline merge` can check that shards belong together.
 
-use rh_scenes::config::Config;
 use rh_catalog::Catalog;
+use rh_scenes::config::Config;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::Path;

@@ -10,7 +10,6 @@
 //! (`dataset::referenced_files`: resume, shard, merge and verify checksum them).
 //! No GPU code here: label-only builds write the columns as nulls.
 
-use rh_scenes::driver::{HazardVisibility, SceneMedia, SceneResult};
 use arrow::array::{
     Array, ArrayRef, Float64Array, Float64Builder, ListArray, ListBuilder, RecordBatch,
     StringArray, StringBuilder, UInt32Array, UInt32Builder,
@@ -19,6 +18,7 @@ use rh_contract::columns::{
     depth_paths_column, mask_paths_column, unoccluded_column, visible_px_column,
 };
 use rh_contract::CAMERAS;
+use rh_scenes::driver::{HazardVisibility, SceneMedia, SceneResult};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 

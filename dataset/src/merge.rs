@@ -9,10 +9,10 @@
 //! not at all.
 
 use crate::finalize::{finalize, BuildError, RowSink};
-use crate::records::WORK_DIR;
-use crate::table;
 use crate::integrity::{self, FileSums};
 use crate::manifest::{Manifest, MANIFEST_FILE};
+use crate::records::WORK_DIR;
+use crate::table;
 use arrow::array::RecordBatch;
 use serde::Serialize;
 use std::collections::BTreeMap;

@@ -26,7 +26,8 @@ pub fn parquet_files(folder: &Path) -> Result<Vec<PathBuf>, String> {
 
 /// A record-batch reader over one Parquet file.
 pub fn open_parquet(file: &Path, batch_size: usize) -> Result<ParquetRecordBatchReader, String> {
-    let f = std::fs::File::open(file).map_err(|e| format!("cannot open {}: {e}", file.display()))?;
+    let f =
+        std::fs::File::open(file).map_err(|e| format!("cannot open {}: {e}", file.display()))?;
     ParquetRecordBatchReaderBuilder::try_new(f)
         .and_then(|b| b.with_batch_size(batch_size).build())
         .map_err(|e| format!("{} is not a readable Parquet file: {e}", file.display()))
@@ -44,7 +45,11 @@ pub fn column<'a>(batch: &'a RecordBatch, file: &Path, name: &str) -> Result<&'a
 }
 
 /// A string column (Utf8, LargeUtf8 or Utf8View), nulls as `None`.
-pub fn strings(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Option<String>>, String> {
+pub fn strings(
+    batch: &RecordBatch,
+    file: &Path,
+    name: &str,
+) -> Result<Vec<Option<String>>, String> {
     let col = column(batch, file, name)?;
     let col = match col.data_type() {
         DataType::Utf8 => col.clone(),
@@ -63,7 +68,11 @@ pub fn strings(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Optio
 }
 
 /// A string column without nulls.
-pub fn required_strings(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<String>, String> {
+pub fn required_strings(
+    batch: &RecordBatch,
+    file: &Path,
+    name: &str,
+) -> Result<Vec<String>, String> {
     strings(batch, file, name)?
         .into_iter()
         .enumerate()
@@ -75,7 +84,11 @@ pub fn required_strings(batch: &RecordBatch, file: &Path, name: &str) -> Result<
 pub fn bools(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<bool>, String> {
     let col = column(batch, file, name)?;
     let arr = col.as_any().downcast_ref::<BooleanArray>().ok_or_else(|| {
-        bad(file, name, format!("has type {}, expected Boolean", col.data_type()))
+        bad(
+            file,
+            name,
+            format!("has type {}, expected Boolean", col.data_type()),
+        )
     })?;
     (0..arr.len())
         .map(|i| match arr.is_null(i) {
@@ -89,7 +102,11 @@ pub fn bools(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<bool>, 
 pub fn u64s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<u64>, String> {
     let col = column(batch, file, name)?;
     let arr = col.as_any().downcast_ref::<UInt64Array>().ok_or_else(|| {
-        bad(file, name, format!("has type {}, expected UInt64", col.data_type()))
+        bad(
+            file,
+            name,
+            format!("has type {}, expected UInt64", col.data_type()),
+        )
     })?;
     (0..arr.len())
         .map(|i| match arr.is_null(i) {
@@ -100,15 +117,32 @@ pub fn u64s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<u64>, St
 }
 
 /// A column of 3-vectors: FixedSizeList<Float64, 3> (or List<Float64> of length 3).
-pub fn vec3s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Option<[f64; 3]>>, String> {
+pub fn vec3s(
+    batch: &RecordBatch,
+    file: &Path,
+    name: &str,
+) -> Result<Vec<Option<[f64; 3]>>, String> {
     let col = column(batch, file, name)?;
-    let wrong = || bad(file, name, format!("has type {}, expected FixedSizeList<Float64, 3>", col.data_type()));
+    let wrong = || {
+        bad(
+            file,
+            name,
+            format!(
+                "has type {}, expected FixedSizeList<Float64, 3>",
+                col.data_type()
+            ),
+        )
+    };
     let mut out = Vec::with_capacity(col.len());
     if let Some(arr) = col.as_any().downcast_ref::<FixedSizeListArray>() {
         if arr.value_length() != 3 {
             return Err(wrong());
         }
-        let values = arr.values().as_any().downcast_ref::<Float64Array>().ok_or_else(wrong)?;
+        let values = arr
+            .values()
+            .as_any()
+            .downcast_ref::<Float64Array>()
+            .ok_or_else(wrong)?;
         for i in 0..arr.len() {
             out.push((!arr.is_null(i)).then(|| {
                 let o = i * 3;
@@ -122,9 +156,16 @@ pub fn vec3s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Option<
                 continue;
             }
             let v = arr.value(i);
-            let v = v.as_any().downcast_ref::<Float64Array>().ok_or_else(wrong)?;
+            let v = v
+                .as_any()
+                .downcast_ref::<Float64Array>()
+                .ok_or_else(wrong)?;
             if v.len() != 3 {
-                return Err(bad(file, name, format!("row {i} has {} values, expected 3", v.len())));
+                return Err(bad(
+                    file,
+                    name,
+                    format!("row {i} has {} values, expected 3", v.len()),
+                ));
             }
             out.push(Some([v.value(0), v.value(1), v.value(2)]));
         }

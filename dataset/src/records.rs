@@ -4,14 +4,14 @@
 //! for `build.json`, and turning a damaged finished build back into records so that only
 //! the damaged groups are computed again.
 
-use crate::table;
-use rh_contract::fsio::{write_unsynced, Unsynced};
 use crate::integrity::{self, FileSums};
 use crate::manifest::Manifest;
-use rh_scenes::driver::{Rejections, SceneResult};
-use rh_scenes::validate::VALIDATOR_COLUMNS;
+use crate::table;
 use arrow::array::RecordBatch;
 use rh_catalog::Catalog;
+use rh_contract::fsio::{write_unsynced, Unsynced};
+use rh_scenes::driver::{Rejections, SceneResult};
+use rh_scenes::validate::VALIDATOR_COLUMNS;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

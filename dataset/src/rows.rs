@@ -2,11 +2,11 @@
 //! order of `rh_contract::COLUMNS`, and the files each row refers to.
 
 use crate::table::{frame_files, optional_string_column, schema, spec_path, string_column};
-use arrow::datatypes::{DataType, Field};
 use arrow::array::{
     ArrayRef, BooleanBuilder, FixedSizeListBuilder, Float32Builder, Float64Builder, ListBuilder,
     RecordBatch, StringBuilder, UInt32Builder, UInt64Builder,
 };
+use arrow::datatypes::{DataType, Field};
 use rh_catalog::Catalog;
 use rh_contract::{CAMERAS as CAMERA_NAMES, VALIDATOR_COLUMNS};
 use rh_scenes::driver::SceneResult;

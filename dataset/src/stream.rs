@@ -148,11 +148,11 @@ pub fn read_columns(path: &Path, names: &[&str]) -> Result<RecordBatch, String> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rh_scenes::config::Config;
     use crate::table::{parquet_bytes, record_batch, string_column, take_rows};
+    use rh_catalog::Catalog;
+    use rh_scenes::config::Config;
     use rh_scenes::driver::produce_group;
     use rh_scenes::selection::plan_group;
-    use rh_catalog::Catalog;
 
     /// A table streamed in small pieces (as a build feeds its groups) is written row
     /// group by row group into the same bytes as the whole table at once, across several

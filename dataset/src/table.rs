@@ -3,23 +3,23 @@
 //! (whole files, column values, the dataset's data files). Rows are built from scene
 //! results by `rows` (feature `write`).
 
+use crate::read;
 use arrow::array::{ArrayRef, RecordBatch};
 use arrow::datatypes::{DataType, Schema};
 use parquet::arrow::ArrowWriter;
 use parquet::basic::Compression;
 use parquet::file::properties::WriterProperties;
-use crate::read;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Rows per Parquet row group: small enough for the Hub's dataset viewer to page.
 pub const ROW_GROUP_SIZE: usize = 1000;
 
+#[cfg(feature = "write")]
+pub use crate::rows::{record_batch, referenced_files};
 pub use crate::stream::{project, read_columns, ParquetStream, SUMMARY_COLUMNS};
 pub use rh_contract::fsio::write_atomic;
 pub use rh_contract::layout::{data_file_name, frame_files, spec_path};
-#[cfg(feature = "write")]
-pub use crate::rows::{record_batch, referenced_files};
 
 /// The Arrow schema of the scene table, in column order, with the `huggingface` metadata
 /// key (the `datasets` features) attached.
@@ -199,7 +199,12 @@ pub fn read_hashes(dir: &Path) -> Result<Vec<(String, String, String)>, String> 
             let ids = read::required_strings(&batch, &path, "scene_id")?;
             let specs = read::required_strings(&batch, &path, "spec_file")?;
             let hashes = read::required_strings(&batch, &path, "state_hash")?;
-            rows.extend(ids.into_iter().zip(specs).zip(hashes).map(|((a, b), c)| (a, b, c)));
+            rows.extend(
+                ids.into_iter()
+                    .zip(specs)
+                    .zip(hashes)
+                    .map(|((a, b), c)| (a, b, c)),
+            );
         }
     }
     Ok(rows)

@@ -13,16 +13,16 @@
 //! `--fast` keeps the replay-only check: each stored spec is simulated and its per-step
 //! state hash compared with the stored one.
 
-use crate::table;
 use crate::integrity::{self, FileProblem};
 use crate::manifest::{catalog_sha256, Manifest, MANIFEST_FILE};
-use rh_scenes::selection::plan_group;
-use rh_scenes::driver::{produce_group, SceneResult};
-use rh_physics::simulate::{simulate, SimOptions};
-use rh_physics::spec::SceneSpec;
+use crate::table;
 use arrow::array::{Array, RecordBatch};
 use rayon::prelude::*;
 use rh_catalog::Catalog;
+use rh_physics::simulate::{simulate, SimOptions};
+use rh_physics::spec::SceneSpec;
+use rh_scenes::driver::{produce_group, SceneResult};
+use rh_scenes::selection::plan_group;
 use serde::Serialize;
 use std::path::Path;
 

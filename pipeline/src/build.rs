@@ -18,21 +18,21 @@
 //! writes the same bytes: finished and fresh groups reach the final table by the same
 //! path (their records). The directory is locked (`flock`) while a build runs in it.
 
+use arrow::array::RecordBatch;
+use rayon::prelude::*;
+use rh_catalog::Catalog;
 use rh_dataset::card;
-use rh_scenes::config::Config;
-use rh_dataset::table;
-use rh_scenes::families;
-use rh_dataset::finalize::{finalize, RowSink};
 pub use rh_dataset::finalize::BuildError;
+use rh_dataset::finalize::{finalize, RowSink};
 use rh_dataset::integrity;
 use rh_dataset::manifest::{Manifest, MANIFEST_FILE};
 pub use rh_dataset::records::FamilyRejections;
 use rh_dataset::records::{gather_rejections, group_files, load_record, reopen_if_damaged};
 pub use rh_dataset::records::{record_path, WORK_DIR};
+use rh_dataset::table;
+use rh_scenes::config::Config;
 use rh_scenes::driver::{run_group, GroupError, RenderStage};
-use arrow::array::RecordBatch;
-use rayon::prelude::*;
-use rh_catalog::Catalog;
+use rh_scenes::families;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
@@ -204,7 +204,8 @@ const SYNC_BACKLOG: usize = 32;
 
 impl Syncer {
     fn start() -> Syncer {
-        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<rh_contract::fsio::Unsynced>>(SYNC_BACKLOG);
+        let (tx, rx) =
+            std::sync::mpsc::sync_channel::<Vec<rh_contract::fsio::Unsynced>>(SYNC_BACKLOG);
         let rx = std::sync::Arc::new(std::sync::Mutex::new(rx));
         let threads = (0..SYNC_THREADS)
             .map(|_| {

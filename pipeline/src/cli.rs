@@ -2,11 +2,11 @@
 //! usage (with a message naming what is wrong), 1 internal failure.
 
 use crate::build::{build, BuildError, BuildOptions};
-use rh_scenes::config::Config;
-use rh_scenes::selection::{LexiconPlanner, Planner};
-use rh_dataset::verify::{verify, verify_fast};
 use clap::{Parser, Subcommand};
 use rh_catalog::Catalog;
+use rh_dataset::verify::{verify, verify_fast};
+use rh_scenes::config::Config;
+use rh_scenes::selection::{LexiconPlanner, Planner};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 

@@ -11,9 +11,9 @@
 //! description text is stored too. Given its selections a build stays seed-pure, and with
 //! the cache a rebuild from the same descriptions makes no request.
 
-use rh_scenes::selection::{LexiconPlanner, PlanError, Planner};
-use rh_physics::spec::{PlannerRecord, Selection};
 use rh_catalog::Catalog;
+use rh_physics::spec::{PlannerRecord, Selection};
+use rh_scenes::selection::{LexiconPlanner, PlanError, Planner};
 use serde::Deserialize;
 use serde_json::{json, Value};
 

@@ -18,11 +18,11 @@
 
 use rayon::prelude::*;
 use rh_catalog::Catalog;
-use rh_scenes::config::Config;
+use rh_physics::simulate::{simulate, SimOptions};
 use rh_render::{with_thread_renderer, RenderOptions};
+use rh_scenes::config::Config;
 use rh_scenes::driver::produce_group;
 use rh_scenes::selection::plan_group;
-use rh_physics::simulate::{simulate, SimOptions};
 use std::time::Instant;
 
 fn env_parse<T: std::str::FromStr>(name: &str) -> Option<T> {

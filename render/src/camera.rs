@@ -2,10 +2,10 @@
 //! validator's camera model), and the full-event video's outside camera.
 
 use super::FULL_EVENT;
-use rh_scenes::view;
 use rh_physics::simulate::Simulation;
 use rh_physics::spec::vec3::{add, dot, norm, scale, sub};
 use rh_physics::spec::{CameraSpec, SceneSpec, Vec3};
+use rh_scenes::view;
 
 /// Column-major view-projection matrix agreeing with `view::View::project`:
 /// clip x/w and y/w are exactly its normalised coordinates; depth maps [near, far] to [0, 1].

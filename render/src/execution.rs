@@ -27,11 +27,11 @@ use super::mesh::{Mesh, Xf};
 use super::observer::link_meshes;
 use super::renderer::Renderer;
 use super::{font, RenderError, Shading};
+use rh_catalog::Catalog;
 use rh_physics::body::{Geometry, LinkPose, Part};
 use rh_physics::execute::ExecFrame;
 use rh_physics::simulate::{BodyState, Simulation};
 use rh_physics::spec::{quat, CameraSpec, SceneSpec, Vec3};
-use rh_catalog::Catalog;
 use std::path::{Path, PathBuf};
 
 /// How execution videos look (`[execution_video]` of `configs/scoring.toml`).

@@ -10,12 +10,12 @@ use super::observer::observer_mesh;
 use super::recipes;
 use super::regions::{bounds, rects_meet, screen_rect, shadow_regions};
 use super::Shading;
-use rh_scenes::view::View;
+use rh_catalog::Catalog;
+use rh_contract::layout::instance;
 use rh_physics::simulate::{BodyState, Simulation};
 use rh_physics::spec::vec3::{add, norm, sub};
 use rh_physics::spec::{BodyKind, CameraSpec, JointKind, SceneSpec, Vec3};
-use rh_catalog::Catalog;
-use rh_contract::layout::instance;
+use rh_scenes::view::View;
 use std::ops::Range;
 
 /// One static mesh piece: its vertices in `statics`, its bounding box, and the
@@ -429,7 +429,11 @@ impl SceneGeometry {
     }
 }
 
-fn object_look_mesh(catalog: &Catalog, id: &str, parts: &[rh_physics::spec::PartSpec]) -> Option<Mesh> {
+fn object_look_mesh(
+    catalog: &Catalog,
+    id: &str,
+    parts: &[rh_physics::spec::PartSpec],
+) -> Option<Mesh> {
     let object = catalog.object(id)?;
     let source = catalog.appearance_source(object);
     let a = &source.appearance;

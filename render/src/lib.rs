@@ -52,8 +52,8 @@ mod regions;
 mod renderer;
 mod sheet;
 
-use rh_scenes::config::RenderConfig;
 use encode::EncodeSettings;
+use rh_scenes::config::RenderConfig;
 use std::collections::BTreeMap;
 
 pub use camera::{full_event_camera, view_proj};

@@ -12,11 +12,11 @@ use super::camera::view_proj;
 use super::geometry::SceneGeometry;
 use super::gpu::{IdImage, IdPass, IdView};
 use super::{RenderError, Renderer, FRAME_TIMES};
-use rh_scenes::driver::HazardVisibility;
-use rh_physics::simulate::Simulation;
-use rh_physics::spec::{CameraSpec, SceneSpec};
 use rh_catalog::Catalog;
 use rh_contract::layout::{depth_path, instance, mask_path};
+use rh_physics::simulate::Simulation;
+use rh_physics::spec::{CameraSpec, SceneSpec};
+use rh_scenes::driver::HazardVisibility;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

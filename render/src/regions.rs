@@ -3,8 +3,8 @@
 
 use super::gpu;
 use super::mesh::Vertex;
-use rh_scenes::view::View;
 use rh_physics::spec::{CameraSpec, Vec3};
+use rh_scenes::view::View;
 
 /// Axis-aligned bounds of some vertices (`None` when there are none).
 pub(super) fn bounds(verts: &[Vertex]) -> Option<[Vec3; 2]> {

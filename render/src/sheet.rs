@@ -2,8 +2,8 @@
 
 use super::font;
 use super::RenderError;
-use rh_physics::spec::SceneSpec;
 use rh_contract::layout::frame_path;
+use rh_physics::spec::SceneSpec;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

@@ -4,17 +4,17 @@
 //! One small render (320×180, three families) is shared by the tests.
 
 use rh_catalog::Catalog;
-use rh_scenes::view::View;
-use rh_scenes::config::Config;
 use rh_contract::fsio::write_atomic;
+use rh_physics::simulate::{simulate, SimOptions, Simulation};
+use rh_physics::spec::SceneSpec;
 use rh_render::{
     contact_sheet, frame_file_name, RenderOptions, RenderedScene, Renderer, Shading, CAMERAS,
     FRAME_TIMES, HAZARD_MASK_RGB,
 };
+use rh_scenes::config::Config;
 use rh_scenes::driver::{full_event_simulation, produce_group};
 use rh_scenes::selection::plan_group;
-use rh_physics::simulate::{simulate, SimOptions, Simulation};
-use rh_physics::spec::SceneSpec;
+use rh_scenes::view::View;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::{Mutex, OnceLock};

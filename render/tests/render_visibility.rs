@@ -11,12 +11,12 @@
 
 use rh_catalog::Catalog;
 use rh_contract::layout::{depth_path, instance, mask_path};
-use rh_scenes::config::Config;
-use rh_render::{RenderOptions, Renderer, CAMERAS, FRAME_TIMES};
-use rh_scenes::driver::produce_group;
-use rh_scenes::selection::plan_group;
 use rh_physics::simulate::{simulate, SimOptions, Simulation};
 use rh_physics::spec::SceneSpec;
+use rh_render::{RenderOptions, Renderer, CAMERAS, FRAME_TIMES};
+use rh_scenes::config::Config;
+use rh_scenes::driver::produce_group;
+use rh_scenes::selection::plan_group;
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::sync::{Mutex, OnceLock};

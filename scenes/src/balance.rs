@@ -16,9 +16,9 @@
 //! Every family also has far-observer groups (about 4%), which are NO_ACTION.
 
 use crate::config::Config;
+use crate::driver::produce_group_counted;
 use crate::families;
 use crate::label::Action;
-use crate::driver::produce_group_counted;
 use crate::selection::plan_group;
 use rh_catalog::Catalog;
 use serde::Serialize;

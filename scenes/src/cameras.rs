@@ -5,12 +5,12 @@
 //! window. Cameras never touch physics, so framing after the simulation changes no
 //! state hash; the chosen poses are stored in the spec.
 
-use rh_physics::simulate::{Obstacles, Simulation};
-use rh_physics::spec::vec3::{add, cross, dot, norm, scale, sub};
-use rh_physics::spec::{CameraSpec, SceneSpec, Vec3};
 use crate::view::{complete_basis, window_steps, View};
 use crate::visibility;
 use rand::RngExt;
+use rh_physics::simulate::{Obstacles, Simulation};
+use rh_physics::spec::vec3::{add, cross, dot, norm, scale, sub};
+use rh_physics::spec::{CameraSpec, SceneSpec, Vec3};
 
 pub const CAMERA_NAMES: [&str; 3] = ["ego", "closeup", "overhead"];
 const FRAMING_ATTEMPTS: u32 = 8;
@@ -343,9 +343,9 @@ const OBSERVER_SECTOR: f64 = 0.9;
 mod tests {
     use crate::config::Config;
     use crate::randomize::{randomize, SceneKey};
+    use rh_catalog::Catalog;
     use rh_physics::simulate::Obstacles;
     use rh_physics::spec::{Selection, ShapeSpec};
-    use rh_catalog::Catalog;
 
     #[test]
     fn furniture_blocks_the_line_of_sight() {

@@ -3,10 +3,10 @@
 //! The default configuration is compiled in, so `rh-pipeline build` needs no files;
 //! `--config FILE` loads another one (its `labels` path is relative to that file).
 
+use rh_physics::spec::{LabelConfig, LABELS_TOML};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use rh_physics::spec::{LabelConfig, LABELS_TOML};
 
 const DEFAULT_TOML: &str = include_str!("../../configs/default.toml");
 

@@ -10,10 +10,10 @@ use crate::families;
 use crate::label::{label, Labels};
 use crate::randomize::{randomize, RandomizeError, SceneKey};
 use crate::selection::plan_group;
-use rh_physics::simulate::{simulate, SimOptions, Simulation};
-use rh_physics::spec::{SceneSpec, Selection};
 use crate::validate::{validate, Verdicts, VALIDATOR_COLUMNS};
 use rh_catalog::Catalog;
+use rh_physics::simulate::{simulate, SimOptions, Simulation};
+use rh_physics::spec::{SceneSpec, Selection};
 
 /// Everything the dataset needs about one finished scene.
 #[derive(Debug, Clone)]

@@ -7,13 +7,13 @@
 
 use crate::config::Config;
 use crate::families::{self, FamilyInput};
+use rand::RngExt;
+use rh_catalog::Catalog;
 use rh_physics::seeds;
 use rh_physics::spec::{
     LightingSpec, ObserverSpec, PhysicsSpec, RoomSpec, SceneSpec, Selection, SpeedBand, VideoSpec,
     SCHEMA_VERSION,
 };
-use rand::RngExt;
-use rh_catalog::Catalog;
 
 /// Identifies one scene of a build: which group and band, at which attempt.
 #[derive(Debug, Clone, PartialEq)]

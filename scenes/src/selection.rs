@@ -7,10 +7,10 @@
 //! * `LexiconPlanner` maps a free-text description to a validated selection with a
 //!   deterministic phrase lexicon. An LLM-backed planner can implement `Planner` later.
 
-use rh_physics::seeds;
-use rh_physics::spec::Selection;
 use rand::RngExt;
 use rh_catalog::{Catalog, Object, Room};
+use rh_physics::seeds;
+use rh_physics::spec::Selection;
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum PlanError {

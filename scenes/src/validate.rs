@@ -5,9 +5,9 @@ use crate::cameras;
 use crate::config::ValidatorConfig;
 use crate::families::Family;
 use crate::label::Labels;
+use crate::visibility;
 use rh_physics::simulate::Simulation;
 use rh_physics::spec::SceneSpec;
-use crate::visibility;
 use serde::{Deserialize, Serialize};
 
 /// The verdict columns, in `Verdicts::as_array` order (the data contract's list).

@@ -89,4 +89,3 @@ pub fn window_steps(spec: &SceneSpec, sim: &Simulation, until_within: f64) -> Ve
         })
         .collect()
 }
-

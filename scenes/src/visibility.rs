@@ -15,8 +15,8 @@
 //! [`assess`] is the one entry point: it measures every camera of a spec over a
 //! simulation; [`Assessment::passes`] is the verdict.
 
-use crate::view::View;
 use crate::config::FramingRules;
+use crate::view::View;
 use rh_physics::simulate::{Obstacles, Simulation};
 use rh_physics::spec::vec3::{add, dot, sub};
 use rh_physics::spec::{quat, CameraSpec, Quat, SceneSpec, ShapeSpec, Vec3};
@@ -292,8 +292,8 @@ mod tests {
     use super::*;
     use crate::config::Config;
     use crate::randomize::{randomize, SceneKey};
-    use rh_physics::spec::{BodyKind, BodyRole, BodySpec, PartSpec, Selection};
     use rh_catalog::Catalog;
+    use rh_physics::spec::{BodyKind, BodyRole, BodySpec, PartSpec, Selection};
 
     const MARGIN: f64 = 0.08;
 

@@ -6,15 +6,15 @@
 //! 0.25 s after Δ.
 
 use rh_catalog::Catalog;
-use rh_scenes::config::Config;
 use rh_physics::body::{Geometry, Part};
 use rh_physics::execute::{replay, ExecConfig, ExecKeyframe, ExecPlan, OutcomeKind};
-use rh_scenes::randomize::{randomize, SceneKey};
-use rh_scenes::driver::counterfactual_options;
-use rh_scenes::driver::{produce_group, SceneResult};
-use rh_scenes::selection::plan_group;
 use rh_physics::simulate::{simulate, SimOptions};
 use rh_physics::spec::{Selection, ShapeSpec};
+use rh_scenes::config::Config;
+use rh_scenes::driver::counterfactual_options;
+use rh_scenes::driver::{produce_group, SceneResult};
+use rh_scenes::randomize::{randomize, SceneKey};
+use rh_scenes::selection::plan_group;
 
 fn scenes(family: &str, group: u64) -> Vec<SceneResult> {
     let catalog = Catalog::embedded().unwrap();

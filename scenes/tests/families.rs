@@ -2,14 +2,14 @@
 //! every family valid and bit-for-bit replayable in all four bands.
 
 use rh_catalog::Catalog;
+use rh_physics::simulate::{simulate, SimOptions, Simulation};
+use rh_physics::spec::{SceneSpec, Selection};
 use rh_scenes::config::Config;
+use rh_scenes::driver::{produce_group, SceneResult};
 use rh_scenes::families::{self, GRAVITY};
 use rh_scenes::label::Action;
 use rh_scenes::randomize::{randomize, SceneKey};
-use rh_scenes::driver::{produce_group, SceneResult};
 use rh_scenes::selection::plan_group;
-use rh_physics::simulate::{simulate, SimOptions, Simulation};
-use rh_physics::spec::{SceneSpec, Selection};
 
 fn setup() -> (Catalog, Config) {
     (Catalog::embedded().unwrap(), Config::embedded().unwrap())

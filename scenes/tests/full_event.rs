@@ -6,11 +6,11 @@
 //! (checked in `tests/render.rs`).
 
 use rh_catalog::Catalog;
+use rh_physics::simulate::{observer_penetration, simulate, SimOptions};
+use rh_physics::spec::SceneSpec;
 use rh_scenes::config::Config;
 use rh_scenes::driver::{counterfactual_options, full_event_simulation, produce_group};
 use rh_scenes::selection::plan_group;
-use rh_physics::simulate::{observer_penetration, simulate, SimOptions};
-use rh_physics::spec::SceneSpec;
 
 /// Among the valid scenes of `family` (build seed 3, two groups of four speed bands)
 /// whose counterfactual run strikes the observer, the one whose plain run passes

@@ -4,15 +4,15 @@
 //! build (17 families × 4 bands × 10 groups).
 
 use rh_catalog::Catalog;
-use rh_scenes::config::Config;
 use rh_physics::body::{Part, HIP_Y};
-use rh_scenes::families;
-use rh_scenes::label::{self, ImpactKind};
-use rh_scenes::selection::plan_group;
-use rh_scenes::randomize::{randomize, SceneKey};
-use rh_scenes::driver::{counterfactual_options, produce_group_counted, run_scene};
 use rh_physics::simulate::{observer_penetration, simulate, SimOptions};
 use rh_physics::spec::{SceneSpec, Selection};
+use rh_scenes::config::Config;
+use rh_scenes::driver::{counterfactual_options, produce_group_counted, run_scene};
+use rh_scenes::families;
+use rh_scenes::label::{self, ImpactKind};
+use rh_scenes::randomize::{randomize, SceneKey};
+use rh_scenes::selection::plan_group;
 use rh_scenes::validate::{reaction_time_ok, VALIDATOR_COLUMNS};
 
 const G: f64 = 9.81;

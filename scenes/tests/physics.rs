@@ -3,12 +3,12 @@
 //! bit-for-bit identical.
 
 use rh_catalog::Catalog;
-use rh_scenes::config::Config;
-use rh_scenes::label::Action;
-use rh_scenes::driver::{produce_group, run_scene, SceneResult};
-use rh_scenes::selection::plan_group;
 use rh_physics::simulate::{simulate, SimOptions, Simulation, TOUCH_FLOOR, TOUCH_SOURCE};
 use rh_physics::spec::{quat, Selection, ShapeSpec};
+use rh_scenes::config::Config;
+use rh_scenes::driver::{produce_group, run_scene, SceneResult};
+use rh_scenes::label::Action;
+use rh_scenes::selection::plan_group;
 
 const G: f64 = 9.81;
 

@@ -11,11 +11,11 @@
 //! `cargo test --release -p rh-pipeline --test pinned -- --ignored regenerate`.
 
 use rh_catalog::Catalog;
-use rh_scenes::config::Config;
-use rh_scenes::selection::plan_group;
-use rh_scenes::driver::produce_group;
 use rh_physics::simulate::{simulate, SimOptions};
 use rh_physics::spec::SceneSpec;
+use rh_scenes::config::Config;
+use rh_scenes::driver::produce_group;
+use rh_scenes::selection::plan_group;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 

@@ -46,8 +46,6 @@ impl BaselineKind {
     }
 }
 
-
-
 /// Hazard direction on the floor in the observer's body frame (default: straight ahead).
 fn hazard_dir_body(scene: &Scene) -> [f64; 2] {
     let [x0, y0, th] = scene.observer_pose;
@@ -60,7 +58,6 @@ fn hazard_dir_body(scene: &Scene) -> [f64; 2] {
     let (s, c) = th.sin_cos();
     [(c * dx + s * dy) / n, (-s * dx + c * dy) / n]
 }
-
 
 /// Arms forward, no walking.
 pub fn catch_template() -> Value {
@@ -83,9 +80,6 @@ pub fn dodge_template(scene: &Scene, cfg: &Config, dist: f64, dur: f64) -> Value
         vec![rest_kf(dur, cfg)],
     )
 }
-
-
-
 
 /// The plan a baseline writes for one scene (the oracle without its optional hints).
 pub fn baseline_plan(
@@ -220,11 +214,11 @@ pub fn write_baseline(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::f64::consts::PI;
     use crate::aia::AiaMatcher;
     use crate::fixture::{dataset_of, synth_rows};
     use crate::metrics::score_decision;
     use crate::plan::plan_from_value;
+    use std::f64::consts::PI;
 
     #[test]
     fn oracle_is_perfect_on_synthetic_scenes() {

@@ -46,10 +46,10 @@ pub mod plan_json;
 #[cfg(feature = "predict")]
 pub mod predict;
 pub mod preds;
-pub mod tables;
 pub mod report;
 pub mod rule;
 pub mod score;
+pub mod tables;
 pub mod types;
 
 pub use config::Config;

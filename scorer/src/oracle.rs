@@ -23,9 +23,9 @@
 //!   would be struck, the first of the label's escape walks that is not replaces it.
 //! * **NO_ACTION** — stand still, hands at rest.
 
-use crate::plan_json::{kf, plan, solve_walk, wrap_angle};
 use crate::config::Config;
 use crate::dataset::{open_parquet, parquet_files, read_replay_keys, Dataset, Scene};
+use crate::plan_json::{kf, plan, solve_walk, wrap_angle};
 use crate::types::Action;
 use anyhow::Result;
 use arrow::array::{Array, FixedSizeListArray, Float32Array, Float64Array, ListArray};
@@ -61,7 +61,6 @@ pub struct OracleHints {
     /// would be struck and an escape walk is not.
     pub dodge: Option<Value>,
 }
-
 
 /// Largest forward distance of the mean hand at body height `zb` above the pelvis that
 /// the arms reach (negative when no forward distance does).

@@ -13,7 +13,11 @@ fn crates(root: &Path) -> Vec<String> {
         .lines()
         .find(|l| l.trim_start().starts_with("members"))
         .expect("a members line");
-    line.split('"').skip(1).step_by(2).map(str::to_string).collect()
+    line.split('"')
+        .skip(1)
+        .step_by(2)
+        .map(str::to_string)
+        .collect()
 }
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {

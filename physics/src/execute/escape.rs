@@ -10,8 +10,8 @@
 //! forward), each `escape_distance` m at `escape_speed` m/s with the hands at rest
 //! (`configs/labels.toml`).
 
-use crate::body::{REST_LEFT, REST_RIGHT};
 use super::{ExecConfig, ExecKeyframe, ExecPlan, OutcomeKind, Replay};
+use crate::body::{REST_LEFT, REST_RIGHT};
 use crate::spec::SceneSpec;
 use std::sync::OnceLock;
 

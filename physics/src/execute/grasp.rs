@@ -25,8 +25,8 @@
 //! slip), the decision is made at one instant from the pre-contact relative speed, and
 //! only a palm (not a forearm) closes.
 
-use crate::body::Part;
 use super::ExecConfig;
+use crate::body::Part;
 use crate::simulate::SceneWorld;
 use rapier3d::prelude::*;
 

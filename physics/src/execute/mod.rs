@@ -21,9 +21,9 @@ pub mod grasp;
 pub mod motion;
 pub mod outcome;
 
+use crate::body::{BodyPose, LinkPose};
 use crate::simulate::{build_world, hash_hex, simulate, BodyState, SceneWorld, SimOptions};
 use crate::spec::{SceneSpec, Vec3};
-use crate::body::{BodyPose, LinkPose};
 use rapier3d::prelude::*;
 
 use sha2::{Digest, Sha256};
@@ -36,7 +36,9 @@ pub use rh_contract::execution::{
 pub fn plan_reach(plan: &ExecPlan) -> f64 {
     plan.keyframes
         .iter()
-        .map(|k| (k.left[0] - crate::body::REST_LEFT[0]).max(k.right[0] - crate::body::REST_RIGHT[0]))
+        .map(|k| {
+            (k.left[0] - crate::body::REST_LEFT[0]).max(k.right[0] - crate::body::REST_RIGHT[0])
+        })
         .fold(0.0, f64::max)
 }
 

@@ -15,8 +15,8 @@
 //!   both hands one point); each target is clamped to the arm's reach and joint limits
 //!   ([`Geometry::reachable`]), and a hand moves at most `max_hand_speed`.
 
-use crate::body::{BodyPose, Geometry, HAND_GAP, REST_LEFT, REST_RIGHT};
 use super::{ExecConfig, ExecPlan};
+use crate::body::{BodyPose, Geometry, HAND_GAP, REST_LEFT, REST_RIGHT};
 use crate::spec::{vec3, Vec3};
 
 /// Rest hand positions (body frame), SPEC §2.

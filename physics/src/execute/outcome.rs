@@ -29,9 +29,9 @@
 //! own horizon, `physics.max_steps`, where the label's counterfactual stops too).
 
 use super::grasp::{self, GraspState};
-use crate::body::{Geometry, LinkShape, Part};
 use super::motion::Motion;
 use super::{ExecConfig, ExecFrame, ExecPlan, Outcome, OutcomeKind, StrikeRecord};
+use crate::body::{Geometry, LinkShape, Part};
 use crate::simulate::{hash_hex, lowest_z, SceneWorld};
 use crate::spec::{SceneSpec, Vec3};
 use crate::strike::{contact_point_speed, StrikeMonitor, StrikeRule, StrikeWindow};
@@ -216,7 +216,8 @@ pub(super) fn run(
         }
     }
     let attempted = m.hand_touched
-        || (super::plan_reach(plan) >= cfg.attempt_reach && m.min_hand_distance <= cfg.attempt_radius);
+        || (super::plan_reach(plan) >= cfg.attempt_reach
+            && m.min_hand_distance <= cfg.attempt_radius);
     let kind = if m.strike.is_some() {
         OutcomeKind::Struck
     } else if m.caught {

@@ -127,5 +127,6 @@ impl Family for ChainReaction {
 /// First step at which the hazard touches a body other than its table or the floor
 /// (the trigger, in this family).
 pub fn first_strike_step(sim: &Simulation) -> Option<u32> {
-    (0..=sim.steps()).find(|&k| sim.hazard_contacts[k as usize] & rh_physics::simulate::TOUCH_OTHER != 0)
+    (0..=sim.steps())
+        .find(|&k| sim.hazard_contacts[k as usize] & rh_physics::simulate::TOUCH_OTHER != 0)
 }

@@ -6,14 +6,14 @@
 //! in the same order whatever the speed, so the four bands of a group differ only in
 //! the speed parameter and what follows from it physically.
 
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
+use rh_catalog::{Object, Room, ShapeKind};
 use rh_physics::simulate::Simulation;
 use rh_physics::spec::{
     quat, BodyKind, BodyRole, BodySpec, JointKind, JointSpec, PartSpec, Quat, SceneSpec, ShapeSpec,
     Vec3, IDENTITY,
 };
-use rand::RngExt;
-use rand_chacha::ChaCha8Rng;
-use rh_catalog::{Object, Room, ShapeKind};
 use std::collections::BTreeMap;
 
 pub mod bouncing_object;
@@ -768,8 +768,8 @@ impl TiltedLaunch {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rh_physics::seeds;
     use rh_catalog::Catalog;
+    use rh_physics::seeds;
 
     /// The band contract: layouts of the four bands differ only in velocities.
     #[test]

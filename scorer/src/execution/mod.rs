@@ -24,9 +24,9 @@ use std::path::PathBuf;
 
 pub use report::ExecutionReport;
 #[cfg(feature = "execute")]
-pub(crate) use run::{checked_replay, replay_key};
-#[cfg(feature = "execute")]
 pub use run::{cache_key, execute_all};
+#[cfg(feature = "execute")]
+pub(crate) use run::{checked_replay, replay_key};
 
 /// One scored decision waiting for execution.
 #[derive(Debug, Clone)]
@@ -78,4 +78,3 @@ pub struct RunStats {
     pub checked_at_decision: usize,
     pub checked_full: usize,
 }
-
