@@ -400,21 +400,36 @@ fn insert_provenance(input: &CardInput, v: &mut BTreeMap<&str, String>) {
 /// What the measured-visibility columns mean, and the masks and depth of `--masks`.
 fn masks_note(masks: bool) -> String {
     use rh_contract::layout::instance;
+    // Paragraphs start at the line's first column: text indented 4+ spaces after a blank
+    // line is a code block in CommonMark (the Hub's renderer).
     let mut s = format!(
-        "**Measured visibility.** For every rendered scene the renderer draws an instance-id          image of each camera at the five observation times (unlit, one sample per pixel,          the same geometry as the frames: the ego camera sits in the observer's head and          does not see its own body). `<cam>_hazard_visible_px` counts the pixels that show          the hazard; `<cam>_hazard_unoccluded_fraction` divides them by the pixels the          hazard covers when drawn with nothing else (1 = nothing in front of it; 0 when it          projects to no pixel of the image). Both are null for unrendered scenes.
-
-         **Segmentation and depth.** Instance ids: {} = room (floor, walls, ceiling) and          empty background; `i + 1` = the spec's body `bodies[i]` (the hazard is          `hazard + 1`); {} = ropes and rods drawn along joints; {} = the observer's body.          Depth: Euclidean distance of the surface from the camera centre in millimetres          (round(d · 1000); 0 = no surface, 65535 = 65.535 m or more). ",
+        "**Measured visibility.** For every rendered scene the renderer draws an instance-id \
+         image of each camera at the five observation times (unlit, one sample per pixel, \
+         the same geometry as the frames: the ego camera sits in the observer's head and \
+         does not see its own body). `<cam>_hazard_visible_px` counts the pixels that show \
+         the hazard; `<cam>_hazard_unoccluded_fraction` divides them by the pixels the \
+         hazard covers when drawn with nothing else (1 = nothing in front of it; 0 when it \
+         projects to no pixel of the image). Both are null for unrendered scenes.\n\n\
+         **Segmentation and depth.** Instance ids: {} = room (floor, walls, ceiling) and \
+         empty background; `i + 1` = the spec's body `bodies[i]` (the hazard is \
+         `hazard + 1`); {} = ropes and rods drawn along joints; {} = the observer's body. \
+         Depth: Euclidean distance of the surface from the camera centre in millimetres \
+         (round(d · 1000); 0 = no surface, 65535 = 65.535 m or more). ",
         instance::ROOM,
         instance::ROPE,
         instance::OBSERVER
     );
     if masks {
         s.push_str(
-            "This build has them (`--masks`): `masks/<scene_id>/<cam>_t0.000.png` … and              `depth/<scene_id>/<cam>_t0.000.png` … (16-bit greyscale PNG, the size of the              frames), named by the `<cam>_mask_paths` and `<cam>_depth_paths` columns in              `FRAME_TIMES` order.",
+            "This build has them (`--masks`): `masks/<scene_id>/<cam>_t0.000.png` … and \
+             `depth/<scene_id>/<cam>_t0.000.png` … (16-bit greyscale PNG, the size of the \
+             frames), named by the `<cam>_mask_paths` and `<cam>_depth_paths` columns in \
+             `FRAME_TIMES` order.",
         );
     } else {
         s.push_str(
-            "This build has none: they are written by `rh-pipeline build --masks`, and the              `<cam>_mask_paths` / `<cam>_depth_paths` columns are null.",
+            "This build has none: they are written by `rh-pipeline build --masks`, and the \
+             `<cam>_mask_paths` / `<cam>_depth_paths` columns are null.",
         );
     }
     s
@@ -624,6 +639,19 @@ the shins 0.3 s after Δ) is resampled: no decision could matter.",
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn masks_note_is_prose_not_a_code_block() {
+        // CommonMark: a line indented 4+ spaces after a blank line starts a code block.
+        for masks in [false, true] {
+            let note = masks_note(masks);
+            assert!(note.contains("\n\n**Segmentation and depth.**"), "{note}");
+            for line in note.lines() {
+                assert!(!line.starts_with("    "), "indented line: {line:?}");
+                assert!(!line.contains("  "), "a run of spaces: {line:?}");
+            }
+        }
+    }
 
     #[test]
     fn eval_prefers_whole_groups_then_fills_by_index() {

@@ -424,8 +424,8 @@ fn finished_build(
         .join(card::EVAL_FILE)
         .exists()
         .then(|| card::eval_selection(&rows).0.len());
-    let groups = manifest.groups().len();
-    Ok(Some(summarize(out, &rows, data_file, groups, 0, eval)))
+    // Nothing was resumed: the build was already complete ("nothing to do").
+    Ok(Some(summarize(out, &rows, data_file, 0, 0, eval)))
 }
 
 /// Builds the dataset described by `opts`.

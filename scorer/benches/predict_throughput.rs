@@ -200,6 +200,8 @@ fn options(dir: &Path, port: u16, out: &Path) -> PredictOptions {
         sample: 0,
         prompt: PromptConfig::load(None).unwrap(),
         progress: false,
+        abort_after_failures: 8,
+        progress_every_s: 10.0,
     }
 }
 

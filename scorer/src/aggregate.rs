@@ -1,5 +1,5 @@
 //! Streaming aggregation: per-decision results are folded into per-model accumulators as
-//! they arrive. Cross-model analyses keep one compact record per (scene, model) — 8 bytes,
+//! they arrive. Cross-model analyses keep one compact record per (scene, model) — 12 bytes,
 //! so memory is bounded by scenes × models, never by the size of the predictions file.
 
 use crate::dataset::{Dataset, Scene};
@@ -104,8 +104,12 @@ pub struct Rec {
     /// 0 CATCH, 1 DODGE, 2 NO_ACTION, 3 no parseable plan.
     pub action: u8,
     pub questions_material: bool,
+    /// AIA × 2 (0, 1 or 2).
+    pub aia2: u8,
     /// d_end, NaN when missing.
     pub d_end: f32,
+    /// HDE d_min, NaN when missing.
+    pub d_min: f32,
 }
 
 impl Rec {
@@ -125,6 +129,16 @@ impl Rec {
     pub fn end_distance(&self) -> Option<f64> {
         (self.is_scored() && !self.d_end.is_nan()).then_some(self.d_end as f64)
     }
+
+    /// The scored decision's HDE `d_min`, when it has one.
+    pub fn min_distance(&self) -> Option<f64> {
+        (self.is_scored() && !self.d_min.is_nan()).then_some(self.d_min as f64)
+    }
+
+    /// The scored decision's AIA.
+    pub fn aia(&self) -> Option<f64> {
+        self.is_scored().then_some(self.aia2 as f64 / 2.0)
+    }
 }
 
 impl Default for Rec {
@@ -133,7 +147,9 @@ impl Default for Rec {
             state: REC_ABSENT,
             action: ACT_NONE,
             questions_material: false,
+            aia2: 0,
             d_end: f32::NAN,
+            d_min: f32::NAN,
         }
     }
 }
@@ -230,6 +246,8 @@ impl ModelAgg {
         rec.action = r.action.map_or(ACT_NONE, |a| a.index() as u8);
         rec.questions_material = r.questions_material;
         rec.d_end = r.d_end.map_or(f32::NAN, |d| d as f32);
+        rec.d_min = r.d_min.map_or(f32::NAN, |d| d as f32);
+        rec.aia2 = (r.aia * 2.0).round() as u8;
         self.overall.add(r);
         self.by_family[scene.family as usize].add(r);
         self.by_band[scene.speed_band.map_or(4, |b| b as usize)].add(r);

@@ -25,6 +25,10 @@ pub struct Config {
     /// default's when a config file has none).
     #[serde(default = "ExecVideoConfig::embedded_default")]
     pub execution_video: ExecVideoConfig,
+    /// `[statistics]`: bootstrap resamples and seed of the report's intervals (the
+    /// defaults when a config file has none).
+    #[serde(default)]
+    pub statistics: crate::stats::StatsConfig,
 }
 
 /// `[execution_video]` of `configs/scoring.toml` (`--execute-videos`).
@@ -167,6 +171,9 @@ impl Config {
             bail!("config field {e}");
         }
         self.execution_video.validate()?;
+        if self.statistics.bootstrap_resamples < 100 || self.statistics.max_bootstrap_draws < 1000 {
+            bail!("config fields statistics.bootstrap_resamples must be >= 100 and statistics.max_bootstrap_draws >= 1000");
+        }
         if self.sanity.max_line_bytes < 1024 {
             bail!("config field sanity.max_line_bytes must be at least 1024");
         }

@@ -61,8 +61,13 @@ PREDICTIONS (preds.jsonl, SPEC §9)
     that is over the size caps below),
     line_too_long (> {ml} bytes; never held in memory), invalid_scene (the dataset marks
     the scene valid = false: never scored, and baselines skip it), duplicate_decision
-    (first line for a (scene, model) pair wins). Blank lines are ignored. A broken line never stops
-    the run; exit status 2 only when the file itself cannot be read.
+    (first line for a (scene, model) pair wins), json_array (a line starting with `[`),
+    outside_subset (a scene outside the expected set, see COVERAGE). Blank lines are
+    ignored. Every dropped line is counted and named by its line number (ranges) in the
+    report. A broken line never stops the run.
+  * Literal NaN, Infinity, -Infinity (Python's json.dumps writes them) are read as the
+    numbers they name, exactly like the strings "NaN", "Infinity", "-Infinity": the plan
+    then fails the sanity check below (R1, absurd_number); the line is not dropped.
 
 ACTION RULE {rule} (SPEC §10)
   Body frame: origin at the pelvis ({ph} m above the floor), x forward, y left, z up.
@@ -149,13 +154,45 @@ fn explain_outputs(cfg: &Config) -> String {
     let an = &cfg.analyses;
     let aia = &cfg.aia;
     format!(
-        r#"AGGREGATION AND MISSING VALUES
+        r#"COVERAGE
+  Every model is expected to answer the same scenes: the dataset's balanced eval subset
+  (eval/*.parquet), or every valid scene with --subset all (also the default when the
+  dataset has no eval subset). Decisions on other scenes are dropped (outside_subset).
+  Per model the report shows answered / expected and marks a model INCOMPLETE when an
+  expected scene has no scored decision (never asked, or lost to an API error). SAA,
+  safety and AIA are over the expected scenes: an unanswered scene counts as failed (SAA
+  0, unsafe, AIA 0) and is reported in its own column `unanswered`, never as R1 (R1 means
+  the model answered without a parseable plan). Distances (d_end, HDE) are over the
+  answered decisions that have one. --answered-only computes everything over the
+  answered scenes instead (the report is labelled ANSWERED-ONLY VIEW).
+  Exit status 2 when no decision could be scored at all: an empty file, a JSON array
+  instead of JSON Lines, lines without `model`, scene ids of another dataset, only
+  scenes outside the subset or only lost decisions — the message names the problem and
+  its first line.
+
+STATISTICS (every interval is 95%)
+  * Rates — SAA, safety, per-class recall, freeze rate, the analyses' per-model rows:
+    Wilson score interval on k of n (n = the rate's denominator), closed form.
+  * Means — d_end, HDE d_min, AIA (overall and per ground-truth action) — and balanced
+    accuracy: percentile bootstrap over scenes, {boot} resamples (fewer on samples so
+    large that values x resamples > {cap}), seeded from [statistics] seed = {seed} and the
+    model, row and metric names: reports are reproducible run to run. Balanced accuracy
+    resamples within each ground-truth class (stratified).
+  * Per-class recall: SAA on the expected scenes of one ground-truth class; balanced
+    accuracy: the mean recall over the classes that have scenes.
+  * --compare A B: paired comparison on the expected scenes both A and B answered. For
+    SAA and for safety: the 2x2 table (both right, only A, only B, neither), the
+    difference A - B with Newcombe's hybrid score interval for paired proportions
+    (method 10, from the two Wilson intervals and the phi correlation), and McNemar's
+    exact two-sided p-value (binomial test of only-A vs only-B at 1/2).
+
+AGGREGATION AND MISSING VALUES
   Means per model, and per model x family, x speed band, x ground-truth action, x
-  adversarial; plus all models pooled (ALL). Lost decisions are counted separately and
-  never enter a denominator. A metric's missing values (d_end, d_min, closing without an
+  adversarial; plus all models pooled (ALL). Lost decisions are counted separately (and
+  are unanswered scenes, see COVERAGE). A metric's missing values (d_end, d_min, closing without an
   impact point or without a plan) leave its denominator and are counted (`*_missing`).
   Rates are fractions in JSON/CSV and percentages in the table and Markdown.
-  Memory: aggregates are folded while streaming; cross-model analyses keep one 8-byte
+  Memory: aggregates are folded while streaming; cross-model analyses keep one 12-byte
   record per (scene, model), so memory is bounded by scenes x models.
 
 ANALYSES (the paper's)
@@ -196,9 +233,13 @@ OUTPUTS
   status scored/lost/duplicate, action, rules fired, metrics).
 
 EXIT STATUS
-  0 success; 2 bad input or usage (unreadable predictions file, missing dataset, missing
-  or mistyped dataset column — the message names the file and column); 1 internal error.
+  0 success; 2 bad input or usage (unreadable predictions file, nothing scored — see
+  COVERAGE —, missing dataset, missing or mistyped dataset column — the message names
+  the file and column); 1 internal error.
 "#,
+        boot = cfg.statistics.bootstrap_resamples,
+        cap = cfg.statistics.max_bootstrap_draws,
+        seed = cfg.statistics.seed,
         mr = an.miss_radius,
         fs = an.far_standing,
         mat = list(&aia.material_doubt),

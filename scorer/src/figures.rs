@@ -84,10 +84,12 @@ fn disposition<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) ->
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(55)
-        .build_cartesian_2d(0f64..100f64, 0f64..100f64)
+        // A margin beyond 0–100 %, so a marker in a corner is drawn whole.
+        .build_cartesian_2d(-6f64..106f64, -6f64..106f64)
         .map_err(e)?;
     chart
         .configure_mesh()
+        .max_light_lines(0)
         .x_desc("SAA on CATCH scenes (%)")
         .y_desc("SAA on DODGE scenes (%)")
         .x_label_formatter(&percent_label)
@@ -116,8 +118,11 @@ fn disposition<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) ->
         let tx = if x > 75.0 { x - 22.0 } else { x + 1.5 };
         chart
             .draw_series(std::iter::once(Text::new(
-                m.model.clone(),
-                (tx, (y + 2.5).min(98.0)),
+                format!(
+                    "{} (n={}/{})",
+                    m.model, m.by_gt_action[0].expected, m.by_gt_action[1].expected
+                ),
+                (tx, (y + 2.5).min(104.0)),
                 (FONT, 13).into_font().color(&c),
             )))
             .map_err(e)?;
@@ -147,6 +152,7 @@ fn freeze_by_band<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report)
         .map_err(e)?;
     chart
         .configure_mesh()
+        .max_light_lines(0)
         .x_labels(4)
         .x_label_formatter(&|x| {
             let i = x.round();
@@ -209,21 +215,43 @@ fn per_family<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> 
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(140)
-        .build_cartesian_2d(0f64..100f64, -0.5f64..(n as f64 - 0.5))
+        // Room right of 100 % for the bars' labels.
+        .build_cartesian_2d(0f64..122f64, -0.5f64..(n as f64 - 0.5))
         .map_err(e)?;
     let names = fams.clone();
     chart
         .configure_mesh()
+        .max_light_lines(0)
         .y_labels(n + 1)
         .y_label_formatter(&|y| category_label(&names, *y))
         .disable_y_mesh()
-        .x_desc("SAA (%)")
+        .x_desc("SAA (%) — each bar labelled with its value and n (expected scenes)")
         .x_label_formatter(&percent_label)
         .label_style((FONT, 12))
         .axis_desc_style((FONT, 14))
         .draw()
         .map_err(e)?;
     let h = 0.8 / k as f64;
+    // Every bar is labelled "57% n=12", so a 0 % bar reads as zero, not as missing.
+    let font = ((h * 0.9 * 380.0 / n as f64) as u32).clamp(8, 12);
+    for (mi, m) in r.models.iter().enumerate() {
+        let labels: Vec<_> = m
+            .by_family
+            .iter()
+            .enumerate()
+            .filter(|(_, row)| row.expected > 0)
+            .map(|(fi, row)| {
+                let y0 = (n - 1 - fi) as f64 + 0.4 - (mi + 1) as f64 * h;
+                let v = row.saa.map_or(0.0, |v| 100.0 * v);
+                Text::new(
+                    format!("{v:.0}% n={}", row.expected),
+                    (v + 0.8, y0 + h * 0.9),
+                    (FONT, font).into_font().color(&color(mi)),
+                )
+            })
+            .collect();
+        chart.draw_series(labels).map_err(e)?;
+    }
     for (mi, m) in r.models.iter().enumerate() {
         let c = color(mi);
         let bars: Vec<_> = m
@@ -270,6 +298,7 @@ fn percent_rows_chart<'a, DB: DrawingBackend>(
         .map_err(e)?;
     chart
         .configure_mesh()
+        .max_light_lines(0)
         .y_labels(n + 1)
         .y_label_formatter(&|y| category_label(names, *y))
         .disable_y_mesh()
@@ -286,7 +315,10 @@ fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -
     root.fill(&WHITE).map_err(e)?;
     let rows: Vec<_> = r.analyses.safety.iter().collect();
     let n = rows.len().max(1);
-    let names: Vec<String> = rows.iter().map(|s| s.model.clone()).collect();
+    let names: Vec<String> = rows
+        .iter()
+        .map(|s| format!("{} n={}", s.model, s.decisions))
+        .collect();
     let legend_items: Vec<(String, RGBColor)> = Rule::ALL
         .iter()
         .map(|r| {
@@ -370,9 +402,10 @@ fn outcome_rows(x: &crate::execution::ExecutionReport) -> Vec<(String, [u64; 5])
     let seg = |c: &Counts| [c.caught, c.struck, c.missed, c.clear, c.not_executed];
     let mut rows = Vec::new();
     for m in &x.models {
-        rows.push((format!("{} (all)", m.model), seg(&m.all)));
+        let n = |c: &Counts| seg(c).iter().sum::<u64>();
+        rows.push((format!("{} (all) n={}", m.model, n(&m.all)), seg(&m.all)));
         for (gt, c) in &m.by_gt_action {
-            rows.push((format!("{}  gt {gt}", m.model), seg(c)));
+            rows.push((format!("{}  gt {gt} n={}", m.model, n(c)), seg(c)));
         }
     }
     rows
@@ -431,7 +464,11 @@ const LEGEND_BELOW: i32 = 60;
 /// Tick label of a percentage axis: whole numbers ("10", not "10.0", which the bitmap
 /// font spaced as "10. 0").
 fn percent_label(v: &f64) -> String {
-    format!("{v:.0}")
+    if (-1e-9..=100.0 + 1e-9).contains(v) {
+        format!("{v:.0}")
+    } else {
+        String::new()
+    }
 }
 
 macro_rules! both {
@@ -480,5 +517,60 @@ fn category_label<S: AsRef<str>>(names: &[S], y: f64) -> String {
         names[names.len() - 1 - i as usize].as_ref().to_string()
     } else {
         String::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::baseline::{baseline_plan, majority_action, BaselineKind};
+    use crate::config::Config;
+    use crate::fixture::{dataset_of, synth_rows};
+
+    #[test]
+    fn bars_carry_value_and_n_and_meshes_have_no_fine_grid() {
+        let ds = dataset_of(&synth_rows(80, 2));
+        let cfg = Config::default();
+        let maj = majority_action(&ds);
+        let mut text = String::new();
+        for s in ds.scenes.iter().filter(|s| s.valid) {
+            let plan = baseline_plan(BaselineKind::Oracle, s, maj, 0, &cfg);
+            text += &serde_json::json!({"scene_id": s.scene_id, "model": "oracle", "plan": plan})
+                .to_string();
+            // A model that never answers with a plan: SAA 0 % in every family.
+            text += &format!(
+                "\n{{\"scene_id\":\"{}\",\"model\":\"mute\",\"response\":\"no\"}}\n",
+                s.scene_id
+            );
+        }
+        let mut sc = crate::score::Scoring::new(&ds, &cfg);
+        sc.score_reader(std::io::Cursor::new(text.into_bytes()))
+            .unwrap();
+        let r = Report::build(&sc, "mem");
+        let dir = tempfile::tempdir().unwrap();
+        write_figures(&r, dir.path()).unwrap();
+        let svg = |name: &str| std::fs::read_to_string(dir.path().join(name)).unwrap();
+        let fam = svg("per_family.svg");
+        // One label per (model, family) bar; the mute model's 0 % bars say so.
+        let labels = fam.matches(" n=").count();
+        assert_eq!(labels, 2 * ds.families.len(), "{labels}");
+        assert!(fam.contains("0% n="), "a 0 % bar is labelled: {fam}");
+        assert!(svg("safety_rules.svg").contains("mute n="));
+        // Only the major mesh lines (plotters draws its fine "light" mesh, the 1 % graph
+        // paper, in black at opacity 0.1; the major lines at 0.2).
+        for f in [
+            "disposition",
+            "freeze_by_band",
+            "per_family",
+            "safety_rules",
+        ] {
+            let text = svg(&format!("{f}.svg"));
+            assert!(
+                text.contains("opacity=\"0.2\""),
+                "{f}: major mesh lines drawn"
+            );
+            assert!(!text.contains("opacity=\"0.1\""), "{f}: no fine mesh");
+        }
+        assert!(svg("disposition.svg").contains("oracle (n="));
     }
 }

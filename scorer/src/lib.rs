@@ -16,11 +16,13 @@
 //! * Absurd numbers (NaN/inf, |speed| > 10 m/s, |yaw rate| > 20 rad/s, durations or
 //!   keyframe times outside [0, 30] s, |hand coordinate| > 10 m) make the plan
 //!   unparseable (R1), counted as `absurd_number`; nothing is clamped.
+//! * Coverage: metrics over the expected scenes (eval subset, or all), an unanswered scene
+//!   counting as failed ([`coverage`]); 95% intervals ([`stats`]); `--compare` ([`compare`]).
 //! * Duplicate (scene, model) lines: the first wins; an `error` line followed by a scored
 //!   line for the same pair is a retry and is replaced.
 //! * Scenes with `valid = false` are not scored (`invalid_scene` warnings); baselines skip
 //!   them.
-//! * Memory is bounded by scenes × models (one 8-byte record per pair for the cross-model
+//! * Memory is bounded by scenes × models (one 12-byte record per pair for the cross-model
 //!   analyses), never by the size of the predictions file.
 //! * Figures: plotters with the SVG and bitmap backends; text is drawn with `ab_glyph`
 //!   from the Hack font embedded via the `epaint_default_fonts` crate, so PNGs need no
@@ -31,13 +33,16 @@
 pub mod aggregate;
 pub mod aia;
 pub mod baseline;
+pub mod compare;
 pub mod config;
+pub mod coverage;
 pub mod dataset;
 pub mod execution;
 pub mod explain;
 pub mod figures;
 pub mod fixture;
 pub mod html;
+pub mod intervals;
 pub mod layout;
 pub mod metrics;
 pub mod oracle;
@@ -46,9 +51,11 @@ pub mod plan_json;
 #[cfg(feature = "predict")]
 pub mod predict;
 pub mod preds;
+pub mod progress;
 pub mod report;
 pub mod rule;
 pub mod score;
+pub mod stats;
 pub mod tables;
 pub mod types;
 

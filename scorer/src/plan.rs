@@ -281,8 +281,54 @@ pub fn plan_from_json_str(text: &str, cfg: &Config) -> Option<Result<Plan, PlanE
     if let Some(parts) = fast::parts(text) {
         return Some(finish(parts, cfg));
     }
-    let v: Value = serde_json::from_str(text).ok()?;
+    let v: Value = match serde_json::from_str(text) {
+        Ok(v) => v,
+        // Literal NaN / Infinity (Python's json.dumps writes them) are numbers to us: they
+        // are read as their string forms and then fail the sanity check like them.
+        Err(_) => serde_json::from_str(&quote_nonfinite(text)?).ok()?,
+    };
     Some(plan_from_value(&v, cfg))
+}
+
+/// `text` with every bare `NaN`, `Infinity`, `-Infinity` (`+Infinity`) value outside
+/// strings written as a JSON string (`"NaN"`, …), which the plan reader parses as the
+/// number; `None` when there is none.
+pub fn quote_nonfinite(text: &str) -> Option<String> {
+    const TOKENS: [&str; 4] = ["-Infinity", "+Infinity", "Infinity", "NaN"];
+    let bytes = text.as_bytes();
+    let mut out = String::with_capacity(text.len() + 8);
+    let mut strings = JsonStrings::default();
+    let (mut last, mut prev, mut i, mut any) = (0usize, b'[', 0usize, false);
+    while i < bytes.len() {
+        let b = bytes[i];
+        if strings.structural(b) && matches!(prev, b'[' | b',' | b':') {
+            let hit = TOKENS.iter().find(|t| {
+                bytes[i..].starts_with(t.as_bytes())
+                    && bytes
+                        .get(i + t.len())
+                        .is_none_or(|c| matches!(c, b',' | b']' | b'}') || c.is_ascii_whitespace())
+            });
+            if let Some(t) = hit {
+                out.push_str(&text[last..i]);
+                out.push('"');
+                out.push_str(t);
+                out.push('"');
+                i += t.len();
+                last = i;
+                prev = b'0';
+                any = true;
+                continue;
+            }
+        }
+        if !b.is_ascii_whitespace() {
+            prev = b;
+        }
+        i += 1;
+    }
+    any.then(|| {
+        out.push_str(&text[last..]);
+        out
+    })
 }
 
 /// Applies defaults and the sanity policy.
@@ -775,6 +821,38 @@ mod tests {
             plan_from_text("{\"walking_cmd\": [1, 0", &cfg()),
             Err(PlanError::NoJson)
         ));
+    }
+
+    #[test]
+    fn literal_nonfinite_numbers_are_absurd_like_their_strings() {
+        for (lit, quoted) in [
+            (
+                r#"{"walking_cmd": [NaN, 0, 0]}"#,
+                r#"{"walking_cmd": ["NaN", 0, 0]}"#,
+            ),
+            (
+                r#"{"walking_cmd": [0,0,0], "keyframes": [[Infinity, 0, 0]]}"#,
+                r#"{"walking_cmd": [0,0,0], "keyframes": [["Infinity", 0, 0]]}"#,
+            ),
+            (
+                r#"{"walking_cmd": [0, -Infinity, 0], "intent": "NaN, Infinity"}"#,
+                r#"{"walking_cmd": [0, "-Infinity", 0], "intent": "NaN, Infinity"}"#,
+            ),
+        ] {
+            assert_eq!(quote_nonfinite(lit).as_deref(), Some(quoted));
+            for text in [lit, quoted] {
+                let r = plan_from_json_str(text, &cfg());
+                assert!(
+                    matches!(r, Some(Err(PlanError::Absurd(_)))),
+                    "{text}: {r:?}"
+                );
+                let r = plan_from_text(&format!("Plan: {text}"), &cfg());
+                assert!(matches!(r, Err(PlanError::Absurd(_))), "{text}: {r:?}");
+            }
+        }
+        // Inside strings and inside words nothing changes.
+        assert_eq!(quote_nonfinite(r#"{"intent": "NaN"}"#), None);
+        assert_eq!(quote_nonfinite(r#"{"a": NaNa}"#), None);
     }
 
     #[test]

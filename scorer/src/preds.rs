@@ -202,6 +202,10 @@ pub fn process_line(raw: &RawLine, ds: &Dataset, cfg: &Config, aia: &AiaMatcher)
     if text.is_empty() {
         return LineOutcome::Blank;
     }
+    if text.starts_with('[') {
+        // A JSON array (or its first line) where JSON Lines are expected.
+        return skip("json_array");
+    }
     // Fast path: typed parse of the line's top level.
     if let Ok(line) = serde_json::from_str::<FastLine>(text) {
         let scene_id = match raw_present(line.scene_id).map(serde_json::from_str::<Value>) {
@@ -231,7 +235,11 @@ pub fn process_line(raw: &RawLine, ds: &Dataset, cfg: &Config, aia: &AiaMatcher)
     }
     let v: Value = match serde_json::from_str(text) {
         Ok(v) => v,
-        Err(_) => return skip("malformed_json"),
+        // Literal NaN / Infinity are read as their string forms (then R1 absurd_number).
+        Err(_) => match crate::plan::quote_nonfinite(text).map(|t| serde_json::from_str(&t)) {
+            Some(Ok(v)) => v,
+            _ => return skip("malformed_json"),
+        },
     };
     let Value::Object(obj) = v else {
         return skip("not_an_object");

@@ -47,45 +47,85 @@ pub struct ActionCounts {
     pub unparseable: u64,
 }
 
-/// Metrics over one group of scored decisions. Rates are fractions in [0, 1]; a metric is
-/// `null` when its denominator is 0. Missing distance values (no impact point, or no
-/// plan) leave the denominator and are counted in `*_missing`.
+/// A 95% interval `[low, high]` (`null` when its estimate is).
+pub type Interval = Option<[f64; 2]>;
+
+/// Metrics over one group of scenes. Rates are fractions in [0, 1]; a metric is `null`
+/// when its denominator is 0. SAA, safety and AIA are over the group's expected scenes,
+/// an unanswered one counting as failed (over the answered ones with `--answered-only`);
+/// the freeze rate is over the answered decisions. Missing distance values (no impact
+/// point, or no plan) leave the denominator and are counted in `*_missing`. `*_ci`: 95%
+/// intervals (Wilson for rates; seeded bootstrap over scenes for means, on the overall
+/// and per-GT-action rows).
 #[derive(Debug, Clone, Serialize)]
 pub struct MetricsRow {
     pub group: String,
+    /// Answered (scored) decisions.
     pub decisions: u64,
+    /// Expected scenes of the group (answered + unanswered).
+    pub expected: u64,
+    /// Expected scenes without a scored decision (failed; not R1).
+    pub unanswered: u64,
     pub saa: Option<f64>,
+    pub saa_ci: Interval,
     pub safety: Option<f64>,
+    pub safety_ci: Interval,
     pub d_end: Option<f64>,
+    pub d_end_ci: Interval,
     pub d_end_n: u64,
     pub d_end_missing: u64,
     pub aia: Option<f64>,
+    pub aia_ci: Interval,
     pub d_min: Option<f64>,
+    pub d_min_ci: Interval,
     pub closing: Option<f64>,
     pub hde_n: u64,
     pub hde_missing: u64,
     pub freeze_rate: Option<f64>,
+    pub freeze_rate_ci: Interval,
     pub first_rule: RuleCounts,
     pub rules_fired: RuleCounts,
     pub predicted: ActionCounts,
 }
 
 impl MetricsRow {
+    /// Metrics over the answered decisions only.
     pub fn from_acc(group: impl Into<String>, a: &Acc) -> Self {
+        Self::with_unanswered(group, a, 0, false)
+    }
+
+    /// Metrics over the expected scenes: `unanswered` of them count as failed, unless
+    /// `answered_only`.
+    pub fn with_unanswered(
+        group: impl Into<String>,
+        a: &Acc,
+        unanswered: u64,
+        answered_only: bool,
+    ) -> Self {
+        let den = if answered_only { a.n } else { a.n + unanswered };
+        let rate = |k: u64| (den > 0).then(|| k as f64 / den as f64);
         MetricsRow {
             group: group.into(),
             decisions: a.n,
-            saa: a.rate(a.saa),
-            safety: a.rate(a.safe),
+            expected: a.n + unanswered,
+            unanswered,
+            saa: rate(a.saa),
+            saa_ci: crate::stats::wilson(a.saa, den),
+            safety: rate(a.safe),
+            safety_ci: crate::stats::wilson(a.safe, den),
             d_end: a.d_end.value(),
+            d_end_ci: None,
             d_end_n: a.d_end.n,
             d_end_missing: a.d_end.missing,
-            aia: a.aia.value(),
+            aia: rate(0).map(|_| a.aia.sum / den as f64),
+            aia_ci: None,
             d_min: a.d_min.value(),
+            d_min_ci: None,
             closing: a.closing.value(),
             hde_n: a.d_min.n,
             hde_missing: a.d_min.missing,
             freeze_rate: a.rate(a.predicted[2]),
+            freeze_rate_ci: crate::stats::wilson(a.predicted[2], a.n),
             first_rule: RuleCounts::new(a.first),
             rules_fired: RuleCounts::new(a.fired),
             predicted: ActionCounts {
@@ -98,9 +138,26 @@ impl MetricsRow {
     }
 }
 
+/// Recall of one ground-truth class: its SAA over its expected scenes.
+#[derive(Debug, Clone, Serialize)]
+pub struct ClassRecall {
+    pub class: String,
+    pub scenes: u64,
+    pub correct: u64,
+    pub recall: Option<f64>,
+    pub recall_ci: Interval,
+}
+
 #[derive(Debug, Clone, Serialize)]
 pub struct ModelReport {
     pub model: String,
+    /// Scenes answered out of those expected.
+    pub coverage: crate::coverage::ModelCoverage,
+    /// Per-class recall (CATCH, DODGE, NO_ACTION).
+    pub recall: Vec<ClassRecall>,
+    /// Mean recall over the classes with scenes (stratified bootstrap interval).
+    pub balanced_accuracy: Option<f64>,
+    pub balanced_accuracy_ci: Interval,
     /// The prompt version(s) of the model's lines (rh-score predict records it; `-` for
     /// lines without one). More than one means the rows mix prompts.
     pub prompt_version: String,
@@ -133,6 +190,11 @@ pub struct DatasetSummary {
 pub struct WarningSummary {
     pub kind: String,
     pub count: u64,
+    /// The kind's lines are not scored.
+    pub dropped: bool,
+    /// Every dropped line ("3-5, 9"), for dropped kinds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lines: Option<String>,
     pub first_lines: Vec<u64>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub examples: Vec<String>,
@@ -146,6 +208,9 @@ pub struct InputSummary {
     pub decisions_scored: u64,
     pub decisions_lost: u64,
     pub duplicates: u64,
+    /// Lines not scored (malformed, unknown scene, duplicate, outside the subset, …),
+    /// each named in `warnings`.
+    pub dropped_lines: u64,
     pub warnings: Vec<WarningSummary>,
 }
 
@@ -252,10 +317,15 @@ pub struct Report {
     pub action_rule: ActionRuleSummary,
     pub dataset: DatasetSummary,
     pub input: InputSummary,
+    /// The expected scenes and which models left some unanswered.
+    pub coverage: crate::coverage::CoverageSummary,
     pub models: Vec<ModelReport>,
     /// All models pooled (`model` = "ALL").
     pub pooled: ModelReport,
     pub analyses: Analyses,
+    /// `--compare A B`: paired comparisons on the scenes both answered.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub comparisons: Vec<crate::compare::Comparison>,
     /// `--execute`: outcomes in physics (SPEC §12).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub execution: Option<crate::execution::ExecutionReport>,
@@ -280,9 +350,66 @@ fn median(v: &mut [f64]) -> Option<f64> {
 
 const BAND_GROUPS: [&str; 5] = ["slow", "normal", "fast", "very_fast", "other"];
 
-fn model_report(m: &ModelAgg, ds: &Dataset) -> ModelReport {
+/// How one model's rows are computed.
+struct RowCtx<'a> {
+    ds: &'a Dataset,
+    expected: &'a [bool],
+    answered_only: bool,
+    stats: &'a crate::stats::StatsConfig,
+}
+
+fn model_report(
+    m: &ModelAgg,
+    recs: &[&[Rec]],
+    un: &crate::coverage::Unanswered,
+    cx: &RowCtx,
+) -> ModelReport {
+    let ds = cx.ds;
+    let ao = cx.answered_only;
+    let row = |g: &str, a: &Acc, u: u64| MetricsRow::with_unanswered(g, a, u, ao);
+    let mut overall = row("all", &m.overall, un.overall);
+    let mut by_gt: Vec<MetricsRow> = Action::ALL
+        .iter()
+        .zip(&m.by_gt)
+        .zip(un.by_gt)
+        .map(|((g, a), u)| row(g.as_str(), a, u))
+        .collect();
+    let fill = |r: &mut MetricsRow, gt: Option<Action>| {
+        crate::intervals::fill_means(r, &m.name, recs, ds, cx.expected, gt, ao, cx.stats)
+    };
+    fill(&mut overall, None);
+    for (r, a) in by_gt.iter_mut().zip(Action::ALL) {
+        fill(r, Some(a));
+    }
+    let classes: Vec<(u64, u64)> = by_gt
+        .iter()
+        .zip(&m.by_gt)
+        .map(|(r, a)| (a.saa, if ao { r.decisions } else { r.expected }))
+        .collect();
+    let recall = by_gt
+        .iter()
+        .zip(&classes)
+        .map(|(r, &(k, n))| ClassRecall {
+            class: r.group.clone(),
+            scenes: n,
+            correct: k,
+            recall: r.saa,
+            recall_ci: r.saa_ci,
+        })
+        .collect();
+    let seed = crate::stats::seed_for(cx.stats.seed, &[&m.name, "balanced_accuracy"]);
     ModelReport {
         model: m.name.clone(),
+        coverage: crate::coverage::ModelCoverage {
+            answered: m.overall.n,
+            expected: m.overall.n + un.overall,
+            unanswered: un.overall,
+            lost: m.lost,
+            complete: un.overall == 0,
+        },
+        recall,
+        balanced_accuracy: crate::stats::balanced_accuracy(&classes),
+        balanced_accuracy_ci: crate::stats::bootstrap_balanced(&classes, cx.stats, seed),
         prompt_version: if m.prompt_versions.is_empty() {
             "-".to_string()
         } else {
@@ -294,28 +421,27 @@ fn model_report(m: &ModelAgg, ds: &Dataset) -> ModelReport {
         },
         lost: m.lost,
         duplicates: m.duplicates,
-        overall: MetricsRow::from_acc("all", &m.overall),
+        overall,
         by_family: ds
             .families
             .iter()
+            .enumerate()
             .zip(&m.by_family)
-            .map(|(f, a)| MetricsRow::from_acc(f.clone(), a))
+            .map(|((i, f), a)| row(f, a, un.by_family.get(i).copied().unwrap_or(0)))
             .collect(),
         by_speed_band: BAND_GROUPS
             .iter()
             .zip(&m.by_band)
-            .filter(|(g, a)| **g != "other" || a.n > 0)
-            .map(|(g, a)| MetricsRow::from_acc(*g, a))
+            .zip(un.by_band)
+            .filter(|((g, a), u)| **g != "other" || a.n + u > 0)
+            .map(|((g, a), u)| row(g, a, u))
             .collect(),
-        by_gt_action: Action::ALL
-            .iter()
-            .zip(&m.by_gt)
-            .map(|(g, a)| MetricsRow::from_acc(g.as_str(), a))
-            .collect(),
+        by_gt_action: by_gt,
         by_adversarial: ["not_adversarial", "adversarial"]
             .iter()
             .zip(&m.by_adv)
-            .map(|(g, a)| MetricsRow::from_acc(*g, a))
+            .zip(un.by_adv)
+            .map(|((g, a), u)| row(g, a, u))
             .collect(),
     }
 }
@@ -561,8 +687,13 @@ fn lookalikes(models: &[&ModelAgg], ds: &Dataset) -> Vec<LookalikeComparison> {
 }
 
 impl Report {
-    /// Builds the report at the end of a scoring run.
+    /// Builds the report at the end of a scoring run (metrics over the expected scenes).
     pub fn build(scoring: &Scoring, preds_file: &str) -> Report {
+        Self::build_with(scoring, preds_file, false)
+    }
+
+    /// Builds the report; `answered_only`: metrics over the answered scenes only.
+    pub fn build_with(scoring: &Scoring, preds_file: &str, answered_only: bool) -> Report {
         let ds = scoring.ds;
         let cfg: &Config = scoring.cfg;
         let mut models: Vec<&ModelAgg> = scoring.models.iter().collect();
@@ -571,6 +702,21 @@ impl Report {
         let pooled = pooled_agg(&owned, ds);
         let all_recs: Vec<&[Rec]> = owned.iter().map(|m| m.records.as_slice()).collect();
         let groups = speed_groups(ds);
+        let expected = &scoring.expected.mask;
+        let unanswered: Vec<crate::coverage::Unanswered> = owned
+            .iter()
+            .map(|m| crate::coverage::Unanswered::of(&m.records, ds, expected))
+            .collect();
+        let mut pooled_un = crate::coverage::Unanswered::default();
+        for u in &unanswered {
+            pooled_un.merge(u);
+        }
+        let cx = RowCtx {
+            ds,
+            expected,
+            answered_only,
+            stats: &cfg.statistics,
+        };
 
         let mut gt_actions = BTreeMap::new();
         for a in Action::ALL {
@@ -651,20 +797,40 @@ impl Report {
                 decisions_scored: scoring.scored,
                 decisions_lost: scoring.lost,
                 duplicates: scoring.duplicates,
+                dropped_lines: scoring.dropped,
                 warnings: scoring
                     .warnings
                     .iter()
                     .map(|(k, w): (&&str, &WarningAcc)| WarningSummary {
                         kind: k.to_string(),
                         count: w.count,
+                        dropped: w.dropped,
+                        lines: w.dropped.then(|| w.lines_text()),
                         first_lines: w.first_lines.clone(),
                         examples: w.examples.clone(),
                     })
                     .collect(),
             },
-            models: owned.iter().map(|m| model_report(m, ds)).collect(),
-            pooled: model_report(&pooled, ds),
+            coverage: crate::coverage::CoverageSummary {
+                subset: scoring.expected.subset.to_string(),
+                expected_scenes: scoring.expected.count(),
+                note: scoring.expected.note.clone(),
+                answered_only,
+                incomplete_models: owned
+                    .iter()
+                    .zip(&unanswered)
+                    .filter(|(_, u)| u.overall > 0)
+                    .map(|(m, _)| m.name.clone())
+                    .collect(),
+            },
+            models: owned
+                .iter()
+                .zip(&unanswered)
+                .map(|(m, u)| model_report(m, &[m.records.as_slice()], u, &cx))
+                .collect(),
+            pooled: model_report(&pooled, &all_recs, &pooled_un, &cx),
             analyses,
+            comparisons: Vec::new(),
             execution: None,
         }
     }

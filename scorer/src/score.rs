@@ -22,6 +22,9 @@ const BATCH_BYTES: usize = 64 << 20;
 /// Line numbers and examples kept per warning kind.
 const KEEP_FIRST: usize = 5;
 
+/// Line-number ranges kept per dropped-line kind (beyond them, lines are only counted).
+const KEEP_RANGES: usize = 1000;
+
 /// Counted warnings of one kind.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct WarningAcc {
@@ -29,6 +32,34 @@ pub struct WarningAcc {
     pub first_lines: Vec<u64>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub examples: Vec<String>,
+    /// The kind drops its lines (not scored).
+    #[serde(skip)]
+    pub dropped: bool,
+    /// Every dropped line, as inclusive ranges in file order (at most [`KEEP_RANGES`]).
+    #[serde(skip)]
+    pub ranges: Vec<(u64, u64)>,
+}
+
+impl WarningAcc {
+    /// The dropped lines as text, "3-5, 9" ("…" when more were dropped than kept).
+    pub fn lines_text(&self) -> String {
+        let mut parts: Vec<String> = self
+            .ranges
+            .iter()
+            .map(|&(a, b)| {
+                if a == b {
+                    a.to_string()
+                } else {
+                    format!("{a}-{b}")
+                }
+            })
+            .collect();
+        let kept: u64 = self.ranges.iter().map(|(a, b)| b - a + 1).sum();
+        if kept < self.count {
+            parts.push(format!("… ({} more)", self.count - kept));
+        }
+        parts.join(", ")
+    }
 }
 
 /// The state of a scoring run.
@@ -44,6 +75,12 @@ pub struct Scoring<'a> {
     pub scored: u64,
     pub lost: u64,
     pub duplicates: u64,
+    /// Lines not scored (skipped kinds, duplicates, scenes outside the expected set).
+    pub dropped: u64,
+    /// The number of the first line that is not blank.
+    pub first_content_line: Option<u64>,
+    /// The scenes every model is expected to answer.
+    pub expected: crate::coverage::Expected,
     decisions_out: Option<Box<dyn Write + 'a>>,
     /// With `--execute`: the decisions to execute, and the decision lines held back until
     /// their outcomes are known.
@@ -74,9 +111,18 @@ impl<'a> Scoring<'a> {
             scored: 0,
             lost: 0,
             duplicates: 0,
+            dropped: 0,
+            first_content_line: None,
+            expected: crate::coverage::Expected::all_valid(ds),
             decisions_out: None,
             exec: None,
         }
+    }
+
+    /// Scores only decisions on these scenes (others are dropped as `outside_subset`).
+    pub fn with_expected(mut self, expected: crate::coverage::Expected) -> Self {
+        self.expected = expected;
+        self
     }
 
     /// Also collect every scored decision's plan for `--execute` (decision lines are then
@@ -112,6 +158,19 @@ impl<'a> Scoring<'a> {
             if let Some(e) = example {
                 w.examples.push(e);
             }
+        }
+    }
+
+    /// A line that is not scored: counted, and named by its number.
+    fn drop_line(&mut self, kind: &'static str, line: u64, example: Option<String>) {
+        self.dropped += 1;
+        self.warn(kind, line, example);
+        let w = self.warnings.get_mut(kind).expect("just counted");
+        w.dropped = true;
+        if w.ranges.last().is_some_and(|r| r.1 + 1 == line) {
+            w.ranges.last_mut().expect("checked").1 = line;
+        } else if w.ranges.len() < KEEP_RANGES {
+            w.ranges.push((line, line));
         }
     }
 
@@ -184,11 +243,14 @@ impl<'a> Scoring<'a> {
 
     fn fold(&mut self, line: u64, too_long: Option<u64>, o: LineOutcome) -> Result<()> {
         self.lines += 1;
+        if !matches!(o, LineOutcome::Blank) && self.first_content_line.is_none() {
+            self.first_content_line = Some(line);
+        }
         match o {
             LineOutcome::Blank => self.blank_lines += 1,
             LineOutcome::Skip { kind, detail } => {
                 let example = detail.or(too_long.map(|l| format!("{l} bytes")));
-                self.warn(kind, line, example);
+                self.drop_line(kind, line, example);
             }
             LineOutcome::Decision {
                 scene,
@@ -198,6 +260,11 @@ impl<'a> Scoring<'a> {
                 prompt_version,
                 plan,
             } => {
+                if !self.expected.mask[scene as usize] {
+                    let id = self.ds.scenes[scene as usize].scene_id.clone();
+                    self.drop_line("outside_subset", line, Some(id));
+                    return Ok(());
+                }
                 for n in notes {
                     self.warn(n, line, None);
                 }
@@ -221,7 +288,7 @@ impl<'a> Scoring<'a> {
                 }
                 if !counted {
                     self.duplicates += 1;
-                    self.warn(
+                    self.drop_line(
                         "duplicate_decision",
                         line,
                         Some(format!("{} / {model}", sc.scene_id)),

@@ -13,6 +13,28 @@ fn num(v: Option<f64>, digits: usize) -> String {
     v.map_or("—".into(), |x| format!("{x:.digits$}"))
 }
 
+/// A 95% interval of a rate, in %: "54.1–77.3".
+fn pct_ci(v: Option<[f64; 2]>) -> String {
+    v.map_or("—".into(), |[a, b]| {
+        format!("{:.1}–{:.1}", 100.0 * a, 100.0 * b)
+    })
+}
+
+/// A 95% interval of a mean: "0.12–0.30".
+fn num_ci(v: Option<[f64; 2]>, digits: usize) -> String {
+    v.map_or("—".into(), |[a, b]| format!("{a:.digits$}–{b:.digits$}"))
+}
+
+/// "answered/expected", marked when incomplete.
+fn coverage_cell(m: &ModelReport) -> String {
+    let c = &m.coverage;
+    if c.complete {
+        format!("{}/{}", c.answered, c.expected)
+    } else {
+        format!("{}/{} INCOMPLETE", c.answered, c.expected)
+    }
+}
+
 /// A simple table rendered either aligned (terminal) or as Markdown.
 struct Table {
     head: Vec<String>,
@@ -101,18 +123,55 @@ fn catch_row(rows: &[MetricsRow]) -> Option<&MetricsRow> {
 }
 
 const MAIN_NOTE: &str = "d_end and HDE (hand-distance error: d_min and d1-d_min over the keyframes) are over CATCH scenes, \
-where meeting the object is the right action; n = CATCH decisions with a distance. They are per GT action below.";
+where meeting the object is the right action; n = CATCH decisions with a distance. They are per GT action below. \
+Answered = scenes with a scored decision out of those expected; Unanswered = expected scenes without one (lost or never \
+asked), counted as failed, never as R1. CI = 95% interval (Wilson for rates, seeded bootstrap over scenes for means and \
+balanced accuracy). Bal. acc = mean recall over CATCH, DODGE, NO_ACTION.";
+
+/// The coverage lines of the header: the expected set, the view, incomplete models.
+fn coverage_text(r: &Report) -> String {
+    let c = &r.coverage;
+    let mut s = format!(
+        "coverage: {} expected scenes per model — {}; {}\n",
+        c.expected_scenes,
+        c.note,
+        if c.answered_only {
+            "ANSWERED-ONLY VIEW: metrics over each model's answered scenes, unanswered ones left out (--answered-only)"
+        } else {
+            "metrics over the expected scenes, an unanswered scene counting as failed"
+        }
+    );
+    for m in r.models.iter().filter(|m| !m.coverage.complete) {
+        let _ = writeln!(
+            s,
+            "INCOMPLETE: {} answered {} of {} expected scenes ({} unanswered, {} of them lost to API errors)",
+            m.model,
+            m.coverage.answered,
+            m.coverage.expected,
+            m.coverage.unanswered,
+            m.coverage.lost
+        );
+    }
+    s
+}
 
 fn main_table(r: &Report) -> Table {
     let mut t = Table::new(&[
         "Model",
         "Prompt",
-        "Decisions",
+        "Answered",
         "Lost",
+        "Unanswered",
         "SAA %",
+        "SAA CI",
+        "Bal. acc %",
+        "Bal. acc CI",
         "Safety %",
+        "Safety CI",
         "AIA",
+        "AIA CI",
         "d_end CATCH (m)",
+        "d_end CI",
         "HDE d_min CATCH (m)",
         "HDE d1-d_min CATCH (m)",
         "n CATCH",
@@ -127,12 +186,19 @@ fn main_table(r: &Report) -> Table {
         t.row(vec![
             name.to_string(),
             prompt.to_string(),
-            o.decisions.to_string(),
+            coverage_cell(m),
             lost.to_string(),
+            o.unanswered.to_string(),
             pct(o.saa),
+            pct_ci(o.saa_ci),
+            pct(m.balanced_accuracy),
+            pct_ci(m.balanced_accuracy_ci),
             pct(o.safety),
+            pct_ci(o.safety_ci),
             num(o.aia, 2),
+            num_ci(o.aia_ci, 2),
             num(c.and_then(|c| c.d_end), 2),
+            num_ci(c.and_then(|c| c.d_end_ci), 2),
             num(c.and_then(|c| c.d_min), 2),
             num(c.and_then(|c| c.closing), 2),
             c.map_or(0, |c| c.d_end_n).to_string(),
@@ -263,9 +329,82 @@ type TitledTable = (String, Table, Option<String>);
 
 fn analyses_tables(r: &Report) -> Vec<TitledTable> {
     let mut out = Vec::new();
+    recall_and_comparison_tables(r, &mut out);
     safety_and_reach_tables(r, &mut out);
     speed_vote_and_adversarial_tables(r, &mut out);
     out
+}
+
+/// Per-class recall with balanced accuracy, and the `--compare` pairs.
+fn recall_and_comparison_tables(r: &Report, out: &mut Vec<TitledTable>) {
+    let mut t = Table::new(&[
+        "Model",
+        "Recall CATCH %",
+        "CI",
+        "Recall DODGE %",
+        "CI",
+        "Recall NO_ACTION %",
+        "CI",
+        "Balanced accuracy %",
+        "CI",
+        "SAA %",
+    ]);
+    for m in r
+        .models
+        .iter()
+        .chain((r.models.len() > 1).then_some(&r.pooled))
+    {
+        let mut row = vec![m.model.clone()];
+        for c in &m.recall {
+            row.push(format!("{} (n={})", pct(c.recall), c.scenes));
+            row.push(pct_ci(c.recall_ci));
+        }
+        row.push(pct(m.balanced_accuracy));
+        row.push(pct_ci(m.balanced_accuracy_ci));
+        row.push(pct(m.overall.saa));
+        t.row(row);
+    }
+    out.push((
+        "Per-class recall and balanced accuracy".into(),
+        t,
+        Some("Recall = SAA on the scenes of one ground-truth class (n = its expected scenes; Wilson 95% CI); balanced accuracy = their mean over the classes with scenes (stratified bootstrap CI). A majority baseline's SAA can look strong; its balanced accuracy cannot.".into()),
+    ));
+    for c in &r.comparisons {
+        let mut t = Table::new(&[
+            "Metric",
+            &format!("{} %", c.a),
+            &format!("{} %", c.b),
+            "Difference (pp)",
+            "95% CI (pp)",
+            "Both",
+            "Only A",
+            "Only B",
+            "Neither",
+            "McNemar exact p",
+        ]);
+        for p in &c.metrics {
+            t.row(vec![
+                p.metric.clone(),
+                pct(p.a),
+                pct(p.b),
+                p.difference
+                    .map_or("—".into(), |d| format!("{:+.1}", 100.0 * d)),
+                p.difference_ci.map_or("—".into(), |[a, b]| {
+                    format!("{:+.1} to {:+.1}", 100.0 * a, 100.0 * b)
+                }),
+                p.both.to_string(),
+                p.only_a.to_string(),
+                p.only_b.to_string(),
+                p.neither.to_string(),
+                format!("{:.4}", p.mcnemar_p),
+            ]);
+        }
+        out.push((
+            format!("Paired comparison: {} vs {} ({} scenes both answered)", c.a, c.b, c.scenes),
+            t,
+            Some("A = the first model. Difference A − B on the expected scenes both models answered, with Newcombe's paired score interval; McNemar's exact test on the discordant scenes (Only A vs Only B).".into()),
+        ));
+    }
 }
 
 /// Safety-rule breakdown, disposition, and correct but out of reach.
@@ -473,6 +612,28 @@ fn header(r: &Report) -> String {
         if r.dataset.invalid_scenes > 0 { format!("; {} invalid scenes not scored", r.dataset.invalid_scenes) } else { String::new() },
         i.file, i.lines, i.decisions_scored, i.decisions_lost, i.duplicates,
         i.warnings.iter().map(|w| w.count).sum::<u64>(),
+    ) + &dropped_text(r) + &coverage_text(r)
+}
+
+/// "dropped N lines: …" naming every dropped line, or nothing.
+fn dropped_text(r: &Report) -> String {
+    let i = &r.input;
+    if i.dropped_lines == 0 {
+        return String::new();
+    }
+    let parts: Vec<String> = i
+        .warnings
+        .iter()
+        .filter_map(|w| {
+            w.lines
+                .as_ref()
+                .map(|l| format!("{} ×{} at lines {l}", w.kind, w.count))
+        })
+        .collect();
+    format!(
+        "dropped {} line(s), not scored: {}\n",
+        i.dropped_lines,
+        parts.join("; ")
     )
 }
 
@@ -489,6 +650,9 @@ fn warnings_text(r: &Report) -> String {
         );
         if !w.examples.is_empty() {
             let _ = write!(s, "  (e.g. {})", w.examples.join("; "));
+        }
+        if let Some(l) = &w.lines {
+            let _ = write!(s, "\n  {:<28} dropped lines: {l}", "");
         }
         s.push('\n');
     }
@@ -589,7 +753,7 @@ fn csv_field(s: &str) -> String {
 /// cells are undefined values.
 pub fn csv(r: &Report) -> String {
     let mut s = String::from(
-        "model,breakdown,group,decisions,lost,saa,safety,d_end,d_end_n,d_end_missing,aia,d_min,closing,hde_n,hde_missing,freeze_rate,first_R1,first_R2,first_R3,first_R4,fired_R1,fired_R2,fired_R3,fired_R4,pred_CATCH,pred_DODGE,pred_NO_ACTION,pred_unparseable\n",
+        "model,breakdown,group,decisions,lost,saa,safety,d_end,d_end_n,d_end_missing,aia,d_min,closing,hde_n,hde_missing,freeze_rate,first_R1,first_R2,first_R3,first_R4,fired_R1,fired_R2,fired_R3,fired_R4,pred_CATCH,pred_DODGE,pred_NO_ACTION,pred_unparseable,expected,unanswered,complete,answered_only,saa_lo,saa_hi,safety_lo,safety_hi,aia_lo,aia_hi,d_end_lo,d_end_hi,d_min_lo,d_min_hi,freeze_rate_lo,freeze_rate_hi,balanced_accuracy,balanced_accuracy_lo,balanced_accuracy_hi\n",
     );
     let f = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x}"));
     let models: Vec<&ModelReport> = r.models.iter().chain(std::iter::once(&r.pooled)).collect();
@@ -603,20 +767,49 @@ pub fn csv(r: &Report) -> String {
         ];
         for (bd, rows) in sets {
             for x in rows {
-                let lost = if bd == "overall" {
+                let overall = bd == "overall";
+                let lost = if overall {
                     m.lost.to_string()
                 } else {
                     String::new()
                 };
+                let ci = |v: Option<[f64; 2]>| match v {
+                    Some([a, b]) => format!("{a},{b}"),
+                    None => ",".into(),
+                };
+                let ba = if overall {
+                    format!("{},{}", f(m.balanced_accuracy), ci(m.balanced_accuracy_ci))
+                } else {
+                    ",,".into()
+                };
+                let extra = format!(
+                    "{},{},{},{},{},{},{},{},{},{},{}",
+                    x.expected,
+                    x.unanswered,
+                    if overall {
+                        m.coverage.complete.to_string()
+                    } else {
+                        String::new()
+                    },
+                    r.coverage.answered_only,
+                    ci(x.saa_ci),
+                    ci(x.safety_ci),
+                    ci(x.aia_ci),
+                    ci(x.d_end_ci),
+                    ci(x.d_min_ci),
+                    ci(x.freeze_rate_ci),
+                    ba
+                );
                 let _ = writeln!(
                     s,
-                    "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                     csv_field(&m.model), bd, csv_field(&x.group), x.decisions, lost,
                     f(x.saa), f(x.safety), f(x.d_end), x.d_end_n, x.d_end_missing, f(x.aia),
                     f(x.d_min), f(x.closing), x.hde_n, x.hde_missing, f(x.freeze_rate),
                     x.first_rule.r1, x.first_rule.r2, x.first_rule.r3, x.first_rule.r4,
                     x.rules_fired.r1, x.rules_fired.r2, x.rules_fired.r3, x.rules_fired.r4,
                     x.predicted.catch, x.predicted.dodge, x.predicted.no_action, x.predicted.unparseable,
+                    extra,
                 );
             }
         }

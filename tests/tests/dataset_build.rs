@@ -121,6 +121,7 @@ fn dataset_build_layout_card_and_manifest() {
         "{card}"
     );
     assert!(!card.contains("load_dataset(\"Alan123"), "{card}");
+    assert!(!card.contains("released build is"), "{card}");
 
     // A build smaller than one group per family says which families got no scene and
     // leaves them out of its tables.
@@ -284,10 +285,11 @@ t = pq.read_table(d + "/data/test-00000-of-00001.parquet")
 e = pq.read_table(d + "/eval/test-00000-of-00001.parquet")
 hf = json.loads(pq.read_schema(d + "/data/test-00000-of-00001.parquet").metadata[b"huggingface"])
 pf = pq.ParquetFile(d + "/data/test-00000-of-00001.parquet")
-# The card's first Python example, run from the dataset's folder as it says.
+# The card's first Python example, run from another folder with DIR given as it says.
 card = open(d + "/README.md").read()
 example = card.split("```python\n")[1].split("```")[0]
-os.chdir(d)
+os.environ["RH_DATASET"] = d
+os.chdir("/")
 ns = {{}}
 exec(example, ns)
 default = datasets.load_dataset(d, "default", split="test")

@@ -296,10 +296,56 @@ fn html_site_opens_in_headless_chromium() {
     );
     assert!(dataset.join("README.md").exists());
 
+    // The scene list's colours have a legend: green is "no rule fired", not "correct".
+    b.goto(&url(&site, "scenes.html"));
+    let legend = b.eval("document.getElementById('legend').textContent");
+    let legend = legend.as_str().unwrap_or_default();
+    assert!(
+        legend.contains("no safety rule fired") && legend.contains("not necessarily correct"),
+        "{legend}"
+    );
+    // The leaderboard shows coverage and 95% intervals.
+    b.goto(&url(&site, "index.html"));
+    let cells = b.eval(
+        "[...document.querySelectorAll('#leaderboard tbody tr:first-child td')].map(td => td.textContent).join('|')",
+    );
+    let cells = cells.as_str().unwrap_or_default();
+    assert!(cells.contains("12/12") && cells.contains("–"), "{cells}");
+
+    // With --execute the leaderboard gains the outcome columns and still fits 1400 px.
+    let exec_site = tmp.path().join("site-exec");
+    run_ok(
+        "rh-score",
+        &[
+            preds_file.to_str().unwrap(),
+            "--dataset",
+            ds,
+            "--quiet",
+            "--execute",
+            "--no-exec-cache",
+            "--html",
+            exec_site.to_str().unwrap(),
+        ],
+    );
+    let mut wide = Browser::launch(&chromium, &tmp.path().join("chromium-1400"), 1400, 900);
+    wide.goto(&url(&exec_site, "index.html"));
+    let struck = wide.eval(
+        "[...document.querySelectorAll('#leaderboard th')].filter(th => th.textContent.startsWith('struck')).length",
+    );
+    assert_eq!(struck.as_u64(), Some(1), "a struck % column");
+    let right = wide
+        .eval("document.getElementById('leaderboard').getBoundingClientRect().right")
+        .as_f64()
+        .unwrap();
+    let shot_exec = wide.screenshot();
+    assert!(right <= 1400.0, "the leaderboard ends at {right} px");
+    assert!(wide.errors.is_empty(), "console errors: {:#?}", wide.errors);
+
     let shots = Path::new(env!("CARGO_TARGET_TMPDIR")).join("screenshots");
     std::fs::create_dir_all(&shots).unwrap();
     std::fs::write(shots.join("leaderboard.png"), &shot_board).unwrap();
     std::fs::write(shots.join("scene.png"), &shot_scene).unwrap();
+    std::fs::write(shots.join("leaderboard-execute-1400.png"), &shot_exec).unwrap();
     assert_eq!(&shot_board[1..4], b"PNG");
     if std::env::var_os("RH_UPDATE_SCREENSHOTS").is_some() {
         let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/screenshots");

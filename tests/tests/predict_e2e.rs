@@ -562,6 +562,20 @@ fn dry_run_prints_the_request_and_paper_layout_is_refused() {
     assert!(user.iter().any(|p| p["text"] == "t = 0.60 s (ego camera)"));
     assert_eq!(v["prompt_version"], "rh-prompt-v4");
     assert_eq!(v["body"]["temperature"], 0.0);
+    // The estimate covers the whole run: 4 scenes of 5 images each; no price for "m".
+    let e = &v["estimate"];
+    assert_eq!(e["scenes"], 4);
+    assert_eq!(e["images_per_scene"], 5);
+    let per = e["input_tokens_per_scene"].as_u64().unwrap();
+    assert!(per > 5 * 85, "{e}");
+    assert_eq!(e["input_tokens"].as_u64(), Some(4 * per));
+    assert_eq!(e["output_tokens_at_most"], 4 * 1024);
+    assert!(e["cost_usd_at_most"].is_null());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("4 scenes ≈") && err.contains("cost unknown"),
+        "{err}"
+    );
 
     // The paper's metadata-only layout, and a directory without Parquet.
     let paper = d.join("paper");
@@ -711,4 +725,107 @@ fn llm_planner_validates_reasks_falls_back_and_caches() {
     let b = rh_e2e::files_under(&out2.join("specs"));
     assert_eq!(a, b);
     assert_no_key_under(d);
+}
+
+/// Safe runs (issue 24): `--max-cost` for a model without a price is refused; a closed
+/// port stops the run with exit 2 within 30 s (default client settings) and writes
+/// nothing; off a terminal, progress is a line every `progress_every_s`.
+#[test]
+fn unpriced_budget_dead_endpoint_and_progress_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = |url: &str, out: &Path| {
+        let mut c = Command::new(bin("rh-score"));
+        c.args(["predict", "--dataset", dataset().to_str().unwrap()])
+            .args(["--model", "my-local-model", "--subset", "all", "--no-cache"])
+            .arg("--out")
+            .arg(out)
+            .args(["--base-url", url])
+            .env_remove("OPENAI_BASE_URL");
+        c
+    };
+    // --max-cost without a price: refused before any request.
+    let o = base("http://127.0.0.1:9/v1", &d.join("a.jsonl"))
+        .args(["--max-cost", "1"])
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("price") && err.contains("--price-in"), "{err}");
+    assert!(!d.join("a.jsonl").exists());
+    // With a price it is accepted (and then the closed port below stops it).
+    // A port nobody listens on: bind, take the number, close.
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let url = format!("http://127.0.0.1:{port}/v1");
+    let out = d.join("dead.jsonl");
+    let t = Instant::now();
+    let o = base(&url, &out)
+        .args(["--max-cost", "1", "--price-in", "1", "--price-out", "1"])
+        .output()
+        .unwrap();
+    let took = t.elapsed();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(took < Duration::from_secs(30), "took {took:?}");
+    assert!(
+        err.contains("connection refused") && err.contains(&url),
+        "{err}"
+    );
+    assert!(
+        std::fs::read_to_string(&out).unwrap_or_default().is_empty(),
+        "no lost lines written"
+    );
+    // A server that answers every request with HTTP 500: the first 4 (every scene here)
+    // fail after their retries, and the run stops with exit 2 without writing them.
+    let failing = Server::start(d, "", "500", &[]);
+    let out = d.join("failing.jsonl");
+    let o = base(&failing.url(), &out)
+        .arg("--config")
+        .arg(fast_config(d))
+        .env("OPENAI_API_KEY", KEY)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("first 4 request(s)") && err.contains("500"),
+        "{err}"
+    );
+    assert!(std::fs::read_to_string(&out).unwrap_or_default().is_empty());
+    // Progress lines off a terminal (stderr is a pipe here), every 0.3 s.
+    let srv = Server::start(d, "", "bare", &["--delay", "0.5"]);
+    let cfg = std::fs::read_to_string(fast_config(d))
+        .unwrap()
+        .replace("progress_every_s = 10.0", "progress_every_s = 0.3");
+    assert!(cfg.contains("progress_every_s = 0.3"));
+    std::fs::write(d.join("progress.toml"), cfg).unwrap();
+    let o = base(&srv.url(), &d.join("p.jsonl"))
+        .args(["--concurrency", "1", "--config"])
+        .arg(d.join("progress.toml"))
+        .env("OPENAI_API_KEY", KEY)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let progress: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains("new scenes done"))
+        .collect();
+    assert!(progress.len() >= 2, "{err}");
+    assert!(
+        progress[0].contains("/4 new scenes done")
+            && progress[0].contains("ETA")
+            && progress[0].contains("lost")
+            && progress[0].contains("so far"),
+        "{err}"
+    );
 }

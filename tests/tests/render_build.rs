@@ -96,6 +96,11 @@ fn rendered_build_has_probed_videos_frames_columns_and_merges_byte_equal() {
         err.contains("nothing to do") && !err.contains("rendering on"),
         "{err}"
     );
+    let said = String::from_utf8_lossy(&rerun.stdout);
+    assert!(
+        !said.contains("resumed"),
+        "nothing to do, nothing resumed: {said}"
+    );
 
     // Per row: scene id, validity, the four video columns (pyarrow reads the table).
     let rows = python(&format!(

@@ -531,3 +531,199 @@ fn lenient_inputs_and_lost_decisions() {
     assert_eq!(dec[0]["action"], "CATCH");
     assert_eq!(dec[0]["status"], "scored");
 }
+
+/// Issue 24: coverage, intervals, `--compare` and strict inputs through the real binary.
+#[test]
+fn coverage_intervals_compare_and_strict_inputs() {
+    let ds = pipeline_dataset();
+    let d = ds.to_str().unwrap();
+    let t = truth(ds);
+    let n = t.scenes.len() as u64;
+    let work = scratch("coverage");
+    let oracle = work.join("oracle.jsonl");
+    baseline(ds, "oracle", &oracle);
+    // A run stopped after 4 scenes: coverage 4/n, SAA over the n expected scenes.
+    let text = std::fs::read_to_string(&oracle).unwrap();
+    let four: String = text.lines().take(4).map(|l| format!("{l}\n")).collect();
+    let stopped = work.join("stopped.jsonl");
+    std::fs::write(&stopped, four).unwrap();
+    let out = run(
+        "rh-score",
+        &[stopped.to_str().unwrap(), "--dataset", d, "--json", "-"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let m = &r["models"][0];
+    assert_eq!(
+        r["coverage"]["subset"], "eval",
+        "a built dataset has an eval subset"
+    );
+    assert_eq!(
+        r["coverage"]["expected_scenes"], n,
+        "small builds: eval = all valid"
+    );
+    assert_eq!(m["coverage"]["answered"], 4);
+    assert_eq!(m["coverage"]["expected"], n);
+    assert_eq!(m["coverage"]["complete"], false);
+    assert_eq!(m["overall"]["unanswered"], n - 4);
+    assert_eq!(m["overall"]["first_rule"]["R1"], 0);
+    let saa = m["overall"]["saa"].as_f64().unwrap();
+    assert!((saa - 4.0 / n as f64).abs() < 1e-12, "{saa}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains(&format!("INCOMPLETE: baseline-oracle answered 4 of {n}")),
+        "{err}"
+    );
+    // Every headline proportion has a 95% interval.
+    for k in ["saa_ci", "safety_ci", "aia_ci", "freeze_rate_ci"] {
+        let ci = m["overall"][k]
+            .as_array()
+            .unwrap_or_else(|| panic!("{k}: {m}"));
+        assert!(ci[0].as_f64().unwrap() <= ci[1].as_f64().unwrap());
+    }
+    assert!(m["balanced_accuracy_ci"].is_array());
+    assert_eq!(m["recall"].as_array().unwrap().len(), 3);
+    // --answered-only: the old view, labelled.
+    let table = run_ok(
+        "rh-score",
+        &[stopped.to_str().unwrap(), "--dataset", d, "--answered-only"],
+    );
+    assert!(
+        table.contains("ANSWERED-ONLY VIEW") && table.contains(&format!("4/{n} INCOMPLETE")),
+        "{table}"
+    );
+
+    // --compare on two baseline files (known answers: the oracle is right everywhere,
+    // always-catch exactly on the CATCH scenes).
+    let both = work.join("both.jsonl");
+    let catch_file = work.join("catch.jsonl");
+    baseline(ds, "always-catch", &catch_file);
+    std::fs::write(
+        &both,
+        text.clone() + &std::fs::read_to_string(&catch_file).unwrap(),
+    )
+    .unwrap();
+    let md = work.join("cmp.md");
+    let out = run_ok(
+        "rh-score",
+        &[
+            both.to_str().unwrap(),
+            "--dataset",
+            d,
+            "--json",
+            "-",
+            "--markdown",
+            md.to_str().unwrap(),
+            "--compare",
+            "baseline-oracle",
+            "baseline-always-catch",
+        ],
+    );
+    let r: Value = serde_json::from_str(&out).unwrap();
+    let c = &r["comparisons"][0];
+    let catch = t.scenes.iter().filter(|s| s.1 == "CATCH").count() as u64;
+    let saa = &c["metrics"][0];
+    assert_eq!(c["scenes"], n);
+    assert_eq!(
+        (
+            saa["both"].as_u64(),
+            saa["only_a"].as_u64(),
+            saa["only_b"].as_u64()
+        ),
+        (Some(catch), Some(n - catch), Some(0))
+    );
+    let p = saa["mcnemar_p"].as_f64().unwrap();
+    let want = (2.0 * 0.5f64.powi((n - catch) as i32)).min(1.0);
+    assert!((p - want).abs() <= 1e-12 * want, "{p} vs {want}");
+    let md = std::fs::read_to_string(&md).unwrap();
+    assert!(
+        md.contains("Paired comparison: baseline-oracle vs baseline-always-catch"),
+        "{md}"
+    );
+    assert!(
+        md.contains("SAA CI") && md.contains("Per-class recall"),
+        "{md}"
+    );
+    let out = run(
+        "rh-score",
+        &[
+            both.to_str().unwrap(),
+            "--dataset",
+            d,
+            "--compare",
+            "baseline-oracle",
+            "nobody",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nobody"));
+
+    // Nothing scorable: exit 2 naming the problem.
+    let id = &t.scenes[0].0;
+    let plan = r#"{"walking_cmd":[0,0,0]}"#;
+    let cases = [
+        ("empty", String::new(), "is empty"),
+        (
+            "array",
+            format!("[{{\"scene_id\":\"{id}\",\"model\":\"m\",\"plan\":{plan}}}]\n"),
+            "JSON array",
+        ),
+        (
+            "nomodel",
+            format!("{{\"scene_id\":\"{id}\",\"plan\":{plan}}}\n"),
+            "`model`",
+        ),
+        (
+            "foreign",
+            format!("{{\"scene_id\":\"00000000\",\"model\":\"m\",\"plan\":{plan}}}\n"),
+            "another dataset",
+        ),
+    ];
+    for (name, body, needle) in cases {
+        let p = work.join(format!("{name}.jsonl"));
+        std::fs::write(&p, body).unwrap();
+        let out = run("rh-score", &[p.to_str().unwrap(), "--dataset", d]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(needle), "{name}: {err}");
+    }
+    // The fixture's predictions scored against the pipeline's dataset: foreign ids.
+    let foreign = work.join("fixture-oracle.jsonl");
+    baseline(fixture_dataset(), "oracle", &foreign);
+    let out = run("rh-score", &[foreign.to_str().unwrap(), "--dataset", d]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("another dataset"));
+
+    // Literal NaN / Infinity: R1 absurd_number, like the strings; dropped lines named.
+    let nan = work.join("nan.jsonl");
+    std::fs::write(
+        &nan,
+        format!(
+            "{{\"scene_id\":\"{id}\",\"model\":\"m\",\"plan\":{{\"walking_cmd\":[NaN,0,0],\"walking_duration\":1}}}}\n\
+             garbage\n\
+             {{\"scene_id\":\"{}\",\"model\":\"m\",\"plan\":{{\"walking_cmd\":[0,0,0],\"keyframes\":[[-Infinity,0,0]]}}}}\n",
+            t.scenes[1].0
+        ),
+    )
+    .unwrap();
+    let out = run(
+        "rh-score",
+        &[nan.to_str().unwrap(), "--dataset", d, "--json", "-"],
+    );
+    assert!(out.status.success());
+    let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(r["models"][0]["overall"]["first_rule"]["R1"], 2);
+    assert_eq!(r["input"]["dropped_lines"], 1);
+    let w: Vec<&Value> = r["input"]["warnings"].as_array().unwrap().iter().collect();
+    assert!(w
+        .iter()
+        .any(|w| w["kind"] == "absurd_number" && w["count"] == 2));
+    assert!(w
+        .iter()
+        .any(|w| w["kind"] == "malformed_json" && w["lines"] == "2"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("malformed_json ×1 dropped (lines 2)"));
+}

@@ -105,6 +105,22 @@ struct Cli {
     #[arg(long, value_name = "ID", requires = "execute_videos")]
     tiled_scene: Option<String>,
 
+    /// Which scenes every model is expected to answer: the dataset's balanced eval subset
+    /// or every valid scene (default: eval when the dataset has an eval/ subset, else all).
+    /// Decisions on other scenes are dropped (`outside_subset`).
+    #[arg(long, value_enum)]
+    subset: Option<rh_score::predict::Subset>,
+
+    /// Metrics over each model's answered scenes only (unanswered scenes left out instead
+    /// of counted as failed); the report says so.
+    #[arg(long)]
+    answered_only: bool,
+
+    /// Paired comparison of two models on the scenes both answered: the difference in SAA
+    /// and safety with a 95% interval, and McNemar's exact p-value.
+    #[arg(long, num_args = 2, value_names = ["A", "B"])]
+    compare: Option<Vec<String>>,
+
     /// Do not print the terminal report.
     #[arg(long, short)]
     quiet: bool,
@@ -276,6 +292,13 @@ fn predict(a: PredictArgs) -> Result<()> {
             output: o.or(t.map(|p| p.output)).unwrap_or(0.0),
         }),
     };
+    rh_score::predict::check_price(&a.model, a.max_cost, price)?;
+    if price.is_none() && !a.dry_run {
+        eprintln!(
+            "rh-score predict: no price for model {:?} in the price table: its cost counts as $0 (give --price-in/--price-out for a real figure)",
+            a.model
+        );
+    }
     let dataset = dataset_dir(a.dataset.clone())?;
     let ds = Dataset::load(&dataset)?;
     let scenes = rh_score::predict::select_scenes(&ds, a.subset, a.limit)?;
@@ -301,9 +324,23 @@ fn predict(a: PredictArgs) -> Result<()> {
         sample: a.sample_index,
         prompt,
         progress: !a.quiet && !a.json,
+        abort_after_failures: cfg.run.abort_after_failures,
+        progress_every_s: cfg.run.progress_every_s,
     };
     if a.dry_run {
-        let req = rh_score::predict::dry_run(&opts, &scenes[0])?;
+        let req = rh_score::predict::dry_run(&opts, &scenes)?;
+        let e = &req["estimate"];
+        eprintln!(
+            "rh-score predict --dry-run: {} scenes ≈ {} input tokens ({} a scene) + at most {} output tokens; cost {}",
+            e["scenes"],
+            e["input_tokens"],
+            e["input_tokens_per_scene"],
+            e["output_tokens_at_most"],
+            match (e["cost_usd_at_least"].as_f64(), e["cost_usd_at_most"].as_f64()) {
+                (Some(lo), Some(hi)) => format!("≈ ${lo:.4} to ${hi:.4} (estimate)"),
+                _ => "unknown: no price for this model (give --price-in/--price-out)".into(),
+            }
+        );
         return print_out(&(serde_json::to_string_pretty(&req)? + "\n"));
     }
     let s = rh_score::predict::run(&opts, &scenes)?;
@@ -439,7 +476,8 @@ fn score(cli: Cli) -> Result<()> {
         .into());
     }
     let ds = Dataset::load(&dataset_dir(cli.dataset)?)?;
-    let mut scoring = Scoring::new(&ds, &cfg);
+    let expected = rh_score::coverage::Expected::resolve(&ds, cli.subset)?;
+    let mut scoring = Scoring::new(&ds, &cfg).with_expected(expected);
     if let Some(p) = &cli.decisions {
         let f = std::fs::File::create(p)
             .map_err(|e| InputError(format!("cannot write decisions to {}: {e}", p.display())))?;
@@ -453,7 +491,12 @@ fn score(cli: Cli) -> Result<()> {
     } else {
         scoring.score_path(&preds)?;
     }
-    let mut report = Report::build(&scoring, &preds.display().to_string());
+    rh_score::coverage::check_scored(&scoring, &preds.display().to_string())?;
+    let mut report = Report::build_with(&scoring, &preds.display().to_string(), cli.answered_only);
+    if let Some(pair) = &cli.compare {
+        let c = rh_score::compare::compare(&scoring, &pair[0], &pair[1])?;
+        report.comparisons.push(c);
+    }
     if cli.execute {
         let cache = (!cli.no_exec_cache).then(|| {
             cli.exec_cache
@@ -539,14 +582,32 @@ fn score(cli: Cli) -> Result<()> {
         );
         // One line per kind, naming its first line, so a user can go and look.
         for w in &report.input.warnings {
-            match w.first_lines.first() {
-                Some(first) => eprintln!(
+            match (&w.lines, w.first_lines.first()) {
+                (Some(lines), _) => eprintln!(
+                    "rh-score:   {} ×{} dropped (lines {lines})",
+                    w.kind, w.count
+                ),
+                (None, Some(first)) => eprintln!(
                     "rh-score:   {} ×{} (first at line {first})",
                     w.kind, w.count
                 ),
-                None => eprintln!("rh-score:   {} ×{}", w.kind, w.count),
+                (None, None) => eprintln!("rh-score:   {} ×{}", w.kind, w.count),
             }
         }
+    }
+    for m in report.models.iter().filter(|m| !m.coverage.complete) {
+        eprintln!(
+            "rh-score: INCOMPLETE: {} answered {} of {} expected scenes (expected: {}); {}",
+            m.model,
+            m.coverage.answered,
+            m.coverage.expected,
+            report.coverage.note,
+            if report.coverage.answered_only {
+                "metrics over its answered scenes only (--answered-only)"
+            } else {
+                "its unanswered scenes count as failed"
+            }
+        );
     }
     Ok(())
 }

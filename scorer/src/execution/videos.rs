@@ -188,7 +188,21 @@ pub fn write_videos(
     } else {
         indicatif::ProgressBar::hidden()
     };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{msg} {bar:30} {pos}/{len} decisions · {elapsed} · ETA {eta}",
+        )
+        .expect("valid template"),
+    );
     bar.set_message("execution videos");
+    // Off a terminal the bar is silent: a line every 10 s instead.
+    let log = crate::progress::ProgressLog::start(
+        req.progress,
+        "rh-score: execution videos",
+        "decisions",
+        total as u64,
+        std::time::Duration::from_secs_f64(crate::progress::LOG_EVERY_S),
+    );
     let mut index = VideoIndex {
         width: vcfg.width,
         height: vcfg.height,
@@ -212,8 +226,10 @@ pub fn write_videos(
             &mut renderer,
         )?;
         bar.inc(list.len() as u64);
+        log.add(list.len() as u64);
         index.scenes.push(sv);
     }
+    drop(log);
     bar.finish_and_clear();
     let text = serde_json::to_string_pretty(&index)? + "\n";
     let path = req.dir.join("index.json");

@@ -46,7 +46,29 @@ pub struct PromptText {
 pub struct PredictConfig {
     pub client: rh_llm::ClientConfig,
     pub generation: Generation,
+    /// `[run]` (the defaults when a config file has none).
+    #[serde(default)]
+    pub run: RunConfig,
     pub prices: BTreeMap<String, Price>,
+}
+
+/// `[run]`: when a run gives up, and how often it reports progress to a log.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RunConfig {
+    /// Stop with exit 2 when the first this-many requests all fail (a dead endpoint).
+    pub abort_after_failures: usize,
+    /// Seconds between progress lines when stderr is not a terminal.
+    pub progress_every_s: f64,
+}
+
+impl Default for RunConfig {
+    fn default() -> Self {
+        RunConfig {
+            abort_after_failures: 8,
+            progress_every_s: 10.0,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, Deserialize, serde::Serialize, PartialEq)]
@@ -113,6 +135,13 @@ impl PredictConfig {
             Some(p) => parse(&read(p)?, &p.display().to_string())?,
             None => parse(PREDICT_TOML, "configs/predict.toml (embedded)")?,
         };
+        if cfg.run.abort_after_failures == 0 || !(cfg.run.progress_every_s > 0.0) {
+            return Err(InputError(
+                "predict config: [run] abort_after_failures and progress_every_s must be positive"
+                    .into(),
+            )
+            .into());
+        }
         if cfg.client.concurrency == 0 || cfg.client.timeout_s <= 0.0 {
             return Err(InputError(
                 "predict config: [client] concurrency and timeout_s must be positive".into(),

@@ -95,6 +95,17 @@ struct Done {
 enum Stop {
     Input(String),
     Fatal(String),
+    /// The first requests all failed: (how many, the last error).
+    Dead(usize, String),
+}
+
+/// Holds back the lost decisions until the endpoint has answered once: when the first
+/// `limit` requests all fail, the run stops (exit 2) without writing them, instead of
+/// marking every scene lost.
+struct Gate {
+    held: Vec<Done>,
+    open: bool,
+    limit: usize,
 }
 
 fn answer_line(
@@ -287,6 +298,11 @@ pub fn run(opts: &PredictOptions, scenes: &[String]) -> Result<Summary> {
         .enable_all()
         .build()?;
     let start = Instant::now();
+    let mut gate = Gate {
+        held: Vec::new(),
+        open: false,
+        limit: opts.abort_after_failures.clamp(1, todo.len().max(1)),
+    };
     let result = rt.block_on(drive(
         opts,
         &client,
@@ -296,6 +312,7 @@ pub fn run(opts: &PredictOptions, scenes: &[String]) -> Result<Summary> {
         &bar,
         &mut s,
         &mut budget,
+        &mut gate,
     ));
     bar.finish_and_clear();
     let stats = client.stats();
@@ -318,6 +335,12 @@ pub fn run(opts: &PredictOptions, scenes: &[String]) -> Result<Summary> {
             "stopped after {} new lines: the server refused the request ({m}); check \
              --base-url, --model and the API key variable",
             s.written
+        ))
+        .into()),
+        Err(Stop::Dead(n, m)) => Err(InputError(format!(
+            "stopped: the first {n} request(s) to {} all failed (last: {m}); nothing was \
+             written for them. Is the server up? Check --base-url, then run again",
+            opts.client.base_url
         ))
         .into()),
     }
@@ -350,8 +373,15 @@ async fn drive(
     bar: &indicatif::ProgressBar,
     s: &mut Summary,
     budget: &mut Budget,
+    gate: &mut Gate,
 ) -> Result<(), Stop> {
+    use std::io::IsTerminal;
     let slots = opts.client.concurrency.max(1);
+    // Not on a terminal (a log file, CI): one progress line every progress_every_s.
+    let log = opts.progress && !std::io::stderr().is_terminal();
+    let every = std::time::Duration::from_secs_f64(opts.progress_every_s.max(0.1));
+    let mut ticker = tokio::time::interval_at(tokio::time::Instant::now() + every, every);
+    let began = Instant::now();
     let mut prepared = futures_util::stream::iter(todo.iter().cloned())
         .map(|scene| prepare_scene(opts, scene))
         .buffered(slots);
@@ -365,7 +395,10 @@ async fn drive(
         tokio::select! {
             biased;
             Some(done) = pending.next(), if !pending.is_empty() => {
-                record(done?, out, bar, s, budget, client)?;
+                gated(done?, out, bar, s, budget, client, gate)?;
+            }
+            _ = ticker.tick(), if log => {
+                eprintln!("{}", progress_line(s, budget, began, todo.len()));
             }
             next = prepared.next(), if can_start => match next {
                 None => exhausted = true,
@@ -378,10 +411,57 @@ async fn drive(
             },
         }
     }
+    for held in std::mem::take(&mut gate.held) {
+        record(held, out, bar, s, budget, client)?;
+    }
     if started < todo.len() {
         s.stopped = "max_cost".into();
     }
     Ok(())
+}
+
+/// Records a finished scene through the [`Gate`].
+fn gated(
+    done: Done,
+    out: &mut Appender,
+    bar: &indicatif::ProgressBar,
+    s: &mut Summary,
+    budget: &mut Budget,
+    client: &Client,
+    gate: &mut Gate,
+) -> Result<(), Stop> {
+    if !gate.open {
+        if done.lost {
+            let err = done.line["error"].as_str().unwrap_or("error").to_string();
+            gate.held.push(done);
+            if gate.held.len() >= gate.limit {
+                return Err(Stop::Dead(gate.held.len(), err));
+            }
+            return Ok(());
+        }
+        gate.open = true;
+        for held in std::mem::take(&mut gate.held) {
+            record(held, out, bar, s, budget, client)?;
+        }
+    }
+    record(done, out, bar, s, budget, client)
+}
+
+/// "12/60 new scenes done · 0.80/s · ETA 1m00s · 0 lost · $0.0123 so far".
+fn progress_line(s: &Summary, budget: &Budget, began: Instant, todo: usize) -> String {
+    let secs = began.elapsed().as_secs_f64();
+    let rate = s.written as f64 / secs.max(1e-9);
+    let left = todo.saturating_sub(s.written);
+    let eta = if s.written == 0 {
+        "unknown".to_string()
+    } else {
+        let e = (left as f64 / rate).round() as u64;
+        format!("{}m{:02}s", e / 60, e % 60)
+    };
+    format!(
+        "rh-score predict: {}/{todo} new scenes done ({} already there) · {rate:.2}/s · ETA {eta} · {} lost · ${:.4} so far (file ${:.4})",
+        s.written, s.already_done, s.lost, budget.spent_run, budget.spent
+    )
 }
 
 /// Appends one finished scene's line and counts it.

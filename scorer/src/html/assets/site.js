@@ -26,6 +26,11 @@
   }
   function num(x, d) { return x == null ? "—" : Number(x).toFixed(d); }
   function pct(x) { return x == null ? "—" : (100 * x).toFixed(1); }
+  // A rate with its 95% interval below it.
+  function pctCi(x, ci) {
+    return el("span", null, pct(x), ci ? el("small", { "class": "ci" },
+      (100 * ci[0]).toFixed(1) + "–" + (100 * ci[1]).toFixed(1)) : null);
+  }
   function color(i) { return PALETTE[i % PALETTE.length]; }
   function params(hash) {
     var out = {};
@@ -48,10 +53,19 @@
         var a = el("a", { href: "scenes.html#model=" + encodeURIComponent(r.model) }, r.model);
         return el("span", null, el("i", { "class": "swatch", style: "background:" + color(i) }), a);
       }, sort: function (r) { return r.model; } },
-      { key: "decisions", label: "Decisions", title: "scored decisions" },
-      { key: "lost", label: "Lost", title: "lost decisions (API errors): counted, never scored" },
-      { key: "saa", label: "SAA %", f: pct, title: "derived action equals the ground truth" },
-      { key: "safety", label: "Safety %", f: pct, title: "no safety rule fired" },
+      { key: "decisions", label: "Answered", title: "expected scenes with a scored decision, of those expected",
+        fmt: function (r) {
+          return el("span", { "class": r.complete ? "" : "incomplete" }, r.decisions + "/" + r.expected,
+            r.complete ? null : el("small", { "class": "ci" }, "incomplete"));
+        } },
+      { key: "unanswered", label: "Unans.", title: "expected scenes without a scored decision (lost or never asked): counted as failed, never as R1" },
+      { key: "lost", label: "Lost", title: "lost decisions (API errors): unanswered, never scored" },
+      { key: "saa", label: "SAA %", fmt: function (r) { return pctCi(r.saa, r.saa_ci); },
+        title: "derived action equals the ground truth, over the expected scenes (95% Wilson interval below)" },
+      { key: "balanced_accuracy", label: "Bal. acc %", fmt: function (r) { return pctCi(r.balanced_accuracy, r.balanced_accuracy_ci); },
+        title: "mean recall over CATCH, DODGE, NO_ACTION (95% bootstrap interval below)" },
+      { key: "safety", label: "Safety %", fmt: function (r) { return pctCi(r.safety, r.safety_ci); },
+        title: "no safety rule fired, over the expected scenes (95% Wilson interval below)" },
       { key: "d_end_catch", label: "d_end CATCH (m)", f: function (x) { return num(x, 2); },
         title: "final hands to impact point, over CATCH scenes (n in the next column)" },
       { key: "d_end_catch_n", label: "n", title: "CATCH decisions with a d_end" },
@@ -78,7 +92,7 @@
     }
     var table = document.getElementById("leaderboard");
     var order = rows.map(function (r, i) { return i; });
-    var state = { col: 3, dir: -1 };
+    var state = { col: 4, dir: -1 };
     function value(c, r) { return c.sort ? c.sort(r) : r[c.key]; }
     function draw() {
       var c = cols[state.col];
@@ -113,14 +127,21 @@
       });
     }
     draw();
+    var C = B.coverage, incomplete = C.incomplete_models;
     document.getElementById("board-note").textContent =
       rows.length + " model" + (rows.length === 1 ? "" : "s") + ", " + B.input.scored + " scored and " +
       B.input.lost + " lost decisions from " + B.input.file + " on " + (B.dataset.scenes - B.dataset.invalid) +
-      " valid scenes (" + B.dataset.dir + "); rh-score " + B.version + ", action rule " + B.action_rule.version + ".";
+      " valid scenes (" + B.dataset.dir + "); rh-score " + B.version + ", action rule " + B.action_rule.version + ". " +
+      "Coverage: " + C.expected_scenes + " expected scenes per model (" + C.note + "); " +
+      (C.answered_only ? "ANSWERED-ONLY VIEW: metrics over each model's answered scenes." :
+        "metrics over the expected scenes, an unanswered scene counting as failed.") +
+      (incomplete.length ? " Incomplete: " + incomplete.join(", ") + "." : "") +
+      (B.input.dropped ? " " + B.input.dropped + " input line(s) dropped (see the report's warnings)." : "");
     document.getElementById("board-defs").textContent =
       "d_end and HDE (hand-distance error: d_min, d₁−d_min over keyframes) are over CATCH scenes, where meeting " +
       "the object is the right action; the report (--markdown, --json) gives them per GT action, family and speed band. " +
-      "R1–R4 count the first rule that fired: " + B.rules.map(function (r) { return r.id + " " + r.text; }).join("; ") + ".";
+      "R1–R4 count the first rule that fired: " + B.rules.map(function (r) { return r.id + " " + r.text; }).join("; ") + ". " +
+      "Intervals are 95%: Wilson for rates, seeded bootstrap over scenes for balanced accuracy.";
   }
 
   // ---------------------------------------------------------------- scene browser

@@ -1,0 +1,45 @@
+//! Bootstrap intervals of a report row's means (d_end, HDE d_min, AIA), from the compact
+//! per-(scene, model) records: resampled over the row's scenes, seeded by the model, row
+//! and metric names (see [`crate::stats`]).
+
+use crate::aggregate::Rec;
+use crate::dataset::Dataset;
+use crate::report::MetricsRow;
+use crate::stats::{bootstrap_mean, seed_for, StatsConfig};
+use crate::types::Action;
+
+/// Fills `d_end_ci`, `d_min_ci` and `aia_ci` of `row`, the row of model `name` over the
+/// expected scenes of `recs` (one slice per model; several for the pooled row) whose
+/// ground truth is `gt` (all with `None`). An unanswered scene has AIA 0 unless
+/// `answered_only`; it has no distance.
+#[allow(clippy::too_many_arguments)]
+pub fn fill_means(
+    row: &mut MetricsRow,
+    name: &str,
+    recs: &[&[Rec]],
+    ds: &Dataset,
+    expected: &[bool],
+    gt: Option<Action>,
+    answered_only: bool,
+    cfg: &StatsConfig,
+) {
+    let (mut d_end, mut d_min, mut aia) = (Vec::new(), Vec::new(), Vec::new());
+    for r in recs {
+        for ((rec, sc), &exp) in r.iter().zip(&ds.scenes).zip(expected) {
+            if !exp || gt.is_some_and(|g| g != sc.gt_action) {
+                continue;
+            }
+            d_end.extend(rec.end_distance());
+            d_min.extend(rec.min_distance());
+            match rec.aia() {
+                Some(a) => aia.push(a),
+                None if !answered_only => aia.push(0.0),
+                None => {}
+            }
+        }
+    }
+    let seed = |metric: &str| seed_for(cfg.seed, &[name, &row.group, metric]);
+    row.d_end_ci = bootstrap_mean(&d_end, cfg, seed("d_end"));
+    row.d_min_ci = bootstrap_mean(&d_min, cfg, seed("d_min"));
+    row.aia_ci = bootstrap_mean(&aia, cfg, seed("aia"));
+}
