@@ -22,8 +22,9 @@
 //! high-water mark is reset before each run (`5` into `/proc/self/clear_refs`) and
 //! `VmHWM` read after it, so each run's peak is its own.
 
+use rh_score::dataset::Subset;
 use rh_score::predict::config::{Generation, PredictConfig, PromptConfig};
-use rh_score::predict::{run, select_scenes, PredictOptions, Subset};
+use rh_score::predict::{run, select_scenes, PredictOptions};
 use rh_score::Dataset;
 use std::io::BufRead;
 use std::path::{Path, PathBuf};

@@ -9,8 +9,7 @@
 
 use crate::aggregate::Rec;
 use crate::dataset::Dataset;
-use crate::predict::Subset;
-use crate::score::Scoring;
+use crate::dataset::Subset;
 use crate::types::InputError;
 use anyhow::Result;
 use serde::Serialize;
@@ -41,7 +40,7 @@ impl Expected {
     pub fn resolve(ds: &Dataset, subset: Option<Subset>) -> Result<Expected> {
         let eval = match subset {
             Some(Subset::All) => return Ok(Expected::all_valid(ds)),
-            _ => crate::predict::eval_scene_ids(&ds.dir)?,
+            _ => crate::dataset::eval_scene_ids(&ds.dir)?,
         };
         match (eval, subset) {
             (Some(ids), _) => Ok(Expected {
@@ -149,7 +148,7 @@ impl Unanswered {
 }
 
 /// What a skipped-line kind means, for the "nothing scored" error.
-fn skip_reason(kind: &str, ds: &Dataset) -> String {
+pub(crate) fn skip_reason(kind: &str, ds: &Dataset) -> String {
     match kind {
         "unknown_scene_id" => format!(
             "scene ids that are not in the dataset {} (predictions for another dataset?)",
@@ -168,83 +167,15 @@ fn skip_reason(kind: &str, ds: &Dataset) -> String {
     }
 }
 
-/// Refuses (exit 2) a predictions file from which no decision was scored: empty, a JSON
-/// array, lines without `model`, ids of another dataset, only lost decisions.
-pub fn check_scored(scoring: &Scoring, file: &str) -> Result<()> {
-    // A file that opens a JSON array is refused even when a line inside it (a
-    // pretty-printed element) happens to be a prediction object.
-    if let Some(w) = scoring.warnings.get("json_array") {
-        if w.first_lines
-            .first()
-            .is_some_and(|&l| Some(l) == scoring.first_content_line)
-        {
-            return Err(InputError(format!(
-                "predictions {file} is a JSON array (line {}: `[`), not JSON Lines: write one \
-                 prediction object per line (e.g. `jq -c '.[]' {file} > preds.jsonl`)",
-                w.first_lines[0]
-            ))
-            .into());
-        }
-    }
-    if scoring.scored > 0 {
-        return Ok(());
-    }
-    if scoring.lines == scoring.blank_lines {
-        return Err(InputError(format!(
-            "predictions {file} is empty: no prediction lines (JSON Lines: one object with scene_id, model and plan or response per line)"
-        ))
-        .into());
-    }
-    let mut reasons: Vec<(u64, String)> = scoring
-        .warnings
-        .iter()
-        .filter(|(_, w)| w.dropped)
-        .map(|(k, w)| {
-            let first = w.first_lines.first().copied().unwrap_or(0);
-            let eg = w
-                .examples
-                .first()
-                .map_or(String::new(), |e| format!(", e.g. {e}"));
-            (
-                w.count,
-                format!(
-                    "{} line(s) with {} (first at line {first}{eg})",
-                    w.count,
-                    skip_reason(k, scoring.ds)
-                ),
-            )
-        })
-        .collect();
-    if scoring.lost > 0 {
-        reasons.push((
-            scoring.lost,
-            format!(
-                "{} decision(s) lost to API errors (`error` lines; `rh-score predict --retry-errors` asks again)",
-                scoring.lost
-            ),
-        ));
-    }
-    reasons.sort_by(|a, b| b.0.cmp(&a.0));
-    let why: Vec<String> = reasons.into_iter().map(|r| r.1).collect();
-    Err(InputError(format!(
-        "no decision could be scored from predictions {file} ({} lines): {}",
-        scoring.lines,
-        if why.is_empty() {
-            "no prediction lines".to_string()
-        } else {
-            why.join("; ")
-        }
-    ))
-    .into())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::baseline::{baseline_plan, majority_action, BaselineKind};
     use crate::config::Config;
     use crate::fixture::{dataset_of, synth_rows};
+    use crate::refusal::check_scored;
     use crate::report::Report;
+    use crate::score::Scoring;
     use crate::types::Action;
 
     fn lines(ds: &Dataset, kind: BaselineKind, model: &str, take: usize) -> String {

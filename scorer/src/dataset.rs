@@ -7,8 +7,9 @@
 use crate::types::FastMap;
 use crate::types::{Action, InputError};
 use anyhow::Result;
-use arrow::array::RecordBatch;
+use arrow::array::{Array, RecordBatch, StringArray};
 use rh_contract::columns::col;
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 /// The speed bands of SPEC §4, slowest first (the data contract's).
@@ -339,4 +340,43 @@ pub fn read_replay_keys(dir: &Path) -> Result<FastMap<String, ReplayKey>> {
         }
     }
     Ok(out)
+}
+
+/// Which scenes a run covers: the eval subset or every valid scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Subset {
+    /// The balanced evaluation subset (the dataset's `eval` config).
+    Eval,
+    /// Every valid scene.
+    All,
+}
+
+/// Scene ids of the dataset's `eval/*.parquet`, or `None` when it has no eval config.
+pub fn eval_scene_ids(dir: &Path) -> Result<Option<BTreeSet<String>>> {
+    let eval = dir.join("eval");
+    if !eval.is_dir() {
+        return Ok(None);
+    }
+    let files = parquet_files(&eval)?;
+    if files.is_empty() {
+        return Ok(None);
+    }
+    let mut ids = BTreeSet::new();
+    for f in files {
+        let bad = |e: &dyn std::fmt::Display| InputError(format!("{}: {e}", f.display()));
+        let reader = open_parquet(&f, 1024)?;
+        for batch in reader {
+            let batch = batch.map_err(|e| bad(&e))?;
+            let col = batch
+                .column_by_name("scene_id")
+                .and_then(|c| c.as_any().downcast_ref::<StringArray>().cloned())
+                .ok_or_else(|| bad(&"no string column `scene_id`"))?;
+            for i in 0..col.len() {
+                if col.is_valid(i) {
+                    ids.insert(col.value(i).to_string());
+                }
+            }
+        }
+    }
+    Ok(Some(ids))
 }

@@ -4,17 +4,16 @@
 
 use crate::aggregate::Rec;
 use crate::dataset::Dataset;
-use crate::report::MetricsRow;
 use crate::stats::{bootstrap_mean, seed_for, StatsConfig};
 use crate::types::Action;
 
-/// Fills `d_end_ci`, `d_min_ci` and `aia_ci` of `row`, the row of model `name` over the
+/// The intervals `[d_end, d_min, aia]` of row `group` of model `name` over the
 /// expected scenes of `recs` (one slice per model; several for the pooled row) whose
 /// ground truth is `gt` (all with `None`). An unanswered scene has AIA 0 unless
 /// `answered_only`; it has no distance.
 #[allow(clippy::too_many_arguments)]
-pub fn fill_means(
-    row: &mut MetricsRow,
+pub fn mean_intervals(
+    group: &str,
     name: &str,
     recs: &[&[Rec]],
     ds: &Dataset,
@@ -22,7 +21,7 @@ pub fn fill_means(
     gt: Option<Action>,
     answered_only: bool,
     cfg: &StatsConfig,
-) {
+) -> [Option<[f64; 2]>; 3] {
     let (mut d_end, mut d_min, mut aia) = (Vec::new(), Vec::new(), Vec::new());
     for r in recs {
         for ((rec, sc), &exp) in r.iter().zip(&ds.scenes).zip(expected) {
@@ -38,8 +37,10 @@ pub fn fill_means(
             }
         }
     }
-    let seed = |metric: &str| seed_for(cfg.seed, &[name, &row.group, metric]);
-    row.d_end_ci = bootstrap_mean(&d_end, cfg, seed("d_end"));
-    row.d_min_ci = bootstrap_mean(&d_min, cfg, seed("d_min"));
-    row.aia_ci = bootstrap_mean(&aia, cfg, seed("aia"));
+    let seed = |metric: &str| seed_for(cfg.seed, &[name, group, metric]);
+    [
+        bootstrap_mean(&d_end, cfg, seed("d_end")),
+        bootstrap_mean(&d_min, cfg, seed("d_min")),
+        bootstrap_mean(&aia, cfg, seed("aia")),
+    ]
 }

@@ -109,7 +109,7 @@ struct Cli {
     /// or every valid scene (default: eval when the dataset has an eval/ subset, else all).
     /// Decisions on other scenes are dropped (`outside_subset`).
     #[arg(long, value_enum)]
-    subset: Option<rh_score::predict::Subset>,
+    subset: Option<rh_score::dataset::Subset>,
 
     /// Metrics over each model's answered scenes only (unanswered scenes left out instead
     /// of counted as failed); the report says so.
@@ -190,7 +190,7 @@ struct PredictArgs {
     api_key_env: String,
     /// Which scenes: the balanced eval subset or every valid scene.
     #[arg(long, value_enum, default_value = "eval")]
-    subset: rh_score::predict::Subset,
+    subset: rh_score::dataset::Subset,
     /// Only the first N scenes of the subset (dataset order).
     #[arg(long, value_name = "N")]
     limit: Option<usize>,
@@ -491,7 +491,7 @@ fn score(cli: Cli) -> Result<()> {
     } else {
         scoring.score_path(&preds)?;
     }
-    rh_score::coverage::check_scored(&scoring, &preds.display().to_string())?;
+    rh_score::refusal::check_scored(&scoring, &preds.display().to_string())?;
     let mut report = Report::build_with(&scoring, &preds.display().to_string(), cli.answered_only);
     if let Some(pair) = &cli.compare {
         let c = rh_score::compare::compare(&scoring, &pair[0], &pair[1])?;

@@ -14,22 +14,13 @@ pub mod prompt;
 pub mod runner;
 
 use crate::dataset::Dataset;
+use crate::dataset::{eval_scene_ids, Subset};
 use crate::types::InputError;
 use anyhow::Result;
-use arrow::array::{Array, StringArray};
-use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
+
+use std::path::PathBuf;
 
 pub use runner::Summary;
-
-/// Which scenes to run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Subset {
-    /// The balanced evaluation subset (the dataset's `eval` config).
-    Eval,
-    /// Every valid scene.
-    All,
-}
 
 /// Everything `rh-score predict` was asked to do.
 #[derive(Debug, Clone)]
@@ -83,36 +74,6 @@ pub fn check_price(model: &str, max_cost: Option<f64>, price: Option<config::Pri
         .into());
     }
     Ok(())
-}
-
-/// Scene ids of the dataset's `eval/*.parquet`, or `None` when it has no eval config.
-pub fn eval_scene_ids(dir: &Path) -> Result<Option<BTreeSet<String>>> {
-    let eval = dir.join("eval");
-    if !eval.is_dir() {
-        return Ok(None);
-    }
-    let files = crate::dataset::parquet_files(&eval)?;
-    if files.is_empty() {
-        return Ok(None);
-    }
-    let mut ids = BTreeSet::new();
-    for f in files {
-        let bad = |e: &dyn std::fmt::Display| InputError(format!("{}: {e}", f.display()));
-        let reader = crate::dataset::open_parquet(&f, 1024)?;
-        for batch in reader {
-            let batch = batch.map_err(|e| bad(&e))?;
-            let col = batch
-                .column_by_name("scene_id")
-                .and_then(|c| c.as_any().downcast_ref::<StringArray>().cloned())
-                .ok_or_else(|| bad(&"no string column `scene_id`"))?;
-            for i in 0..col.len() {
-                if col.is_valid(i) {
-                    ids.insert(col.value(i).to_string());
-                }
-            }
-        }
-    }
-    Ok(Some(ids))
 }
 
 /// The scene ids to run, in dataset order: valid scenes of the subset, first `limit`.
