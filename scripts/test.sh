@@ -5,7 +5,7 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
 cargo build --release --workspace --bins
-cargo test --release --workspace
+cargo test --release --workspace --no-fail-fast
 # The quick start's main job, end to end on a reduced size (8 rendered scenes).
 qs_out="$(mktemp -d)"
 RH_QUICKSTART_N=8 RH_OUT="$qs_out" bash scripts/quickstart.sh

@@ -188,6 +188,8 @@ fn garbage_truncated_and_huge_lines_never_stop_the_run() {
                 "invalid_utf8",
                 "line_too_long",
                 "invalid_scene",
+                "json_array",
+                "outside_subset",
                 "retry_after_error",
             ]
             .contains(&w["kind"].as_str().unwrap())
@@ -200,6 +202,15 @@ fn garbage_truncated_and_huge_lines_never_stop_the_run() {
         + input["blank_lines"].as_u64().unwrap()
         + skipped;
     assert_eq!(acc, total_lines, "{input}");
+    // Every dropped line is counted under a kind that names it.
+    let dropped: u64 = input["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|w| w["dropped"] == true)
+        .map(|w| w["count"].as_u64().unwrap())
+        .sum();
+    assert_eq!(input["dropped_lines"].as_u64(), Some(dropped), "{input}");
     let too_long = input["warnings"]
         .as_array()
         .unwrap()
