@@ -4,7 +4,7 @@
 
 use crate::integrity::{self, FileSums};
 use crate::manifest::{Manifest, MANIFEST_FILE};
-use crate::{card, table};
+use crate::{card, stream, table};
 use arrow::array::RecordBatch;
 use std::path::Path;
 
@@ -32,7 +32,7 @@ pub type RowSource<'a> = dyn Fn(&mut RowSink) -> Result<(), BuildError> + 'a;
 /// Writes the dataset's final files from its rows (in scene-index order, streamed from
 /// `rows`): the data Parquet (row group by row group), the eval subset (whole builds; a
 /// second pass over the rows picks it), and the card. Memory stays flat in the number of
-/// rows but for `table::SUMMARY_COLUMNS`, which it returns (every row, those columns)
+/// rows but for `stream::SUMMARY_COLUMNS`, which it returns (every row, those columns)
 /// with the eval subset's size. Then it writes `build.json` again, now with the SHA-256
 /// of every file (`sums`: the groups' specs and media, plus the files written here).
 pub fn finalize(
@@ -43,10 +43,10 @@ pub fn finalize(
 ) -> Result<(RecordBatch, Option<usize>), BuildError> {
     let data_file = table::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
     let data_path = out.join(&data_file);
-    let mut data = table::ParquetStream::create(&data_path).map_err(BuildError::Internal)?;
-    let summary_schema = table::project(
+    let mut data = stream::ParquetStream::create(&data_path).map_err(BuildError::Internal)?;
+    let summary_schema = stream::project(
         &RecordBatch::new_empty(std::sync::Arc::new(table::schema())),
-        &table::SUMMARY_COLUMNS,
+        &stream::SUMMARY_COLUMNS,
     )
     .schema();
     let compact = |parts: &[RecordBatch]| {
@@ -56,7 +56,7 @@ pub fn finalize(
     let mut summary: Vec<RecordBatch> = Vec::new();
     rows(&mut |batch| {
         data.write(&batch).map_err(BuildError::Internal)?;
-        summary.push(table::project(&batch, &table::SUMMARY_COLUMNS));
+        summary.push(stream::project(&batch, &stream::SUMMARY_COLUMNS));
         if summary.len() >= 256 {
             summary = vec![compact(&summary)?];
         }

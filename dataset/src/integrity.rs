@@ -52,7 +52,7 @@ pub fn sums_of(root: &Path, files: &[String]) -> std::io::Result<FileSums> {
 
 /// The sums of every file the rows of `batch` refer to (specs, videos, frames).
 pub fn group_sums(root: &Path, batch: &RecordBatch) -> std::io::Result<FileSums> {
-    sums_of(root, &table::referenced_files(batch))
+    sums_of(root, &crate::rows::referenced_files(batch))
 }
 
 /// As `group_sums`, but files whose sums are already `known` (written from memory and
@@ -62,7 +62,7 @@ pub fn group_sums_known(
     batch: &RecordBatch,
     known: FileSums,
 ) -> std::io::Result<FileSums> {
-    let rest: Vec<String> = table::referenced_files(batch)
+    let rest: Vec<String> = crate::rows::referenced_files(batch)
         .into_iter()
         .filter(|f| !known.contains_key(f))
         .collect();

@@ -7,7 +7,7 @@
 //! One entry point each way: [`measured_columns`] turns scenes into those columns (the
 //! dataset writer), [`media_of_row`] reads a row's media back (`verify`, which cannot
 //! derive them without rendering), and [`mask_files`] lists the files a row names
-//! (`dataset::referenced_files`: resume, shard, merge and verify checksum them).
+//! (`rows::referenced_files`: resume, shard, merge and verify checksum them).
 //! No GPU code here: label-only builds write the columns as nulls.
 
 use arrow::array::{

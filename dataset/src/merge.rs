@@ -12,7 +12,7 @@ use crate::finalize::{finalize, BuildError, RowSink};
 use crate::integrity::{self, FileSums};
 use crate::manifest::{Manifest, MANIFEST_FILE};
 use crate::records::WORK_DIR;
-use crate::table;
+use crate::{stream, table};
 use arrow::array::RecordBatch;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -32,7 +32,7 @@ fn input(msg: String) -> BuildError {
     BuildError::Input(msg)
 }
 
-/// The columns a shard's checks and file copies read (`table::referenced_files`: specs,
+/// The columns a shard's checks and file copies read (`rows::referenced_files`: specs,
 /// videos, and the mask/depth path lists); the full rows are streamed from the shard
 /// files by `finalize` instead of held in memory.
 fn file_columns() -> Vec<String> {
@@ -74,7 +74,7 @@ fn read_shard(dir: &Path) -> Result<(Manifest, arrow::array::RecordBatch), Build
     }
     let columns = file_columns();
     let names: Vec<&str> = columns.iter().map(String::as_str).collect();
-    let rows = table::read_columns(&data, &names).map_err(input)?;
+    let rows = stream::read_columns(&data, &names).map_err(input)?;
     let indices = table::u64_column(&rows, "scene_index");
     let expected: Vec<u64> = manifest
         .groups()
@@ -108,7 +108,7 @@ fn read_shard(dir: &Path) -> Result<(Manifest, arrow::array::RecordBatch), Build
             integrity::describe(&problems, 5)
         )));
     }
-    for file in table::referenced_files(&rows) {
+    for file in crate::rows::referenced_files(&rows) {
         if !sums.contains_key(&file) {
             return Err(input(format!(
                 "{}: {file} is named by a row but has no recorded checksum",
@@ -216,9 +216,9 @@ pub fn merge(out: &Path, shards: &[PathBuf]) -> Result<MergeSummary, BuildError>
             out.display()
         ))
     })?;
-    let rows = table::read_columns(
+    let rows = stream::read_columns(
         &out.join(table::data_file_name(0, 1)),
-        &table::SUMMARY_COLUMNS,
+        &stream::SUMMARY_COLUMNS,
     )
     .map_err(BuildError::Internal)?;
     Ok(MergeSummary {
@@ -249,7 +249,7 @@ fn write_merged(staging: &Path, whole: &Manifest, shards: &[Shard]) -> Result<()
     for (dir, (manifest, rows)) in shards {
         // Specs, videos and frames: every file a row names, with its checked checksum.
         let shard_sums = manifest.files.as_ref().expect("checked by read_shard");
-        for file in table::referenced_files(rows) {
+        for file in crate::rows::referenced_files(rows) {
             sums.insert(file.clone(), shard_sums[&file].clone());
             let (from, to) = (dir.join(&file), staging.join(&file));
             if let Some(parent) = to.parent() {

@@ -51,7 +51,7 @@ pub fn group_files(
         files.push(write_unsynced(&path, json.as_bytes()).map_err(|e| internal(&path, e))?);
     }
     let path = record_path(out, g);
-    let batch = table::record_batch(results, catalog);
+    let batch = crate::rows::record_batch(results, catalog);
     let sums = integrity::group_sums_known(out, &batch, spec_sums).map_err(|e| internal(out, e))?;
     let sums_path = integrity::group_sums_path(&path);
     let text = integrity::sums_json(&sums);
@@ -158,7 +158,7 @@ pub fn load_record(out: &Path, manifest: &Manifest, g: u64) -> Option<RecordBatc
     }
     // Every file the rows name, with the checksum recorded when the group finished.
     let sums = integrity::read_group_sums(&path)?;
-    let named: Vec<String> = table::referenced_files(&batch);
+    let named: Vec<String> = crate::rows::referenced_files(&batch);
     if named.len() != sums.len() || !named.iter().all(|f| sums.contains_key(f)) {
         return None;
     }
@@ -207,7 +207,7 @@ pub fn reopen_if_damaged(
                 .filter(|&i| index[i as usize] / 4 == g)
                 .collect();
             let batch = table::take_rows(&rows, &picks);
-            let files = table::referenced_files(&batch);
+            let files = crate::rows::referenced_files(&batch);
             if picks.is_empty()
                 || files
                     .iter()

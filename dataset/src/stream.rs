@@ -148,7 +148,8 @@ pub fn read_columns(path: &Path, names: &[&str]) -> Result<RecordBatch, String> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::table::{parquet_bytes, record_batch, string_column, take_rows};
+    use crate::rows::record_batch;
+    use crate::table::{parquet_bytes, string_column, take_rows};
     use rh_catalog::Catalog;
     use rh_scenes::config::Config;
     use rh_scenes::driver::produce_group;

@@ -15,9 +15,6 @@ use std::sync::Arc;
 /// Rows per Parquet row group: small enough for the Hub's dataset viewer to page.
 pub const ROW_GROUP_SIZE: usize = 1000;
 
-#[cfg(feature = "write")]
-pub use crate::rows::{record_batch, referenced_files};
-pub use crate::stream::{project, read_columns, ParquetStream, SUMMARY_COLUMNS};
 pub use rh_contract::fsio::write_atomic;
 pub use rh_contract::layout::{data_file_name, frame_files, spec_path};
 

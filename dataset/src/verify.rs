@@ -253,7 +253,7 @@ fn check_group(
     for (row, r) in results.iter_mut().enumerate() {
         r.media = crate::media_columns::media_of_row(stored, row);
     }
-    let derived = table::record_batch(results, catalog);
+    let derived = crate::rows::record_batch(results, catalog);
     for (i, field) in derived.schema().fields().iter().enumerate() {
         let (a, b) = (stored.column(i), derived.column(i));
         if a.as_ref() == b.as_ref() {

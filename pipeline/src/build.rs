@@ -29,7 +29,7 @@ use rh_dataset::manifest::{Manifest, MANIFEST_FILE};
 pub use rh_dataset::records::FamilyRejections;
 use rh_dataset::records::{gather_rejections, group_files, load_record, reopen_if_damaged};
 pub use rh_dataset::records::{record_path, WORK_DIR};
-use rh_dataset::table;
+use rh_dataset::{stream, table};
 use rh_scenes::config::Config;
 use rh_scenes::driver::{run_group, GroupError, RenderStage};
 use rh_scenes::families;
@@ -418,7 +418,7 @@ fn finished_build(
         );
     }
     let data_file = table::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
-    let rows = table::read_columns(&out.join(&data_file), &table::SUMMARY_COLUMNS)
+    let rows = stream::read_columns(&out.join(&data_file), &stream::SUMMARY_COLUMNS)
         .map_err(BuildError::Internal)?;
     let eval = out
         .join(card::EVAL_FILE)

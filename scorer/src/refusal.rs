@@ -1,6 +1,7 @@
-//! Refusing a predictions file from which nothing could be scored (exit 2, naming why):
-//! empty, a JSON array, lines without `model`, ids of another dataset, only lost
-//! decisions.
+//! What `rh-score` tells the user about its input: refusing a predictions file from
+//! which nothing could be scored (exit 2, naming why: empty, a JSON array, lines without
+//! `model`, ids of another dataset, only lost decisions), and the notes after a report
+//! (every dropped line named, incomplete models).
 
 use crate::coverage::skip_reason;
 use crate::score::Scoring;
@@ -75,4 +76,51 @@ pub fn check_scored(scoring: &Scoring, file: &str) -> Result<()> {
         }
     ))
     .into())
+}
+
+/// What `rh-score` says on stderr after a report: the input warnings (every dropped line
+/// named) and the incomplete models.
+pub fn stderr_notes(report: &crate::report::Report) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let warned: u64 = report.input.warnings.iter().map(|w| w.count).sum();
+    if warned > 0 {
+        let _ = writeln!(
+            s,
+            "rh-score: {warned} input warning(s) in {}; see the report's warnings section",
+            report.input.file
+        );
+        // One line per kind, naming its lines, so a user can go and look.
+        for w in &report.input.warnings {
+            let _ = match (&w.lines, w.first_lines.first()) {
+                (Some(lines), _) => writeln!(
+                    s,
+                    "rh-score:   {} ×{} dropped (lines {lines})",
+                    w.kind, w.count
+                ),
+                (None, Some(first)) => writeln!(
+                    s,
+                    "rh-score:   {} ×{} (first at line {first})",
+                    w.kind, w.count
+                ),
+                (None, None) => writeln!(s, "rh-score:   {} ×{}", w.kind, w.count),
+            };
+        }
+    }
+    for m in report.models.iter().filter(|m| !m.coverage.complete) {
+        let _ = writeln!(
+            s,
+            "rh-score: INCOMPLETE: {} answered {} of {} expected scenes (expected: {}); {}",
+            m.model,
+            m.coverage.answered,
+            m.coverage.expected,
+            report.coverage.note,
+            if report.coverage.answered_only {
+                "metrics over its answered scenes only (--answered-only)"
+            } else {
+                "its unanswered scenes count as failed"
+            }
+        );
+    }
+    s
 }

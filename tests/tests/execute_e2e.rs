@@ -64,6 +64,10 @@ fn execute(
         decisions.to_str().unwrap(),
         "--exec-cache",
         cache.to_str().unwrap(),
+        // Every valid scene of the build, not the eval subset: the figures docs/execution.md
+        // quotes are over the whole 340-scene build.
+        "--subset",
+        "all",
     ];
     args.extend_from_slice(extra);
     let out = Command::new(bin("rh-score"))
@@ -234,7 +238,7 @@ fn pipe_bad_plans_cache_and_thread_count() {
     let status = Command::new("sh")
         .arg("-c")
         .arg(format!(
-            "'{}' baseline oracle --dataset '{d}' | '{}' - --dataset '{d}' --execute --json '{}' --exec-cache '{}' --quiet",
+            "'{}' baseline oracle --dataset '{d}' | '{}' - --dataset '{d}' --subset all --execute --json '{}' --exec-cache '{}' --quiet",
             bin("rh-score").display(),
             bin("rh-score").display(),
             json.display(),

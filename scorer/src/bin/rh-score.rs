@@ -574,41 +574,7 @@ fn score(cli: Cli) -> Result<()> {
             index.display()
         );
     }
-    let warned: u64 = report.input.warnings.iter().map(|w| w.count).sum();
-    if warned > 0 {
-        eprintln!(
-            "rh-score: {warned} input warning(s) in {}; see the report's warnings section",
-            preds.display()
-        );
-        // One line per kind, naming its first line, so a user can go and look.
-        for w in &report.input.warnings {
-            match (&w.lines, w.first_lines.first()) {
-                (Some(lines), _) => eprintln!(
-                    "rh-score:   {} ×{} dropped (lines {lines})",
-                    w.kind, w.count
-                ),
-                (None, Some(first)) => eprintln!(
-                    "rh-score:   {} ×{} (first at line {first})",
-                    w.kind, w.count
-                ),
-                (None, None) => eprintln!("rh-score:   {} ×{}", w.kind, w.count),
-            }
-        }
-    }
-    for m in report.models.iter().filter(|m| !m.coverage.complete) {
-        eprintln!(
-            "rh-score: INCOMPLETE: {} answered {} of {} expected scenes (expected: {}); {}",
-            m.model,
-            m.coverage.answered,
-            m.coverage.expected,
-            report.coverage.note,
-            if report.coverage.answered_only {
-                "metrics over its answered scenes only (--answered-only)"
-            } else {
-                "its unanswered scenes count as failed"
-            }
-        );
-    }
+    eprint!("{}", rh_score::refusal::stderr_notes(&report));
     Ok(())
 }
 
