@@ -198,6 +198,7 @@ pub fn oracle_plan(scene: &Scene, hints: Option<&OracleHints>, cfg: &Config) -> 
 /// The hints of every scene: [`read_hints`], then the physics-checked dodges
 /// ([`physics_dodges`]).
 pub fn load_hints(ds: &Dataset, cfg: &Config) -> Result<BTreeMap<String, OracleHints>> {
+    #[cfg_attr(not(feature = "execute"), allow(unused_mut))]
     let mut hints = read_hints(ds)?;
     #[cfg(feature = "execute")]
     for (id, plan) in physics_dodges(ds, &hints, cfg) {

@@ -689,6 +689,7 @@ fn write_videos(
 }
 
 #[cfg(not(feature = "videos"))]
+#[cfg_attr(not(feature = "execute"), allow(dead_code))]
 fn write_videos(
     _: &Dataset,
     _: &[rh_score::execution::Pending],
