@@ -33,7 +33,8 @@ pub fn open_parquet(file: &Path, batch_size: usize) -> Result<ParquetRecordBatch
         .map_err(|e| format!("{} is not a readable Parquet file: {e}", file.display()))
 }
 
-fn bad(file: &Path, column: &str, what: impl std::fmt::Display) -> String {
+/// The error of a column: `FILE: column `NAME` WHAT`.
+pub fn bad(file: &Path, column: &str, what: impl std::fmt::Display) -> String {
     format!("{}: column `{column}` {what}", file.display())
 }
 
@@ -80,40 +81,41 @@ pub fn required_strings(
         .collect()
 }
 
-/// A Boolean column without nulls.
-pub fn bools(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<bool>, String> {
+/// A column of type `A` without nulls, each value taken by `value`; `expected` names the
+/// Arrow type in the error.
+fn non_null<A: Array + 'static, T>(
+    batch: &RecordBatch,
+    file: &Path,
+    name: &str,
+    expected: &str,
+    value: impl Fn(&A, usize) -> T,
+) -> Result<Vec<T>, String> {
     let col = column(batch, file, name)?;
-    let arr = col.as_any().downcast_ref::<BooleanArray>().ok_or_else(|| {
+    let arr = col.as_any().downcast_ref::<A>().ok_or_else(|| {
         bad(
             file,
             name,
-            format!("has type {}, expected Boolean", col.data_type()),
+            format!("has type {}, expected {expected}", col.data_type()),
         )
     })?;
     (0..arr.len())
         .map(|i| match arr.is_null(i) {
             true => Err(bad(file, name, format!("is null in row {i}"))),
-            false => Ok(arr.value(i)),
+            false => Ok(value(arr, i)),
         })
         .collect()
 }
 
+/// A Boolean column without nulls.
+pub fn bools(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<bool>, String> {
+    non_null(batch, file, name, "Boolean", |a: &BooleanArray, i| {
+        a.value(i)
+    })
+}
+
 /// A UInt64 column without nulls.
 pub fn u64s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<u64>, String> {
-    let col = column(batch, file, name)?;
-    let arr = col.as_any().downcast_ref::<UInt64Array>().ok_or_else(|| {
-        bad(
-            file,
-            name,
-            format!("has type {}, expected UInt64", col.data_type()),
-        )
-    })?;
-    (0..arr.len())
-        .map(|i| match arr.is_null(i) {
-            true => Err(bad(file, name, format!("is null in row {i}"))),
-            false => Ok(arr.value(i)),
-        })
-        .collect()
+    non_null(batch, file, name, "UInt64", |a: &UInt64Array, i| a.value(i))
 }
 
 /// A column of 3-vectors: FixedSizeList<Float64, 3> (or List<Float64> of length 3).

@@ -195,7 +195,7 @@ pub struct SceneInput {
 }
 
 fn bad(file: &Path, column: &str, what: impl std::fmt::Display) -> anyhow::Error {
-    InputError(format!("{}: column `{column}` {what}", file.display())).into()
+    InputError(rh_dataset::read::bad(file, column, what)).into()
 }
 
 fn strings(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Option<String>>> {
