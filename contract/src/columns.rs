@@ -67,6 +67,10 @@ pub mod col {
     pub const TIME_TO_REACH: &str = "time_to_reach";
     pub const STRIKE_SPEED: &str = "strike_speed";
     pub const STRIKE_IMPULSE: &str = "strike_impulse";
+    pub const HARM_REGION: &str = "harm_region";
+    pub const HARM_ENERGY: &str = "harm_energy";
+    pub const HARM_FORCE: &str = "harm_force";
+    pub const HARM_RATIO: &str = "harm_ratio";
     pub const OBJECT_START: &str = "object_start";
     pub const OBSERVER_POSE: &str = "observer_pose";
     pub const LABEL_RULE: &str = "label_rule";
@@ -276,7 +280,7 @@ pub const COLUMNS: &[Column] = &[
         col::DANGER_PRESENT,
         Bool,
         false,
-        "The hazard would strike the observer standing still (counterfactual simulation; judged by the contact point's speed and the impulse, rule below)",
+        "The hazard would harm the observer standing still (counterfactual simulation; label rule v5: a touch over the per-body-region limits of ISO/TS 15066 Annex A, or any touch of a sharp or hot hazard; rule below)",
     ),
     c(
         col::DANGER_REASONS,
@@ -330,13 +334,37 @@ pub const COLUMNS: &[Column] = &[
         col::STRIKE_SPEED,
         Float64,
         true,
-        "Counterfactual (observer standing still, label rule v3: the humanoid's rest-pose links): largest speed of the hazard's contact point relative to the body over the strike window — the strike's, else the first touch's (m/s); null if it never touches the body",
+        "Counterfactual (observer standing still, label rule v3: the humanoid's rest-pose links): largest speed of the hazard's contact point relative to the body over the harm test's window — the harming one, else the first touch's (m/s); null if it never touches the body",
     ),
     c(
         col::STRIKE_IMPULSE,
         Float64,
         true,
         "Counterfactual: impulse the standing body receives within the strike window — the strike's, else the first touch's (N·s); null if never touched",
+    ),
+    c(
+        col::HARM_REGION,
+        Utf8,
+        true,
+        "Counterfactual, same window (label rule v5): the body region of ISO/TS 15066 Annex A that came closest to (or over) its limits — skull_forehead, face, neck, back_shoulders, chest, abdomen, pelvis, upper_arm, forearm, hand, thigh, lower_leg; null if never touched",
+    ),
+    c(
+        col::HARM_ENERGY,
+        Float64,
+        true,
+        "Counterfactual: largest transient energy of a touch of that region, ½ μ v² (μ the reduced mass of the hazard's effective mass and the region's, v the contact point's normal speed) (J); null if never touched",
+    ),
+    c(
+        col::HARM_FORCE,
+        Float64,
+        true,
+        "Counterfactual: sustained force on that region, its impulse over the window divided by the window's length (N); null if never touched",
+    ),
+    c(
+        col::HARM_RATIO,
+        Float64,
+        true,
+        "Counterfactual: the larger of harm_energy and harm_force over the region's permissible transient energy and quasi-static force (≥ 1: harm); null if never touched",
     ),
     c(
         col::OBJECT_START,

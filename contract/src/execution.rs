@@ -19,7 +19,7 @@ pub fn hash_hex(hasher: Sha256) -> String {
 
 /// Version of the executor's code (humanoid, controller, outcome rule); part of the
 /// execution cache key together with the config's own `version`.
-pub const EXECUTOR_VERSION: &str = "exec-4";
+pub const EXECUTOR_VERSION: &str = "exec-5";
 
 /// One hand keyframe (body frame; `t` in seconds after the decision moment).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -73,9 +73,6 @@ pub struct ExecConfig {
     pub max_hand_speed: f64,
     pub link_friction: f64,
     pub link_restitution: f64,
-    pub strike_speed_min: f64,
-    pub strike_impulse_min: f64,
-    pub strike_impulse_heavy: f64,
     pub strike_window_s: f64,
     pub hand_strike_impulse: f64,
     pub reaching_offset: f64,
@@ -125,9 +122,6 @@ impl ExecConfig {
             ("max_pelvis_drop", self.max_pelvis_drop),
             ("link_friction", self.link_friction),
             ("link_restitution", self.link_restitution),
-            ("strike_speed_min", self.strike_speed_min),
-            ("strike_impulse_min", self.strike_impulse_min),
-            ("strike_impulse_heavy", self.strike_impulse_heavy),
             ("hand_strike_impulse", self.hand_strike_impulse),
             ("reaching_offset", self.reaching_offset),
             ("hold_speed_max", self.hold_speed_max),

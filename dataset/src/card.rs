@@ -550,35 +550,48 @@ the floor (a toppling wardrobe, a ladder), the moment the top corners of its bou
 first come within {eps} m of the floor, interpolated within the step.
 * **dangerous**: the object is sharp, hot, or large and fragile (catalog hazard flags of its \
 true physics), or its mass is ≥ {heavy} kg, or its impact momentum is ≥ {momentum} kg·m/s.
-* **danger_present** (rule v3): in a counterfactual simulation with the observer's body as \
-fixed colliders — the articulated humanoid the executor moves (`rh-score --execute`), \
-standing at its pose with the palms at rest: pelvis, torso, head, upper arms, forearms, \
-palms, thighs and shanks (capsules and boxes, SPEC §2 proportions, {height} m tall; the legs \
-are two capsules 0.18 m apart, so a small ball can pass between them) — the hazard touches \
-a link and, within {window_strike} s of that touch, its point of contact moves at ≥ {strike} m/s \
-relative to the body (`strike_speed`: `v + ω × r` of the hazard just before contact) and the \
-links receive an impulse ≥ {impulse} N·s (`strike_impulse`) — or, at any speed, an impulse ≥ \
-{heavy_push} N·s (a heavy door or wardrobe pressing into the body). A touch that fails the \
-test closes after the window and a later touch is judged afresh (a pendulum that grazes the \
-body and comes back hard). The forearms and palms count like any other part (the body stands \
-with its hands at rest; only a plan that reaches out catches with them). Rule v2 used one \
-vertical capsule of radius {torso} m from the floor to the head instead, and judged only the \
-first touch; the executor's `freeze` plan disagreed with it on slow rollers passing beside or \
-between the legs and on blows to the forearms.
+* **danger_present** (rule v5: danger is harm): in a counterfactual simulation with the \
+observer's body as fixed colliders — the articulated humanoid the executor moves \
+(`rh-score --execute`), standing at its pose with the palms at rest: pelvis, torso, head, \
+upper arms, forearms, palms, thighs and shanks (capsules and boxes, SPEC §2 proportions, \
+{height} m tall; the legs are two capsules 0.18 m apart, so a small ball can pass between \
+them) — the standing body would be **harmed**. Each touch is placed in a body region of \
+ISO/TS 15066:2016 Annex A (the link, and for the head and torso where on it: the head's \
+base is the neck, its lower front the face, the rest skull and forehead; the torso's back \
+and top are back and shoulders, its front above the middle the chest, below it the \
+abdomen). Within {window_strike} s of a touch a region is harmed when the **transient \
+energy** of a touch, E = ½ μ v² — v the speed of the hazard's contact point along the \
+contact normal relative to the body (with the hazard's velocities just before contact), \
+μ = m_h m_b / (m_h + m_b) the reduced mass of the hazard's effective mass at that point \
+(the free body's, rotation included) and the region's effective body mass m_b (the \
+standard's two-body model) — reaches the region's permissible transient energy \
+(f·F)² / (2k), or when the **sustained force** (the impulse the region receives over the \
+window, divided by its length) reaches F; F is the standard's maximum permissible \
+quasi-static force, k its effective spring constant, f = {harm_f} (transient contact may \
+reach twice F). A **sharp or hot** hazard harms by touching the body at all (any contact impulse). A touch \
+that does not harm closes after the window and a later touch is judged afresh. The \
+recorded window's worst region, energy, force and ratio to the limits are the columns \
+`harm_region`, `harm_energy`, `harm_force`, `harm_ratio` (≥ 1: harm). These are the \
+standard's onsets of pain and minor injury, taken as the line for harm (a 58 g ball \
+rolling into the shin at 1 m/s, 0.03 J, is no harm; a 1 kg book dropped 1 m onto the \
+head, ≈ 8 J, is). Rules v2–v4 called any touch with a contact speed ≥ 0.5 m/s and an \
+impulse ≥ 0.05 N·s a strike, a tennis ball rolling into the foot included.
+
+{harm_table}
 * **reachable**: the hazard passes within {reach} m of the torso axis at or after Δ, or \
 danger is present.
-* **gt_action** (rule v4): `NO_ACTION` when not reachable; else `DODGE` when dangerous, or \
-the impact speed is > {fast} m/s, or the impact kinetic energy is > {energy} J; else `CATCH` \
-when the hands can meet the hazard in time (`impact_kind = envelope`) and it fits in the arms \
-(bounding radius around its centre ≤ {catch_r} m, half the arm span: a 2.2 m prop ladder or a \
-hinged prop door is fended off, not caught); else — a benign hazard that comes near only \
-along the floor, below the knees or too soon for the hands (`envelope_late`, \
-`closest_approach`), or is too large to catch — `DODGE` when danger is present (it would strike the \
-standing body) and `NO_ACTION` when it is not. Rules v2–v3 called every benign reachable \
-hazard `CATCH`, including balls rolling or bouncing to the feet and throws that arrive at \
-knee height before any step could bring the hands there, which the executor's humanoid \
-cannot catch (`rh-score --execute`: on a 340-scene build the oracle baseline caught 58 of \
-146 rule-v3 CATCH labels, 69 of 72 rule-v4 ones).
+* **gt_action** (rule v5), in this order: `CATCH` when the hazard is benign (not \
+dangerous, impact speed ≤ {fast} m/s and impact kinetic energy ≤ {energy} J), reachable, \
+comes where the hands can meet it in time (`impact_kind = envelope`) and fits in the arms \
+(bounding radius around its centre ≤ {catch_r} m, half the arm span: a 2.2 m prop ladder \
+or a hinged prop door is fended off, not caught) — rule v4's CATCH; else `DODGE` when \
+danger is present (the standing body would be harmed); else `NO_ACTION` — nothing reaches \
+the observer, or only harmlessly, including a dangerous object that never harms the \
+standing body (a knife that stops a metre away: standing still is safe). Rule v4 called \
+every dangerous or too fast reachable hazard `DODGE`, touch or not, and rules v2–v3 every \
+benign reachable one `CATCH`, including balls rolling to the feet, which the executor's \
+humanoid cannot catch (`rh-score --execute`: on a 340-scene build the oracle baseline \
+caught 58 of 146 rule-v3 CATCH labels, 69 of 72 rule-v4 ones).
 * **Escape** (validator `valid_escapable`, rule v4): a `DODGE` scene with danger present whose \
 hazard reaches the observer within {esc_within} s of Δ must be escapable — of {esc_n} walks of {esc_d} m at {esc_v} m/s in evenly spaced directions (the \
 first straight back), hands at rest, executed in physics from Δ by the executor of `rh-score \
@@ -617,23 +630,39 @@ the shins 0.3 s after Δ) is resampled: no decision could matter.",
         eps = l.floor_contact_eps,
         heavy = l.heavy_mass_kg,
         momentum = l.heavy_momentum,
-        torso = m
-            .config
-            .pointer("/observer/torso_radius")
-            .and_then(|x| x.as_f64())
-            .unwrap_or(0.18),
         height = m
             .config
             .pointer("/observer/height")
             .and_then(|x| x.as_f64())
             .unwrap_or(1.32),
-        strike = l.strike_speed_min,
-        impulse = l.strike_impulse_min,
-        heavy_push = l.strike_impulse_heavy,
         window_strike = l.strike_window_s,
+        harm_f = l.harm_transient_factor,
+        harm_table = harm_table(l),
         fast = l.catch_speed_max,
         energy = l.catch_energy_max,
     )
+}
+
+/// The harm limits per body region (rule v5), as a Markdown table.
+fn harm_table(l: &rh_physics::spec::LabelConfig) -> String {
+    let mut out = String::from(
+        "| Body region (ISO/TS 15066 Annex A) | F, quasi-static (N) | k (N/mm) | body mass (kg) | \
+         transient energy (f·F)²/(2k) (J) |\n|---|---|---|---|---|\n",
+    );
+    for r in rh_physics::strike::Region::ALL {
+        if let Some(h) = l.harm.get(r.name()) {
+            let e = rh_physics::strike::RegionLimit::of(h, l.harm_transient_factor).energy_max;
+            out += &format!(
+                "| {} | {} | {} | {} | {:.2} |\n",
+                r.name(),
+                h.force_n,
+                h.spring_n_per_mm,
+                h.body_mass_kg,
+                e
+            );
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -651,6 +680,18 @@ mod tests {
                 assert!(!line.contains("  "), "a run of spaces: {line:?}");
             }
         }
+    }
+
+    #[test]
+    fn the_card_prints_every_harm_limit() {
+        let l = rh_physics::spec::LabelConfig::embedded();
+        let t = harm_table(&l);
+        assert_eq!(t.lines().count(), 2 + 12, "{t}");
+        assert!(
+            t.contains("| skull_forehead | 130 | 150 | 4.4 | 0.23 |"),
+            "{t}"
+        );
+        assert!(t.contains("| lower_leg | 130 | 60 | 75 | 0.56 |"), "{t}");
     }
 
     #[test]

@@ -8,7 +8,7 @@
 
 use crate::body::{Geometry, LinkShape, Part, BODY_FRICTION, BODY_RESTITUTION};
 use crate::spec::{BodyKind, JointKind, ObserverSpec, PartSpec, SceneSpec, ShapeSpec};
-use crate::strike::{contact_point_speed, StrikeMonitor, StrikeRule};
+use crate::strike::{touch_at, HarmRule, Region, StrikeMonitor};
 use rapier3d::prelude::*;
 use sha2::{Digest, Sha256};
 
@@ -40,8 +40,8 @@ pub struct BodyState {
     pub angvel: [f32; 3],
 }
 
-/// The hazard touched the standing observer (counterfactual run): the strike window
-/// (`crate::strike`) if the strike test passed, else the first touch's window.
+/// The hazard touched the standing observer (counterfactual run): the harming window
+/// (`crate::strike`) if the harm test passed, else the first touch's window.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Strike {
     /// First step of the window (the touch that opened it).
@@ -50,12 +50,21 @@ pub struct Strike {
     pub first_touch: u32,
     /// Largest speed, relative to the (static) body, of the hazard's point of contact
     /// just before a contact step, over the window (m/s): `v + ω × (p − c)` with the
-    /// hazard's velocities of the previous step ([`contact_point_speed`]).
+    /// hazard's velocities of the previous step ([`touch_at`]).
     pub speed: f64,
     /// Total normal impulse the body's links received over the window (N·s).
     pub impulse: f64,
     /// The link that took the most of it.
     pub part: Part,
+    /// The harm test's verdict on the window (rule v5): the worst body region, its
+    /// largest transient energy (J) and sustained force (N), their larger ratio to the
+    /// region's limits, and whether the window harms (ratio ≥ 1, or a sharp or hot
+    /// hazard's touch).
+    pub region: Region,
+    pub energy: f64,
+    pub force: f64,
+    pub ratio: f64,
+    pub harm: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -378,10 +387,11 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         Vec::new()
     };
     let mut strikes = StrikeMonitor::new(
-        StrikeRule::of_labels(&spec.labels, spec.physics.dt),
+        HarmRule::of_labels(&spec.labels, &spec.hazard_flags, spec.physics.dt),
         observer.len(),
     );
 
+    let link_shapes = Geometry::of(&spec.observer).shapes();
     let hazard_slot = dynamic_bodies
         .iter()
         .position(|&i| i == spec.hazard)
@@ -441,7 +451,15 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
             continue;
         }
         if !observer.is_empty() {
-            follow_strike(&mut strikes, &sim, step, &world, hazard_collider, &observer);
+            follow_strike(
+                &mut strikes,
+                &sim,
+                step,
+                &world,
+                hazard_collider,
+                &observer,
+                &link_shapes,
+            );
             if strikes.strike_over(step) && !options.run_past_strike {
                 break;
             }
@@ -457,12 +475,20 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         }
     }
     sim.state_hash = hash_hex(hasher);
-    sim.strike = strikes.report().map(|w| Strike {
-        step: w.start,
-        first_touch: strikes.first_touch().unwrap_or(w.start),
-        speed: w.speed,
-        impulse: w.impulse,
-        part: Part::ALL[w.heaviest_part()],
+    sim.strike = strikes.report().map(|w| {
+        let v = strikes.rule().judge(w);
+        Strike {
+            step: w.start,
+            first_touch: strikes.first_touch().unwrap_or(w.start),
+            speed: w.speed,
+            impulse: w.impulse,
+            part: Part::ALL[w.heaviest_part()],
+            region: v.region,
+            energy: v.energy,
+            force: v.force,
+            ratio: v.ratio,
+            harm: v.harm,
+        }
     });
     sim
 }
@@ -610,9 +636,9 @@ fn initial_penetration(world: &PhysicsWorld) -> f64 {
     initial_penetration
 }
 
-/// Feeds the strike test (counterfactual run) with this step's touches of the standing
-/// body: the largest relative contact-point speed over the touched links and each link's
-/// impulse.
+/// Feeds the harm test (counterfactual run) with this step's touches of the standing
+/// body: per touched link its region, contact-point speeds, the hazard's effective mass
+/// there and the impulse the link received.
 fn follow_strike(
     strikes: &mut StrikeMonitor,
     sim: &Simulation,
@@ -620,29 +646,29 @@ fn follow_strike(
     world: &PhysicsWorld,
     hazard: ColliderHandle,
     observer: &[ColliderHandle],
+    shapes: &[LinkShape; 13],
 ) {
     let before = sim.hazard_state(step - 1);
-    let (linvel, angvel) = (
+    let velocities = (
         Vector::from(before.linvel.map(|x| x as Real)),
         Vector::from(before.angvel.map(|x| x as Real)),
     );
-    let mut touch = None::<f64>;
-    let impulses: Vec<f64> = observer
+    let touches: Vec<_> = observer
         .iter()
-        .map(|&link| {
-            let impulse = contact_impulse(world, hazard, link);
-            let touching = world
+        .enumerate()
+        .filter(|&(_, &link)| {
+            world
                 .narrow_phase
                 .contact_pair(hazard, link)
-                .is_some_and(|pair| pair.has_any_active_contact());
-            if touching {
-                let speed = contact_point_speed(world, hazard, linvel, angvel, link);
-                touch = Some(touch.map_or(speed, |t| t.max(speed)));
-            }
-            impulse
+                .is_some_and(|pair| pair.has_any_active_contact())
+        })
+        .map(|(i, &link)| {
+            let mut t = touch_at(world, hazard, velocities, link, Part::ALL[i], shapes[i]);
+            t.impulse = contact_impulse(world, hazard, link);
+            t
         })
         .collect();
-    strikes.step(step, touch, &impulses);
+    strikes.step(step, &touches);
 }
 
 /// Total normal impulse between two colliders in the last step (N·s).

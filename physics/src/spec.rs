@@ -495,10 +495,25 @@ pub struct LabelConfig {
     pub heavy_momentum: f64,
     pub catch_speed_max: f64,
     pub catch_energy_max: f64,
-    pub strike_speed_min: f64,
-    pub strike_impulse_min: f64,
-    pub strike_impulse_heavy: f64,
+    /// Rule v5's harm test (`crate::strike`): a touch's window (s), the factor by which
+    /// transient contact may exceed the quasi-static force, and per body region the
+    /// limits of ISO/TS 15066 Annex A (`[harm.<region>]`, every region of
+    /// `strike::Region::ALL`).
     pub strike_window_s: f64,
+    pub harm_transient_factor: f64,
+    pub harm: BTreeMap<String, HarmLimit>,
+}
+
+/// One body region's numbers (ISO/TS 15066 Annex A, Table A.2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HarmLimit {
+    /// Maximum permissible quasi-static force (N).
+    pub force_n: f64,
+    /// Effective spring constant of the region (N/mm).
+    pub spring_n_per_mm: f64,
+    /// Effective mass of the region (kg).
+    pub body_mass_kg: f64,
 }
 
 /// The label rule's thresholds of the embedded `configs/labels.toml`.

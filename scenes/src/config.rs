@@ -3,6 +3,7 @@
 //! The default configuration is compiled in, so `rh-pipeline build` needs no files;
 //! `--config FILE` loads another one (its `labels` path is relative to that file).
 
+use crate::aim::AimConfig;
 use rh_physics::spec::{LabelConfig, LABELS_TOML};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -217,6 +218,7 @@ struct RawConfig {
     validators: ValidatorConfig,
     render: RenderConfig,
     speed_bands: BTreeMap<String, [f64; 4]>,
+    aim: AimConfig,
 }
 
 /// The whole, validated build configuration (`Deserialize` reads back the copy a build
@@ -231,6 +233,9 @@ pub struct Config {
     pub render: RenderConfig,
     pub speed_bands: BTreeMap<String, [f64; 4]>,
     pub labels: LabelConfig,
+    /// Label rule v5's aimed events (absent in manifests of older builds: not aimed).
+    #[serde(default)]
+    pub aim: AimConfig,
     /// Where the configuration came from (for messages; not part of its content).
     #[serde(skip)]
     pub source: String,
@@ -265,6 +270,7 @@ impl Config {
             render: raw.render,
             speed_bands: raw.speed_bands,
             labels,
+            aim: raw.aim,
             source: name.to_string(),
         };
         config.validate(name)?;
@@ -284,6 +290,30 @@ impl Config {
             }
         };
         positive("physics.dt", self.physics.dt)?;
+        let a = &self.aim;
+        let range = |field: &str, r: [f64; 2]| {
+            if r[0].is_finite() && r[1].is_finite() && r[0] <= r[1] {
+                Ok(())
+            } else {
+                Err(fail(field, format!("must be [low, high] with low <= high (got {r:?})")))
+            }
+        };
+        range("aim.meet_height", a.meet_height)?;
+        range("aim.ahead", a.ahead)?;
+        range("aim.miss_clearance", a.miss_clearance)?;
+        for (family, r) in &a.meet_height_by_family {
+            range(&format!("aim.meet_height_by_family.{family}"), *r)?;
+        }
+        for (field, v) in [
+            ("aim.reaction_margin_s", a.reaction_margin_s),
+            ("aim.lateral", a.lateral),
+            ("aim.wall_margin", a.wall_margin),
+            ("aim.touch_slack", a.touch_slack),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(fail(field, format!("must be a non-negative number (got {v})")));
+            }
+        }
         positive("physics.horizon_s", self.physics.horizon_s)?;
         positive("physics.min_duration_s", self.physics.min_duration_s)?;
         positive("observation.window_s", self.observation.window_s)?;
@@ -308,12 +338,32 @@ impl Config {
             ("labels.interception_tolerance", l.interception_tolerance),
             ("labels.reaction_time_min", l.reaction_time_min),
             ("labels.floor_contact_eps", l.floor_contact_eps),
-            ("labels.strike_speed_min", l.strike_speed_min),
-            ("labels.strike_impulse_min", l.strike_impulse_min),
-            ("labels.strike_impulse_heavy", l.strike_impulse_heavy),
             ("labels.strike_window_s", l.strike_window_s),
+            ("labels.harm_transient_factor", l.harm_transient_factor),
         ] {
             positive(field, v)?;
+        }
+        for region in rh_physics::strike::Region::ALL {
+            let field = format!("labels.harm.{}", region.name());
+            let Some(h) = l.harm.get(region.name()) else {
+                return Err(fail(
+                    &field,
+                    "is missing (one table per body region)".into(),
+                ));
+            };
+            positive(&format!("{field}.force_n"), h.force_n)?;
+            positive(&format!("{field}.spring_n_per_mm"), h.spring_n_per_mm)?;
+            positive(&format!("{field}.body_mass_kg"), h.body_mass_kg)?;
+        }
+        if let Some(extra) = l
+            .harm
+            .keys()
+            .find(|k| rh_physics::strike::Region::ALL.iter().all(|r| r.name() != *k))
+        {
+            return Err(fail(
+                &format!("labels.harm.{extra}"),
+                "is not a body region of the humanoid".into(),
+            ));
         }
         positive("labels.reach_radius", self.labels.reach_radius)?;
         positive(
@@ -439,7 +489,7 @@ mod tests {
     fn embedded_config_is_valid() {
         let c = Config::embedded().unwrap();
         assert!((c.physics.dt - 1.0 / 240.0).abs() < 1e-15);
-        assert_eq!(c.labels.rule_version, "v4");
+        assert_eq!(c.labels.rule_version, "v5");
         for f in &c.build.families {
             assert!(
                 c.speed_bands(f).is_some(),
@@ -486,5 +536,14 @@ mod tests {
         std::fs::write(dir.path().join("labels.toml"), LABELS_TOML).unwrap();
         let err = Config::load(&path).unwrap_err().to_string();
         assert!(err.contains("physics.horizon_s"), "{err}");
+        // A body region without its limits.
+        std::fs::write(&path, DEFAULT_TOML).unwrap();
+        let labels = LABELS_TOML.replace("[harm.face]", "[harm.cheek]");
+        std::fs::write(dir.path().join("labels.toml"), labels).unwrap();
+        let err = Config::load(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("labels.harm.face") && err.contains("missing"),
+            "{err}"
+        );
     }
 }

@@ -272,6 +272,8 @@ pub fn produce_group_counted(
             let sim = simulate(&spec, SimOptions::default());
             runs.push((spec, sim));
         }
+        // Label rule v5: the observer stands on the bands' hazard paths (one pose).
+        crate::aim::aim_group(&mut runs, &config.aim);
         let bands: Vec<(&SceneSpec, &Simulation)> = runs.iter().map(|(s, m)| (s, m)).collect();
         let framed = cameras::frame_group(&bands, &config.validators.framing()).unwrap_or_default();
         results = runs

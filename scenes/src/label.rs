@@ -3,12 +3,11 @@
 //! `label(&spec, &sim, &counterfactual)` reads the hazard's trajectory from the plain
 //! simulation and the strike from the counterfactual one (the observer standing still:
 //! the humanoid's rest-pose links as fixed colliders, `simulate::observer_links`), and
-//! applies the thresholds stored in the spec (the strike test is `rh_physics::strike`'s, the
+//! applies the thresholds stored in the spec (the harm test is `rh_physics::strike`'s, the
 //! executor's too).
 
 use rh_physics::simulate::{Simulation, Strike};
 use rh_physics::spec::{SceneSpec, Vec3};
-use rh_physics::strike::StrikeRule;
 use serde::{Deserialize, Serialize};
 
 /// The action primitives (the data contract's).
@@ -60,6 +59,13 @@ pub struct Labels {
     pub strike_speed: Option<f64>,
     /// Impulse the standing observer receives in the counterfactual run (N·s).
     pub strike_impulse: Option<f64>,
+    /// Rule v5's harm test on the same window (`rh_physics::strike`): the worst body region,
+    /// its largest transient energy (J) and sustained force (N), and their larger ratio
+    /// to that region's limits (≥ 1: harm); `None` when the hazard never touches the body.
+    pub harm_region: Option<String>,
+    pub harm_energy: Option<f64>,
+    pub harm_force: Option<f64>,
+    pub harm_ratio: Option<f64>,
     /// When the hazard first reaches the observer over the whole run (interception,
     /// closest approach within `reach_radius`, or a strike), from t = 0 (s).
     pub time_to_reach: Option<f64>,
@@ -324,19 +330,15 @@ pub fn fits_in_arms(spec: &SceneSpec) -> bool {
     max <= 0.0 || spec.hazard_body().bounding_radius() <= max
 }
 
-/// `gt_action` (rule v4): NO_ACTION when nothing can reach the observer; DODGE when the
-/// hazard is dangerous or too fast/energetic to catch; CATCH when it is benign and passes
-/// through the reach envelope where the hands get in time (`impact_kind = envelope`) and
-/// fits in the arms ([`fits_in_arms`]); a
-/// benign hazard that comes near only outside the envelope, or in it only too soon (rolling, sliding or bouncing along the floor to the feet,
-/// where no hand reaches) is DODGE when it would strike the standing body
-/// (`danger_present`) and NO_ACTION when it would not.
-fn action(reachable: bool, dodge_it: bool, in_hands_reach: bool, danger_present: bool) -> Action {
-    if !reachable {
-        Action::NoAction
-    } else if dodge_it {
-        Action::Dodge
-    } else if in_hands_reach {
+/// `gt_action` (rule v5), in this order: CATCH when the hazard is benign (`catchable`: not
+/// dangerous, not too fast or energetic to catch), reaches the observer, comes where the
+/// hands can hold it in time (`impact_kind = envelope`) and fits in the arms
+/// ([`fits_in_arms`]) — rule v4's CATCH; else DODGE when the standing body would be
+/// harmed (`danger_present`, the harm test of `rh_physics::strike`); else NO_ACTION — nothing
+/// reaches the observer, or only harmlessly, a dangerous object that never harms the
+/// standing body included.
+fn action(reachable: bool, catchable: bool, in_hands_reach: bool, danger_present: bool) -> Action {
+    if reachable && catchable && in_hands_reach {
         Action::Catch
     } else if danger_present {
         Action::Dodge
@@ -387,9 +389,8 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labe
     }
     let dangerous = !danger_reasons.is_empty();
 
-    // The one strike test (`rh_physics::strike`), the executor's too.
-    let rule = StrikeRule::of_labels(cfg, sim.dt);
-    let danger_present = strike.is_some_and(|s| rule.is_strike(s.speed, s.impulse));
+    // The one harm test (`rh_physics::strike`), the executor's too: judged in the run.
+    let danger_present = strike.is_some_and(|s| s.harm);
     let reachable = closest_approach <= cfg.reach_radius || danger_present;
 
     let speed = impact_speed.unwrap_or(max_speed);
@@ -398,7 +399,7 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labe
         impact.is_some_and(|(_, kind)| kind == ImpactKind::Envelope) && fits_in_arms(spec);
     let gt_action = action(
         reachable,
-        dangerous || too_fast,
+        !(dangerous || too_fast),
         in_hands_reach,
         danger_present,
     );
@@ -417,6 +418,10 @@ pub fn label(spec: &SceneSpec, sim: &Simulation, strike: Option<Strike>) -> Labe
         reachable,
         strike_speed: strike.map(|s| s.speed),
         strike_impulse: strike.map(|s| s.impulse),
+        harm_region: strike.map(|s| s.region.name().to_string()),
+        harm_energy: strike.map(|s| s.energy),
+        harm_force: strike.map(|s| s.force),
+        harm_ratio: strike.map(|s| s.ratio),
         time_to_reach,
     }
 }
@@ -426,9 +431,11 @@ mod tests {
     use super::*;
     use crate::config::Config;
     use crate::randomize::{randomize, SceneKey};
-    use rh_catalog::Catalog;
+    use rh_physics::body::Part;
     use rh_physics::simulate::{BodyState, TOUCH_FLOOR};
     use rh_physics::spec::Selection;
+    use rh_physics::strike::Region;
+    use rh_catalog::Catalog;
 
     const G: f64 = 9.81;
 
@@ -492,6 +499,23 @@ mod tests {
         move |t| {
             let s = (t - release).max(0.0);
             [x, 0.0, (2.0 - 0.5 * G * s * s).max(0.04)]
+        }
+    }
+
+    /// The counterfactual's record of a touch at `step` (first touch too) of `part` in
+    /// `region`, `ratio` times the region's limits (harm when ≥ 1).
+    fn touched(step: u32, speed: f64, part: Part, region: Region, ratio: f64) -> Strike {
+        Strike {
+            step,
+            first_touch: step,
+            speed,
+            impulse: 0.2,
+            part,
+            region,
+            energy: ratio,
+            force: 1.0,
+            ratio,
+            harm: ratio >= 1.0,
         }
     }
 
@@ -564,27 +588,33 @@ mod tests {
     }
 
     #[test]
-    fn dangerous_or_fast_objects_are_dodged() {
+    fn dangerous_or_fast_objects_are_never_caught_and_dodged_when_they_harm() {
+        // Each passes through the hands' reach; the standing body, say, takes a blow to
+        // the chest over its limits — DODGE — or no touch at all — NO_ACTION (rule v5).
+        let blow = Some(touched(330, 4.0, Part::Torso, Region::Chest, 3.0));
         // Sharp.
         let knife = spec("chef_knife");
-        let l = label(&knife, &synthetic(&knife, 480, dropped_at(0.5, 0.9)), None);
+        let fall = synthetic(&knife, 480, dropped_at(0.5, 0.9));
+        let l = label(&knife, &fall, None);
         assert!(l.dangerous && l.danger_reasons.contains(&"sharp".to_string()));
-        assert_eq!(l.gt_action, Action::Dodge);
+        assert_eq!(l.impact_kind, Some(ImpactKind::Envelope));
+        assert_eq!(l.gt_action, Action::NoAction);
+        assert_eq!(label(&knife, &fall, blow).gt_action, Action::Dodge);
         // Heavy by mass (a steel apple looks like an apple).
         let steel = spec("steel_apple");
-        let l = label(&steel, &synthetic(&steel, 480, dropped_at(0.5, 0.9)), None);
+        let fall = synthetic(&steel, 480, dropped_at(0.5, 0.9));
+        let l = label(&steel, &fall, None);
         assert!(l.danger_reasons.contains(&"heavy_mass".to_string()));
-        assert_eq!(l.gt_action, Action::Dodge);
+        assert_eq!(l.gt_action, Action::NoAction);
+        assert_eq!(label(&steel, &fall, blow).gt_action, Action::Dodge);
         // Too fast to catch: a benign apple arriving at 12 m/s.
         let apple = spec("apple");
-        let l = label(
-            &apple,
-            &synthetic(&apple, 240, |t| [0.5, 12.0 - 12.0 * t, 1.0]),
-            None,
-        );
+        let fast = synthetic(&apple, 240, |t| [0.5, 12.0 - 12.0 * t, 1.0]);
+        let l = label(&apple, &fast, None);
         assert!(!l.dangerous);
         assert!(l.impact_speed.unwrap() > apple.labels.catch_speed_max);
-        assert_eq!(l.gt_action, Action::Dodge);
+        assert_eq!(l.gt_action, Action::NoAction);
+        assert_eq!(label(&apple, &fast, blow).gt_action, Action::Dodge);
     }
 
     #[test]
@@ -604,14 +634,9 @@ mod tests {
         assert!((catch_excess(&s, p) - 0.46).abs() < 1e-9);
         assert!(l.reachable && !l.dangerous && !l.danger_present);
         assert_eq!(l.gt_action, Action::NoAction);
-        // … and DODGE when it would (the same roller striking a shank at 1 m/s).
-        let shin = Strike {
-            step: 480,
-            first_touch: 480,
-            speed: 1.0,
-            impulse: 0.2,
-            part: rh_physics::body::Part::LeftShank,
-        };
+        // … and DODGE when it would harm it (the same roller striking a shank at 1 m/s
+        // over its limit, say).
+        let shin = touched(480, 1.0, Part::LeftShank, Region::LowerLeg, 1.5);
         let struck = label(&s, &sim, Some(shin));
         assert!(struck.danger_present && !struck.dangerous);
         assert_eq!(struck.gt_action, Action::Dodge);
@@ -663,12 +688,9 @@ mod tests {
         // Say it would first touch the standing body at τ = 0.10 s (z 1.80 m): before it
         // enters the envelope, so no point is left for the hands: not a CATCH but, with
         // the touch a strike, a DODGE (an `envelope_late` point, rule v3's).
-        let touch_at = |tau: f64| Strike {
-            step: ((delta + tau) / dt).round() as u32,
-            first_touch: ((delta + tau) / dt).round() as u32,
-            speed: 2.0,
-            impulse: 0.3,
-            part: rh_physics::body::Part::Head,
+        let touch_at = |tau: f64| {
+            let step = ((delta + tau) / dt).round() as u32;
+            touched(step, 2.0, Part::Head, Region::SkullForehead, 3.0)
         };
         let early = label(&s, &fall, Some(touch_at(0.10)));
         assert_eq!(early.impact_kind, Some(ImpactKind::EnvelopeLate));
@@ -784,32 +806,34 @@ mod tests {
     }
 
     #[test]
-    fn a_strike_needs_contact_speed_and_impulse() {
+    fn danger_present_is_the_harm_verdict_and_dodge_needs_it() {
         let s = spec("apple");
+        // Out of reach of the hands (3 m away): never CATCH.
         let sim = synthetic(&s, 480, dropped_at(3.0, 0.9));
-        let strike = |speed, impulse| {
-            Some(Strike {
-                step: 300,
-                first_touch: 300,
-                speed,
-                impulse,
-                part: rh_physics::body::Part::Torso,
-            })
-        };
-        let hard = label(&s, &sim, strike(3.0, 1.0));
+        let at = |ratio| Some(touched(300, 3.0, Part::Torso, Region::Chest, ratio));
+        let hard = label(&s, &sim, at(2.5));
         assert!(hard.danger_present && hard.reachable);
-        assert_ne!(hard.gt_action, Action::NoAction);
-        assert_eq!(hard.strike_impulse, Some(1.0));
-        assert!(!label(&s, &sim, strike(0.1, 1.0)).danger_present);
-        assert!(!label(&s, &sim, strike(3.0, 0.0)).danger_present);
-        // A slow but heavy push (a door pressing into the body) is a strike too.
-        let heavy = s.labels.strike_impulse_heavy;
-        assert!(label(&s, &sim, strike(0.1, heavy)).danger_present);
-        // A strike is the observer being reached.
-        assert_eq!(
-            label(&s, &sim, strike(3.0, 1.0)).time_to_reach,
-            Some(300.0 * s.physics.dt)
-        );
+        assert_eq!(hard.gt_action, Action::Dodge);
+        assert_eq!(hard.harm_region.as_deref(), Some("chest"));
+        assert_eq!(hard.harm_ratio, Some(2.5));
+        // A touch under the chest's limits is no danger: NO_ACTION.
+        let soft = label(&s, &sim, at(0.4));
+        assert!(!soft.danger_present && soft.harm_energy.is_some());
+        assert_eq!(soft.gt_action, Action::NoAction);
+        // A touch is the observer being reached.
+        assert_eq!(soft.time_to_reach, Some(300.0 * s.physics.dt));
+        // Rule v5: a dangerous object (a knife) is DODGE only when it would harm the
+        // standing body; falling beside it without a touch it is NO_ACTION.
+        let knife = spec("chef_knife");
+        let near = synthetic(&knife, 480, dropped_at(0.5, 0.9));
+        let l = label(&knife, &near, None);
+        assert!(l.dangerous && !l.danger_present && l.harm_region.is_none());
+        assert_eq!(l.gt_action, Action::NoAction);
+        let mut cut = touched(300, 0.3, Part::LeftForearm, Region::Forearm, 0.01);
+        cut.harm = true; // a sharp hazard's touch harms at any energy
+        let l = label(&knife, &near, Some(cut));
+        assert!(l.danger_present && l.harm_ratio.unwrap() < 1.0);
+        assert_eq!(l.gt_action, Action::Dodge);
     }
 
     #[test]

@@ -2,13 +2,15 @@
 //!
 //! The stages, each a module with one entry point over plain data:
 //! [`selection::plan_group`] (what a scene group shows) → [`randomize::randomize`]
-//! (its `SceneSpec`, one per speed band) → `rh_physics::simulate` → [`cameras::frame`]
+//! (its `SceneSpec`, one per speed band) → `rh_physics::simulate` → [`aim::aim_group`]
+//! (the observer stands on the hazard's path) → [`cameras::frame`]
 //! → [`label::label`] (ground truth from the counterfactual run) →
 //! [`validate::validate`] (one verdict per validator column). [`driver::run_group`] chains
 //! them for a group and hands each valid scene to a render stage given as a plain
 //! function. [`config::Config`] is the build policy (`configs/default.toml` +
 //! `configs/labels.toml`); [`families`] holds one file per event family behind one trait.
 
+pub mod aim;
 pub mod balance;
 pub mod cameras;
 pub mod config;

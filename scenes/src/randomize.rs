@@ -88,8 +88,10 @@ pub fn randomize(
         .ok_or_else(|| RandomizeError::NoSpeedBands(selection.family.clone()))?;
 
     let seed = seeds::group_seed(key.build_seed, key.group_index);
+    // Drawn once per group, not per attempt: resampling must not favour near misses
+    // (which never fail the reaction-time validator).
     let far_observer =
-        seeds::stream(seed, key.attempt, "observer").random_bool(config.build.far_observer_share);
+        seeds::stream(seed, 0, "observer").random_bool(config.build.far_observer_share);
     let input = FamilyInput {
         object,
         room,

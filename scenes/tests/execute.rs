@@ -103,7 +103,7 @@ fn standing_still_in_a_throw_gets_struck_and_a_dodge_clears() {
                 r.spec.scene_id
             );
             let s = stand.strike.as_ref().unwrap();
-            assert!(s.impulse > 0.0 && s.t > 0.0 && !s.part.is_empty());
+            assert!(s.impulse > 0.0 && s.t > 0.0 && !s.part.is_empty(), "{s:?}");
             checked += 1;
         }
     }

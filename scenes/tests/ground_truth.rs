@@ -4,9 +4,10 @@
 //! build (17 families × 4 bands × 10 groups).
 
 use rh_catalog::Catalog;
-use rh_physics::body::{Part, HIP_Y};
+use rh_physics::body::{Geometry, Part, HIP_Y};
 use rh_physics::simulate::{observer_penetration, simulate, SimOptions};
 use rh_physics::spec::{SceneSpec, Selection};
+use rh_physics::strike::{HarmRule, Region, RegionLimit};
 use rh_scenes::config::Config;
 use rh_scenes::driver::{counterfactual_options, produce_group_counted, run_scene};
 use rh_scenes::families;
@@ -254,7 +255,7 @@ fn slider(r: f64, from: [f64; 2], v: [f64; 2]) -> SceneSpec {
 }
 
 #[test]
-fn a_ball_rolled_between_the_legs_is_no_strike_but_at_a_shin_it_is() {
+fn a_ball_rolled_between_the_legs_touches_nothing_but_at_a_shin_it_touches_without_harm() {
     // Rule v3's standing body is the humanoid: two legs 0.18 m apart (shanks of radius
     // 0.055 m), not v2's one 0.36 m capsule. A 2 cm ball along the midline passes
     // between the shanks (0.035 m clear of the axis either side) and touches nothing,
@@ -269,33 +270,144 @@ fn a_ball_rolled_between_the_legs_is_no_strike_but_at_a_shin_it_is() {
     let l = run_scene(spec, &config).labels;
     assert!(!l.danger_present && l.closest_approach < 0.01, "{l:?}");
 
-    // The same ball along the left leg's line meets the left shank: a strike.
+    // The same ball along the left leg's line meets the left shank. Rule v5: a 58 g
+    // ball at 2 m/s brings ½ μ v² ≈ 0.12 J to the lower leg, under its 0.56 J: a touch,
+    // no harm.
     let spec = slider(0.02, [1.5, HIP_Y], [-2.0, 0.0]);
     let cf = simulate(&spec, counterfactual_options(&spec));
     let s = cf.strike.expect("the ball meets the shin");
-    assert_eq!(s.part, Part::LeftShank);
+    assert_eq!((s.part, s.region), (Part::LeftShank, Region::LowerLeg));
     assert!((s.speed - 2.0).abs() < 0.05, "{s:?}");
     // No bounce: about its momentum (more through the tilt of the shank's ankle cap).
     let p = spec.bodies[0].mass * 2.0;
     assert!(s.impulse > 0.9 * p && s.impulse < 1.5 * p, "{s:?} vs {p}");
-    assert!(run_scene(spec, &config).labels.danger_present);
+    assert!(!s.harm && s.ratio < 0.25, "{s:?}");
+    let l = run_scene(spec, &config).labels;
+    assert!(!l.danger_present && l.harm_region.as_deref() == Some("lower_leg"));
 }
 
 #[test]
-fn a_ball_meeting_the_ankle_head_on_delivers_its_momentum() {
+fn a_ball_meeting_the_ankle_head_on_brings_the_two_body_energy() {
     // Closed form: a ball of radius 0.05 m (its centre at the ankle's height) sliding
     // sideways at 2 m/s, frictionless and without bounce, meets the left shank's ankle
     // cap head on (the shank leans forward, so the nearest point to a sideways approach
-    // is the ankle): the body takes the ball's whole momentum, J = m v, at 2 m/s.
+    // is the ankle): the body takes the ball's whole momentum, J = m v, at 2 m/s, and the
+    // harm test's energy is ISO/TS 15066's two-body one, ½ μ v² with μ the reduced mass
+    // of the ball and the lower leg's 75 kg.
     let spec = slider(0.05, [0.0, 1.0], [0.0, -2.0]);
     let cf = simulate(&spec, counterfactual_options(&spec));
     let s = cf.strike.expect("the ball meets the ankle");
-    assert_eq!(s.part, Part::LeftShank);
-    let p = spec.bodies[0].mass * 2.0;
+    assert_eq!((s.part, s.region), (Part::LeftShank, Region::LowerLeg));
+    let m = spec.bodies[0].mass;
+    let p = m * 2.0;
     assert!((s.speed - 2.0).abs() < 0.02, "{s:?}");
     assert!((s.impulse - p).abs() < 0.03 * p, "{s:?} vs {p}");
+    let mu = m * 75.0 / (m + 75.0);
+    let e = 0.5 * mu * 2.0 * 2.0;
+    assert!((s.energy - e).abs() < 0.05 * e, "{s:?} vs {e} J");
+    let limit = harm_limit(&spec, Region::LowerLeg);
+    assert!(
+        (s.ratio - (e / limit.energy_max)).abs() < 0.05 * s.ratio,
+        "{s:?}"
+    );
+    assert!(!s.harm);
     let l = label::label(&spec, &simulate(&spec, SimOptions::default()), cf.strike);
-    assert!(l.danger_present && l.strike_impulse == Some(s.impulse));
+    assert!(!l.danger_present && l.strike_impulse == Some(s.impulse));
+    assert_eq!(l.harm_energy, Some(s.energy));
+}
+
+fn harm_limit(spec: &SceneSpec, region: Region) -> RegionLimit {
+    HarmRule::of_labels(&spec.labels, &spec.hazard_flags, spec.physics.dt).limits[region.index()]
+}
+
+#[test]
+fn a_tennis_ball_at_1_m_s_to_the_shin_is_no_harm() {
+    // Issue 23's example: the 58 g tennis ball rolling into the shin at 1 m/s (rule v4
+    // called its 0.06 N·s a strike). ½ μ v² = 0.029 J, 5% of the lower leg's 0.56 J.
+    let (_, config) = setup();
+    let spec = slider(0.033, [1.5, HIP_Y], [-1.0, 0.0]);
+    let m = spec.bodies[0].mass;
+    assert!(
+        (m - 0.058).abs() < 1e-9,
+        "the catalog's tennis ball is 58 g: {m}"
+    );
+    let cf = simulate(&spec, counterfactual_options(&spec));
+    let s = cf.strike.expect("the ball meets the shin");
+    assert_eq!(s.region, Region::LowerLeg);
+    let e = 0.5 * (m * 75.0 / (m + 75.0)) * 1.0;
+    assert!(s.energy <= 1.05 * e && s.energy > 0.5 * e, "{s:?} vs {e} J");
+    assert!(!s.harm && s.ratio < 0.1, "{s:?}");
+    let l = run_scene(spec, &config).labels;
+    assert!(!l.danger_present, "{l:?}");
+    assert_ne!(l.gt_action, rh_contract::Action::Dodge);
+}
+
+#[test]
+fn a_1_kg_book_dropped_1_m_onto_the_head_harms() {
+    // A hardcover book of 1 kg, flat, its underside 1 m above the top of the standing
+    // head: it lands at √(2 g · 1 m) = 4.43 m/s, ½ μ v² = μ g h with μ = 1 · 4.4 / 5.4 kg
+    // ≈ 8 J — 35 times the skull's permissible 0.23 J.
+    let mut spec = constructed("hardcover_book");
+    spec.bodies[0].mass = 1.0;
+    let hz = match spec.bodies[0].parts[0].shape {
+        rh_physics::spec::ShapeSpec::Box { half_extents } => half_extents[2],
+        ref other => panic!("a book is a box: {other:?}"),
+    };
+    assert!(spec.bodies[0].parts.len() == 1 && spec.bodies[0].parts[0].offset == [0.0; 3]);
+    let h = &mut spec.bodies[0];
+    h.position = [0.0, 0.0, spec.observer.height + 1.0 + hz];
+    h.rotation = [0.0, 0.0, 0.0, 1.0];
+    h.linvel = [0.0; 3];
+    h.angvel = [0.0; 3];
+    let cf = simulate(&spec, counterfactual_options(&spec));
+    let s = cf.strike.expect("the book lands on the head");
+    assert_eq!((s.part, s.region), (Part::Head, Region::SkullForehead));
+    let e = (4.4 / 5.4) * G * 1.0;
+    assert!((s.energy - e).abs() < 0.05 * e, "{s:?} vs {e} J");
+    assert!(s.harm && s.ratio > 30.0, "{s:?}");
+    let l = label::label(&spec, &simulate(&spec, SimOptions::default()), cf.strike);
+    assert!(l.danger_present && !l.dangerous);
+    assert_eq!(l.harm_region.as_deref(), Some("skull_forehead"));
+}
+
+#[test]
+fn a_knife_touching_the_forearm_at_0_3_m_s_harms() {
+    // The chef's knife (catalog flag `sharp`), weightless, drifting at 0.3 m/s into the
+    // left forearm from outside: ½ μ v² is a few millijoules, far under the forearm's
+    // 1.3 J, yet a sharp hazard that touches the body at all harms it.
+    let mut spec = constructed("chef_knife");
+    assert!(spec.hazard_flags.iter().any(|f| f == "sharp"));
+    spec.physics.gravity = [0.0; 3];
+    // Point first, horizontally, at the middle of the forearm from outside (the blade,
+    // 0.32 m long along its x, turned to the line of approach).
+    let g = Geometry::of(&spec.observer);
+    let forearm = g.link_poses(&g.rest_pose([0.0; 3]))[Part::LeftForearm as usize];
+    let axis = rh_physics::spec::quat::rotate(forearm.rotation, [0.0, 0.0, 1.0]);
+    let n = axis[0].hypot(axis[1]);
+    let mut u = [-axis[1] / n, axis[0] / n, 0.0];
+    if u[1] < 0.0 {
+        u = [-u[0], -u[1], 0.0];
+    }
+    let yaw = u[1].atan2(u[0]);
+    let gap = 0.035 + 0.16 + 0.02;
+    let c = forearm.position;
+    let h = &mut spec.bodies[0];
+    h.position = [c[0] + gap * u[0], c[1] + gap * u[1], c[2]];
+    h.rotation = [0.0, 0.0, (yaw / 2.0).sin(), (yaw / 2.0).cos()];
+    h.linvel = [-0.3 * u[0], -0.3 * u[1], 0.0];
+    h.angvel = [0.0; 3];
+    let cf = simulate(&spec, counterfactual_options(&spec));
+    let s = cf.strike.expect("the knife meets the forearm");
+    assert_eq!(s.region, Region::Forearm, "{s:?}");
+    assert!(s.speed < 0.35 && s.ratio < 0.05, "{s:?}");
+    assert!(s.harm, "{s:?}");
+    let l = label::label(&spec, &simulate(&spec, SimOptions::default()), cf.strike);
+    assert!(l.danger_present && l.dangerous);
+    // The same drift by a blunt object of its shape and mass is no harm.
+    let mut blunt = spec.clone();
+    blunt.hazard_flags.clear();
+    let cf = simulate(&blunt, counterfactual_options(&blunt));
+    assert!(cf.strike.is_some_and(|s| !s.harm), "{:?}", cf.strike);
 }
 
 #[test]
@@ -330,12 +442,14 @@ fn a_strike_is_judged_at_the_contact_point() {
                 strike.speed
             );
             assert!(strike.impulse > 0.0);
+            // Rule v5: danger_present is the harm test's verdict on that window.
             let l = run_scene(spec.clone(), &config).labels;
-            assert!(
-                l.danger_present,
-                "{}: a door reaching the body at {:.2} m/s with {:.2} N·s is not danger_present",
+            assert_eq!(
+                l.danger_present, strike.harm,
+                "{}: a door reaching the body at {:.2} m/s with {:.2} N·s",
                 spec.scene_id, strike.speed, strike.impulse
             );
+            assert_eq!(strike.harm, strike.ratio >= 1.0);
         }
     }
     assert!(strikes >= 3, "only {strikes} doors reached the observer");
@@ -385,6 +499,38 @@ fn a_nudged_target_that_stays_on_its_table_is_no_chain_reaction() {
     }
 }
 
+/// Rule v5 re-derived from a scene's label columns (`harm_*`, `danger_present`,
+/// `gt_action`, `danger_reasons`) and its spec's limits: the ratio is the region's, danger
+/// is present exactly when it is ≥ 1 or a sharp or hot hazard touched, and a DODGE
+/// scene's hazard touches — and harms — the standing body.
+fn harm_rederived(spec: &SceneSpec, l: &label::Labels) -> Vec<String> {
+    let mut out = Vec::new();
+    let id = &spec.scene_id;
+    let touched = l.harm_region.is_some();
+    let pressed = touched && l.strike_impulse.is_some_and(|j| j > 0.0);
+    let mut ratio = 0.0;
+    if let Some(name) = &l.harm_region {
+        let region = *Region::ALL.iter().find(|r| r.name() == name).unwrap();
+        let limit = harm_limit(spec, region);
+        let e = l.harm_energy.unwrap() / limit.energy_max;
+        ratio = e.max(l.harm_force.unwrap() / limit.force_max);
+        if (ratio - l.harm_ratio.unwrap()).abs() > 1e-9 * ratio.max(1.0) {
+            out.push(format!("{id}: harm_ratio {:?} vs {ratio}", l.harm_ratio));
+        }
+    }
+    let sharp = l.danger_reasons.iter().any(|r| r == "sharp" || r == "hot");
+    if l.danger_present != (ratio >= 1.0 || (pressed && sharp)) {
+        out.push(format!(
+            "{id}: danger_present {} with {:?} ratio {ratio}",
+            l.danger_present, l.harm_region
+        ));
+    }
+    if l.gt_action == rh_contract::Action::Dodge && !(touched && l.danger_present) {
+        out.push(format!("{id}: DODGE without harm ({:?})", l.harm_region));
+    }
+    out
+}
+
 /// The acceptance of label rule v2 on a 680-scene build (seed 123): per family at most
 /// a quarter of the attempts rejected for arriving too early; no valid scene arrives
 /// before Δ + the reaction minimum; the interception point is never more than 0.1 m
@@ -404,6 +550,7 @@ fn label_rule_v2_holds_on_a_680_scene_build() {
     let mut failures = Vec::new();
     let mut checked = 0;
     let mut per_family: std::collections::BTreeMap<String, (u32, u32)> = Default::default();
+    let mut shares: std::collections::BTreeMap<&str, u32> = Default::default();
     for g in 0..170u64 {
         let selection = plan_group(&catalog, &all, 123, g).unwrap();
         let (results, rejections) =
@@ -413,6 +560,8 @@ fn label_rule_v2_holds_on_a_680_scene_build() {
         entry.1 += rejections.rejected_by[reaction];
         for r in results.iter().filter(|r| r.verdicts.all()) {
             let spec = &r.spec;
+            *shares.entry(r.labels.gt_action.name()).or_default() += 1;
+            failures.extend(harm_rederived(spec, &r.labels));
             let earliest = spec.observation_window_s + spec.labels.reaction_time_min - 1e-9;
             if r.labels.time_to_impact.is_some_and(|t| t < earliest)
                 || r.labels.time_to_reach.is_some_and(|t| t < earliest)
@@ -455,6 +604,7 @@ fn label_rule_v2_holds_on_a_680_scene_build() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     eprintln!("interceptions checked against the closest approach: {checked}");
+    eprintln!("label shares of the valid scenes: {shares:?}");
     // 34 on this build (v4).
     assert!(checked >= 20, "only {checked} interceptions checked");
 }

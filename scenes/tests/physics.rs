@@ -290,8 +290,16 @@ fn thrown_object_apex_and_range_are_ballistic() {
     assert!(apexes >= 4, "only {apexes} upward throws");
 }
 
-/// Runs the same group layout with the object swapped for its look-alike twin.
-fn twin_labels(family: &str, real: &str, twin: &str) -> Option<(SceneResult, SceneResult)> {
+/// Runs the same group layout with the object swapped for its look-alike twin, in every
+/// speed band, until the light one is a CATCH and the heavy one would harm the standing
+/// body (rule v5: a dangerous object that never harms it is NO_ACTION) — or, without
+/// `need_harm`, whatever the heavy one does.
+fn twin_labels(
+    family: &str,
+    real: &str,
+    twin: &str,
+    need_harm: bool,
+) -> Option<(SceneResult, SceneResult)> {
     let (catalog, config) = setup();
     for seed in 0..40u64 {
         let room = plan_group(&catalog, &[family.to_string()], seed, 0)
@@ -305,23 +313,21 @@ fn twin_labels(family: &str, real: &str, twin: &str) -> Option<(SceneResult, Sce
                 description: None,
                 planner: None,
             };
-            // The normal band of group 0.
-            produce_group(&selection, seed, 0, 2, &catalog, &config)
-                .unwrap()
-                .remove(1)
+            produce_group(&selection, seed, 0, 4, &catalog, &config).unwrap()
         };
-        let (a, b) = (pick(real), pick(twin));
-        // Same layout, same look: only the physics (mass, flags) differs.
-        let light = if a.spec.hazard_body().mass < b.spec.hazard_body().mass {
-            &a
-        } else {
-            &b
-        };
-        if a.spec.attempt == b.spec.attempt
-            && light.labels.reachable
-            && light.labels.gt_action == Action::Catch
-        {
-            return Some((a, b));
+        for (a, b) in pick(real).into_iter().zip(pick(twin)) {
+            let (light, heavy) = if a.spec.hazard_body().mass < b.spec.hazard_body().mass {
+                (&a, &b)
+            } else {
+                (&b, &a)
+            };
+            if a.spec.attempt == b.spec.attempt
+                && light.labels.reachable
+                && light.labels.gt_action == Action::Catch
+                && (heavy.labels.danger_present || !need_harm)
+            {
+                return Some((a, b));
+            }
         }
     }
     None
@@ -330,12 +336,13 @@ fn twin_labels(family: &str, real: &str, twin: &str) -> Option<(SceneResult, Sce
 #[test]
 fn labels_follow_physics_not_appearance() {
     let catalog = Catalog::embedded().unwrap();
-    // A foam twin of a heavy object is safe to catch; the real one must be dodged.
+    // A foam twin of a heavy object is safe to catch; the real one, landing on the
+    // standing body, must be dodged.
     let anvil = catalog.object("anvil").unwrap();
     let foam = catalog.object("foam_anvil").unwrap();
     assert_eq!(catalog.appearance_source(foam).appearance, anvil.appearance);
     let (real, twin) =
-        twin_labels("object_drop", "anvil", "foam_anvil").expect("a reachable layout");
+        twin_labels("object_drop", "anvil", "foam_anvil", true).expect("a reachable layout");
     assert_eq!(
         real.spec.hazard_body().parts,
         twin.spec.hazard_body().parts,
@@ -352,13 +359,21 @@ fn labels_follow_physics_not_appearance() {
     assert_eq!(twin.labels.gt_action, Action::Catch);
     assert!(!twin.labels.dangerous);
 
-    // A steel twin of a light object is dangerous; the real apple is caught.
+    // A steel twin of a light object is dangerous; the real apple is caught. Rule v5: the
+    // steel one is dodged only where it would harm the standing body — in object_drop's
+    // layouts (4 bands × 40 seeds) a steel apple that would be caught as an apple never
+    // does: it falls in front of the body (issue 23's aimed twins are still to come).
     let (apple, steel) =
-        twin_labels("object_drop", "apple", "steel_apple").expect("a reachable layout");
+        twin_labels("object_drop", "apple", "steel_apple", false).expect("a reachable layout");
     assert_eq!(apple.labels.gt_action, Action::Catch);
     assert!(!apple.labels.dangerous);
-    assert_eq!(steel.labels.gt_action, Action::Dodge);
     assert!(steel.labels.dangerous);
+    let expected = if steel.labels.danger_present {
+        Action::Dodge
+    } else {
+        Action::NoAction
+    };
+    assert_eq!(steel.labels.gt_action, expected, "{:?}", steel.labels);
 }
 
 #[test]

@@ -155,7 +155,7 @@ fn dataset_build_layout_card_and_manifest() {
     assert_eq!(manifest["seed"], 11);
     assert_eq!(manifest["n"], 40);
     assert_eq!(manifest["shard"], serde_json::json!([0, 1]));
-    assert_eq!(manifest["config"]["labels"]["rule_version"], "v4");
+    assert_eq!(manifest["config"]["labels"]["rule_version"], "v5");
 }
 
 #[test]
@@ -336,4 +336,58 @@ print(json.dumps({{
         "{out}"
     );
     assert!(out["valid"].as_str().unwrap().contains("bool"), "{out}");
+}
+
+/// Label rule v5 re-derived from the stored columns alone (and the build's label config
+/// in `build.json`): `harm_ratio` is the larger of `harm_energy` and `harm_force` over
+/// the limits of `harm_region` (ISO/TS 15066 Annex A, `configs/labels.toml`);
+/// `danger_present` holds exactly when that ratio is ≥ 1 or a sharp or hot hazard pressed
+/// on the body (`strike_impulse` > 0); no DODGE scene's hazard leaves the standing body untouched, and every DODGE
+/// scene has danger present.
+#[test]
+fn dataset_labels_rederive_from_the_stored_harm_columns() {
+    let (_, dir) = single();
+    let script = format!(
+        r#"
+import json
+import pyarrow.parquet as pq
+d = {dir:?}
+t = pq.read_table(d + "/data/test-00000-of-00001.parquet").to_pylist()
+labels = json.load(open(d + "/build.json"))["config"]["labels"]
+f = labels["harm_transient_factor"]
+bad, touched, dodge, harm = [], 0, 0, 0
+for r in t:
+    region = r["harm_region"]
+    sharp = any(h in ("sharp", "hot") for h in r["hazards"])
+    if region is None:
+        ratio, hit = 0.0, False
+        if r["harm_energy"] is not None or r["harm_ratio"] is not None:
+            bad.append((r["scene_id"], "harm numbers without a region"))
+    else:
+        touched += 1
+        lim = labels["harm"][region]
+        e_max = (f * lim["force_n"]) ** 2 / (2 * lim["spring_n_per_mm"] * 1000)
+        ratio = max(r["harm_energy"] / e_max, r["harm_force"] / lim["force_n"])
+        if abs(ratio - r["harm_ratio"]) > 1e-9 * max(1.0, ratio):
+            bad.append((r["scene_id"], "ratio", ratio, r["harm_ratio"]))
+        hit = (r["strike_impulse"] or 0.0) > 0.0
+    present = ratio >= 1.0 or (hit and sharp)
+    if present != r["danger_present"]:
+        bad.append((r["scene_id"], "danger_present", r["danger_present"], region, ratio))
+    if r["gt_action"] == "DODGE":
+        dodge += 1
+        if region is None or not r["danger_present"]:
+            bad.append((r["scene_id"], "DODGE without harm", region))
+    harm += r["danger_present"]
+print(json.dumps({{"bad": bad, "rows": len(t), "touched": touched, "dodge": dodge, "harm": harm,
+  "rule": sorted(set(r["label_rule"] for r in t))}}))
+"#,
+        dir = dir.to_str().unwrap()
+    );
+    let out: serde_json::Value = serde_json::from_str(python(&script).trim()).unwrap();
+    assert_eq!(out["bad"], serde_json::json!([]), "{out}");
+    assert_eq!(out["rule"], serde_json::json!(["v5"]), "{out}");
+    assert!(out["touched"].as_u64().unwrap() >= 5, "{out}");
+    assert!(out["dodge"].as_u64().unwrap() >= 3, "{out}");
+    eprintln!("{out}");
 }

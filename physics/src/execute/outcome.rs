@@ -1,12 +1,12 @@
 //! The execution loop and the outcome rule (versioned with `[execution]` in
 //! `configs/scoring.toml`; times are seconds after the decision moment Δ):
 //!
-//! * `struck` — the strike test of the counterfactual label (`crate::strike`, the same
-//!   [`StrikeMonitor`]; thresholds `strike_*` equal to the label's) on the moving body:
-//!   within `strike_window_s` of a touch, the hazard's contact point moves at ≥
-//!   `strike_speed_min` relative to the touched link with a total impulse ≥
-//!   `strike_impulse_min`, or the impulse alone is ≥ `strike_impulse_heavy`. The part that
-//!   took the most impulse, the impulse and the time of the touch are recorded.
+//! * `struck` — the harm test of the counterfactual label (`crate::strike`, the same
+//!   [`StrikeMonitor`] with the same numbers: the scene's own `labels` — the per-region
+//!   limits of ISO/TS 15066 Annex A, the window, a sharp or hot hazard harming at a touch)
+//!   on the moving body: within `strike_window_s` of a touch some body region takes a
+//!   transient energy or a sustained force over its limit. The part that took the most
+//!   impulse, the impulse and the time of the touch are recorded.
 //!   While the plan is *reaching* (a palm more than `reaching_offset` from rest,
 //!   [`Motion::reaching`]) the hands and forearms are catching, not part of that test:
 //!   they count as struck only under a blow of `hand_strike_impulse` or more within the
@@ -34,7 +34,7 @@ use super::{ExecConfig, ExecFrame, ExecPlan, Outcome, OutcomeKind, StrikeRecord}
 use crate::body::{Geometry, LinkShape, Part};
 use crate::simulate::{hash_hex, lowest_z, SceneWorld};
 use crate::spec::{SceneSpec, Vec3};
-use crate::strike::{contact_point_speed, StrikeMonitor, StrikeRule, StrikeWindow};
+use crate::strike::{touch_at, HarmRule, StrikeMonitor, StrikeWindow, Touch};
 use rapier3d::prelude::*;
 
 use sha2::{Digest, Sha256};
@@ -79,18 +79,14 @@ struct Monitor {
     hand_touched: bool,
     min_hand_distance: f64,
     grasp: GraspState,
+    /// The links' shapes (for the body region of a touch).
+    shapes: [LinkShape; 13],
 }
 
 impl Monitor {
-    /// Nothing seen yet; the strike test with `[execution]`'s numbers at step `dt`.
-    fn new(cfg: &ExecConfig, dt: f64) -> Monitor {
-        let rule = StrikeRule::new(
-            cfg.strike_speed_min,
-            cfg.strike_impulse_min,
-            cfg.strike_impulse_heavy,
-            cfg.strike_window_s,
-            dt,
-        );
+    /// Nothing seen yet; the harm test with the scene's label numbers at step `dt`.
+    fn new(spec: &SceneSpec, shapes: [LinkShape; 13], dt: f64) -> Monitor {
+        let rule = HarmRule::of_labels(&spec.labels, &spec.hazard_flags, dt);
         Monitor {
             first_contact: None,
             strikes: StrikeMonitor::new(rule, Part::ALL.len()),
@@ -103,6 +99,7 @@ impl Monitor {
             hand_touched: false,
             min_hand_distance: f64::INFINITY,
             grasp: GraspState::Open,
+            shapes,
         }
     }
 }
@@ -151,7 +148,7 @@ pub(super) fn run(
         .map(|k| k.t)
         .fold(plan.walking_duration, f64::max);
     let started_on_floor = lowest_z(&sw.world.colliders[hazard_c]) <= cfg.floor_contact_eps;
-    let mut m = Monitor::new(cfg, dt);
+    let mut m = Monitor::new(spec, shapes, dt);
     let attempting = super::plan_reach(plan) >= cfg.attempt_reach;
     let mut hasher = Sha256::new();
     let mut executed = 0;
@@ -264,9 +261,9 @@ fn observe(
     let world = &sw.world;
     let hazard = &world.colliders[hazard_c];
     let v_hazard = world.bodies[hazard_b].linvel();
-    let (mut on_floor, mut touching_hands, mut body_touch) = (false, false, None::<f64>);
+    let (mut on_floor, mut touching_hands) = (false, false);
     let mut hold_speed = f64::INFINITY;
-    let mut impulses = [0.0f64; 13];
+    let mut touches: Vec<Touch> = Vec::new();
     let mut hand_impulses = [0.0f64; 13];
     for (pair, other) in crate::simulate::active_contacts(world, hazard_c) {
         if other == sw.floor {
@@ -287,9 +284,16 @@ fn observe(
             hand_impulses[i] += pair.total_impulse_magnitude() as f64;
             hold_speed = hold_speed.min(norm(v_hazard - link_v));
         } else {
-            impulses[i] += pair.total_impulse_magnitude() as f64;
-            let speed = contact_point_speed(world, hazard_c, v_before, w_before, other);
-            body_touch = Some(body_touch.map_or(speed, |s| s.max(speed)));
+            let mut t = touch_at(
+                world,
+                hazard_c,
+                (v_before, w_before),
+                other,
+                part,
+                m.shapes[i],
+            );
+            t.impulse = pair.total_impulse_magnitude() as f64;
+            touches.push(t);
         }
     }
     for hand in [Part::LeftHand, Part::RightHand] {
@@ -314,7 +318,7 @@ fn observe(
         touching_hands = true;
         hold_speed = hold_speed.min(grasp::held_speed(sw, links, g, hazard_b));
     }
-    m.strikes.step(step, body_touch, &impulses);
+    m.strikes.step(step, &touches);
     if let Some(w) = m.strikes.strike() {
         // The test passed: stop here (the verdict cannot change within the window).
         m.strike = Some(StrikeRecord {
@@ -357,7 +361,7 @@ fn follow_hand_strike(
     let Some(w) = m.hand_window.as_mut() else {
         return;
     };
-    w.add(None, impulses);
+    w.add_impulses(impulses);
     if w.impulse >= cfg.hand_strike_impulse {
         m.strike = Some(StrikeRecord {
             part: Part::ALL[w.heaviest_part()].name().to_string(),

@@ -1,0 +1,283 @@
+//! Aimed events (label rule v5, SPEC §6): the observer stands where the hazard's own
+//! path passes, after Δ plus the reaction time, at a sampled meeting height.
+//!
+//! The plain simulation never contains the observer's body (only the counterfactual run
+//! does), so a scene's hazard path is known before the observer is placed. [`aim_group`]
+//! takes a group's simulated bands (one observer pose for all four, SPEC §4: the bands
+//! share everything but the speed), draws candidate meeting points on their paths from
+//! the group's "aim" stream and keeps the first pose that every band's path meets after
+//! Δ + `reaction_time_min` + `reaction_margin_s` and none reaches earlier — else the
+//! candidate that most bands meet. A group drawn as a near miss (`build.far_observer_share`)
+//! stands beside the path instead, beyond the reach envelope. Everything else of the
+//! family's layout is unchanged; the pose depends only on the paths and the draws.
+
+use crate::label::approach;
+use rand::RngExt;
+use rh_physics::simulate::{Obstacles, Simulation};
+use rh_physics::spec::{BodyKind, SceneSpec, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// `[aim]` of `configs/default.toml`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct AimConfig {
+    /// Candidate meeting points drawn per group (0: events are not aimed; the family's
+    /// own observer pose stands).
+    pub candidates: u32,
+    /// Extra time beyond Δ + `reaction_time_min` before the path may meet the observer (s).
+    pub reaction_margin_s: f64,
+    /// The meeting height band (hazard centre height, m) for every family but those in
+    /// `meet_height_by_family`.
+    pub meet_height: [f64; 2],
+    #[serde(default)]
+    pub meet_height_by_family: std::collections::BTreeMap<String, [f64; 2]>,
+    /// The torso axis stands this far (m) ahead of the meeting point along the hazard's
+    /// horizontal motion, and up to `lateral` (m) to either side.
+    pub ahead: [f64; 2],
+    pub lateral: f64,
+    /// A near miss stands this far (m) beyond `reach_radius` + the hazard's bounding
+    /// radius, beside the path.
+    pub miss_clearance: [f64; 2],
+    /// The observer's axis keeps this distance (m) from the room's walls.
+    pub wall_margin: f64,
+    /// The hazard counts as meeting the body when its centre comes within the torso
+    /// radius + its bounding radius + this (m) of the torso axis.
+    pub touch_slack: f64,
+}
+
+/// What the aim decided, recorded in the spec's `family_params` (`aim_*`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aim {
+    pub x: f64,
+    pub y: f64,
+    pub yaw: f64,
+    /// Which candidate won, and the meeting point's height on the band it was drawn on.
+    pub candidate: u32,
+    pub meet_height: f64,
+    /// How many bands' paths meet the pose as intended.
+    pub bands_met: u32,
+    pub near_miss: bool,
+}
+
+/// The hazard speed below which a path point is not a meeting candidate (m/s).
+const MOVING: f64 = 0.1;
+
+/// Places the observer of every band of `runs` (same pose) on the bands' hazard paths.
+/// Returns the chosen aim, or `None` (poses unchanged) when no candidate stands inside
+/// the room clear of the furniture.
+pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Option<Aim> {
+    if cfg.candidates == 0 || runs.is_empty() {
+        return None;
+    }
+    let first = &runs[0].0;
+    let near_miss = first
+        .family_params
+        .get("far_observer")
+        .is_some_and(|&v| v == 1.0);
+    let mut rng = rh_physics::seeds::stream(first.seed, first.attempt, "aim");
+    // Always the same draws, whatever the paths.
+    let draws: Vec<[f64; 4]> = (0..cfg.candidates)
+        .map(|_| {
+            [
+                rng.random_range(0.0..1.0),
+                rng.random_range(cfg.ahead[0]..=cfg.ahead[1]),
+                rng.random_range(-cfg.lateral..=cfg.lateral),
+                rng.random_range(cfg.miss_clearance[0]..=cfg.miss_clearance[1]),
+            ]
+        })
+        .collect();
+    let band = cfg
+        .meet_height_by_family
+        .get(&first.family)
+        .copied()
+        .unwrap_or(cfg.meet_height);
+    let mut best: Option<(u32, Aim)> = None;
+    for (c, d) in draws.iter().enumerate() {
+        let (spec, sim) = &runs[c % runs.len()];
+        let Some((x, y, yaw, meet_height)) = candidate(spec, sim, cfg, band, near_miss, d) else {
+            continue;
+        };
+        if !stands_clear(spec, cfg, x, y) {
+            continue;
+        }
+        let met = runs
+            .iter()
+            .filter(|(s, m)| meets(&posed(s, x, y, yaw), m, cfg, near_miss))
+            .count() as u32;
+        let aim = Aim {
+            x,
+            y,
+            yaw,
+            candidate: c as u32,
+            meet_height,
+            bands_met: met,
+            near_miss,
+        };
+        if best.is_none_or(|(m, _)| met > m) {
+            best = Some((met, aim));
+        }
+        if met as usize == runs.len() {
+            break;
+        }
+    }
+    if std::env::var_os("RH_AIM_DEBUG").is_some() {
+        let tried = draws.len();
+        let with_point = (0..tried)
+            .filter(|&c| {
+                let (spec, sim) = &runs[c % runs.len()];
+                candidate(spec, sim, cfg, band, near_miss, &draws[c]).is_some()
+            })
+            .count();
+        let clear = (0..tried)
+            .filter(|&c| {
+                let (spec, sim) = &runs[c % runs.len()];
+                candidate(spec, sim, cfg, band, near_miss, &draws[c])
+                    .is_some_and(|(x, y, _, _)| stands_clear(spec, cfg, x, y))
+            })
+            .count();
+        eprintln!(
+            "aim {} {} attempt {}: {with_point}/{tried} with a point, {clear} clear, best met {:?}",
+            first.family,
+            first.selection.object_id,
+            first.attempt,
+            best.map(|(m, a)| (m, a.candidate, a.meet_height))
+        );
+    }
+    let (_, aim) = best?;
+    for (spec, _) in runs.iter_mut() {
+        *spec = posed(spec, aim.x, aim.y, aim.yaw);
+        let p = &mut spec.family_params;
+        p.insert("aim_candidate".into(), aim.candidate as f64);
+        p.insert("aim_meet_height".into(), aim.meet_height);
+        p.insert("aim_bands_met".into(), aim.bands_met as f64);
+    }
+    Some(aim)
+}
+
+/// The spec with its observer standing at (x, y) facing `yaw`.
+pub fn posed(spec: &SceneSpec, x: f64, y: f64, yaw: f64) -> SceneSpec {
+    let mut s = spec.clone();
+    s.observer.x = x;
+    s.observer.y = y;
+    s.observer.yaw = yaw;
+    s
+}
+
+/// The first step from which the path may meet the observer.
+fn earliest_step(spec: &SceneSpec, cfg: &AimConfig) -> u32 {
+    let t = spec.observation_window_s + spec.labels.reaction_time_min + cfg.reaction_margin_s;
+    (t / spec.physics.dt).ceil() as u32
+}
+
+/// A candidate pose from draw `d` = [time fraction, ahead, lateral, miss clearance] on
+/// one band's path: the meeting point is the `d[0]` fraction of the moving path points
+/// after the earliest step whose centre height is in `band`.
+fn candidate(
+    spec: &SceneSpec,
+    sim: &Simulation,
+    cfg: &AimConfig,
+    band: [f64; 2],
+    near_miss: bool,
+    d: &[f64; 4],
+) -> Option<(f64, f64, f64, f64)> {
+    let from = earliest_step(spec, cfg);
+    let moving: Vec<u32> = (from..=sim.steps())
+        .filter(|&k| norm(sim.hazard_velocity(k)) > MOVING)
+        .collect();
+    let in_band: Vec<u32> = moving
+        .iter()
+        .copied()
+        .filter(|&k| (band[0]..=band[1]).contains(&sim.hazard_com(k)[2]))
+        .collect();
+    // A path that never passes at a height of the band meets the body where it can.
+    let points = if near_miss || in_band.is_empty() {
+        moving
+    } else {
+        in_band
+    };
+    if points.is_empty() {
+        return None;
+    }
+    let k = points[((d[0] * points.len() as f64) as usize).min(points.len() - 1)];
+    let p = sim.hazard_com(k);
+    let v = sim.hazard_velocity(k);
+    let start = sim.hazard_com(0);
+    // Along the horizontal motion there; for a (nearly) vertical fall, away from where
+    // it started, else toward where the family stood its observer.
+    let o = &spec.observer;
+    let u = unit2([v[0], v[1]])
+        .or_else(|| unit2([p[0] - start[0], p[1] - start[1]]))
+        .or_else(|| unit2([o.x - p[0], o.y - p[1]]))
+        .unwrap_or([1.0, 0.0]);
+    let side = [-u[1], u[0]];
+    let (along, across) = if near_miss {
+        let r = spec.hazard_body().bounding_radius();
+        let off = spec.labels.reach_radius + r + d[3];
+        (0.0, if d[2] < 0.0 { -off } else { off })
+    } else {
+        (d[1], d[2])
+    };
+    let x = p[0] + u[0] * along + side[0] * across;
+    let y = p[1] + u[1] * along + side[1] * across;
+    // Face the hazard as the decision moment shows it; straight at the oncoming path
+    // when it is (nearly) overhead then.
+    let seen = sim.hazard_com(spec.decision_step().min(sim.steps()));
+    let yaw = match unit2([seen[0] - x, seen[1] - y]) {
+        Some(f) if ((seen[0] - x).powi(2) + (seen[1] - y).powi(2)).sqrt() > 0.3 => f[1].atan2(f[0]),
+        _ => (-u[1]).atan2(-u[0]),
+    };
+    Some((x, y, yaw, p[2]))
+}
+
+/// Whether an observer at (x, y) stands inside the room, clear of every body as it
+/// stands at t0 (furniture, props and the hazard itself).
+fn stands_clear(spec: &SceneSpec, cfg: &AimConfig, x: f64, y: f64) -> bool {
+    let [w, d] = [spec.room.size[0], spec.room.size[1]];
+    if x.abs() > w / 2.0 - cfg.wall_margin || y.abs() > d / 2.0 - cfg.wall_margin {
+        return false;
+    }
+    let o = &spec.observer;
+    let r = o.torso_radius + 0.05;
+    let mut at_rest = spec.clone();
+    for b in at_rest.bodies.iter_mut() {
+        b.kind = BodyKind::Fixed;
+    }
+    let bodies = Obstacles::of(&at_rest);
+    let ring = [[0.0, 0.0], [r, 0.0], [-r, 0.0], [0.0, r], [0.0, -r]];
+    [0.05, 0.4, 0.8, 1.1, o.height].iter().all(|&z| {
+        !ring
+            .iter()
+            .any(|[dx, dy]| bodies.contains([x + dx, y + dy, z]))
+    })
+}
+
+/// Whether a posed band's path does what the aim intends: nothing enters the reach
+/// envelope before the earliest step; then the hazard comes within touching distance of
+/// the body (or, for a near miss, never within `reach_radius`).
+pub fn meets(spec: &SceneSpec, sim: &Simulation, cfg: &AimConfig, near_miss: bool) -> bool {
+    let from = earliest_step(spec, cfg).min(sim.steps() + 1);
+    let o = &spec.observer;
+    let touch = o.torso_radius + spec.hazard_body().bounding_radius() + cfg.touch_slack;
+    let distance = |k: u32| o.torso_axis_distance(sim.hazard_com(k));
+    // The reaction-time validator's "reaches the observer" (label `time_to_reach`), and
+    // no touch of the body, before the earliest step.
+    let reached = approach(spec, sim, 0, spec.labels.reach_radius).map(|(k, _)| k);
+    if reached.is_some_and(|k| k < from) {
+        return false;
+    }
+    let closest = (from..=sim.steps()).map(distance).fold(f64::INFINITY, f64::min);
+    if near_miss {
+        closest > spec.labels.reach_radius
+    } else {
+        closest <= touch
+    }
+}
+
+fn norm(v: Vec3) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+fn unit2(v: [f64; 2]) -> Option<[f64; 2]> {
+    let n = (v[0] * v[0] + v[1] * v[1]).sqrt();
+    (n > 0.2).then(|| [v[0] / n, v[1] / n])
+}
