@@ -8,15 +8,13 @@
 
 use crate::manifest::Manifest;
 use crate::table;
+use rh_scenes::eval_subset::{self, EvalConfig, EvalRow};
 use arrow::array::{Array, RecordBatch};
 use arrow::datatypes::DataType;
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
 const TEMPLATE: &str = include_str!("../card_template.md");
-
-/// Scenes per family in the evaluation subset (17 families × 18 = 306).
-pub const EVAL_PER_FAMILY: usize = 18;
 
 /// The `eval` config's Parquet file.
 pub const EVAL_FILE: &str = "eval/test-00000-of-00001.parquet";
@@ -74,70 +72,68 @@ pub fn family_counts(batch: &RecordBatch) -> BTreeMap<String, FamilyCounts> {
     out
 }
 
-/// The balanced evaluation subset: per family, valid scenes taken first as whole
-/// speed-band groups (all four bands valid) in scene-index order while they fit in 18,
-/// then single valid scenes in scene-index order up to 18. Returns row indices in
-/// scene-index order and how many scenes each family got.
-pub fn eval_selection(batch: &RecordBatch) -> (Vec<u32>, BTreeMap<String, usize>) {
+/// The evaluation subset as the manifest's configuration chooses it (the label-blind
+/// default for manifests that cannot say).
+pub fn manifest_eval_selection(
+    batch: &RecordBatch,
+    manifest: &Manifest,
+) -> (Vec<u32>, BTreeMap<String, usize>) {
+    let cfg = manifest.build_config().map(|c| c.eval).unwrap_or_default();
+    eval_selection(batch, &cfg)
+}
+
+/// The evaluation subset of a build's rows under `cfg` (`rh_scenes::eval_subset`): row
+/// indices in scene-index order and how many scenes each family got.
+pub fn eval_selection(
+    batch: &RecordBatch,
+    cfg: &EvalConfig,
+) -> (Vec<u32>, BTreeMap<String, usize>) {
     let family = table::string_column(batch, "family");
     let valid = table::bool_column(batch, "valid");
     let index = table::u64_column(batch, "scene_index");
-    let rows: Vec<(&str, u64, bool)> = (0..batch.num_rows())
-        .map(|i| (family[i].as_str(), index[i], valid[i]))
+    let action = table::string_column(batch, "gt_action");
+    let rows: Vec<EvalRow> = (0..batch.num_rows())
+        .map(|i| EvalRow {
+            family: family[i].as_str(),
+            scene_index: index[i],
+            valid: valid[i],
+            action: action[i].as_str(),
+        })
         .collect();
-    select_eval(&rows)
-}
-
-/// `eval_selection` over `(family, scene_index, valid)` rows.
-pub fn select_eval(rows: &[(&str, u64, bool)]) -> (Vec<u32>, BTreeMap<String, usize>) {
-    let mut by_family: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
-    for (i, &(fam, _, valid)) in rows.iter().enumerate() {
-        if valid {
-            by_family.entry(fam).or_default().push(i);
-        }
-    }
-    let index = |r: usize| rows[r].1;
-    let mut chosen = Vec::new();
-    let mut counts = BTreeMap::new();
-    for (fam, mut members) in by_family {
-        members.sort_by_key(|&r| index(r));
-        let mut groups: BTreeMap<u64, Vec<usize>> = BTreeMap::new();
-        for &r in &members {
-            groups.entry(index(r) / 4).or_default().push(r);
-        }
-        let mut taken: Vec<usize> = Vec::new();
-        for group in groups.values() {
-            if group.len() == 4 && taken.len() + 4 <= EVAL_PER_FAMILY {
-                taken.extend(group);
-            }
-        }
-        for &r in &members {
-            if taken.len() >= EVAL_PER_FAMILY {
-                break;
-            }
-            if !taken.contains(&r) {
-                taken.push(r);
-            }
-        }
-        counts.insert(fam.to_string(), taken.len());
-        chosen.extend(taken);
-    }
-    chosen.sort_by_key(|&r| index(r));
+    let (chosen, counts) = eval_subset::select(&rows, cfg);
     (chosen.into_iter().map(|r| r as u32).collect(), counts)
 }
 
-/// "object_drop 4, shelf_slide 4, …" (families in name order).
-fn eval_counts_text(eval: &BTreeMap<String, usize>) -> String {
+/// "18 in each of 17 families" or "5 families, 2 of them with 18".
+fn eval_counts_text(eval: &BTreeMap<String, usize>, per_family: usize) -> String {
     let families = eval.values().filter(|&&n| n > 0).count();
-    let full = eval.values().filter(|&&n| n == EVAL_PER_FAMILY).count();
+    let full = eval.values().filter(|&&n| n == per_family).count();
     if families == full {
-        format!("{EVAL_PER_FAMILY} in each of {families} families")
+        format!("{per_family} in each of {families} families")
     } else {
         format!(
-            "{} famil{}, {full} of them with {EVAL_PER_FAMILY}",
+            "{} famil{}, {full} of them with {per_family}",
             families,
             if families == 1 { "y" } else { "ies" }
         )
+    }
+}
+
+/// How the subset is chosen, in words (the card's config table).
+fn eval_rule_text(cfg: &EvalConfig) -> String {
+    match cfg.catch_share {
+        Some(share) => format!(
+            "evaluation subset, stratified by label (label rule v5): up to {} valid scenes per \
+             family, {:.0}% of them CATCH where the family has them, at most {} NO_ACTION, the \
+             rest DODGE; a family short of one kind gives more of the others",
+            cfg.per_family,
+            100.0 * share,
+            cfg.no_action_per_family
+        ),
+        None => format!(
+            "balanced evaluation subset: up to {} valid scenes per family (whole speed-band groups first)",
+            cfg.per_family
+        ),
     }
 }
 
@@ -218,14 +214,17 @@ pub fn text(input: &CardInput) -> String {
         if m.is_whole() { "build" } else { "shard" }
     );
     let total_eval: usize = input.eval.map(|e| e.values().sum()).unwrap_or(0);
+    let eval_cfg = m.build_config().map(|c| c.eval).unwrap_or_default();
+    let per_family = eval_cfg.per_family;
     if input.eval.is_some() {
         configs.push_str(
             "- config_name: eval\n  data_files:\n  - split: test\n    path: eval/test-*.parquet\n",
         );
         let _ = writeln!(
             table,
-            "| `eval` | `{EVAL_FILE}` | {total_eval} | balanced evaluation subset: up to {EVAL_PER_FAMILY} valid scenes per family (whole speed-band groups first); here {} |",
-            eval_counts_text(input.eval.unwrap_or(&BTreeMap::new()))
+            "| `eval` | `{EVAL_FILE}` | {total_eval} | {}; here {} |",
+            eval_rule_text(&eval_cfg),
+            eval_counts_text(input.eval.unwrap_or(&BTreeMap::new()), per_family)
         );
         v.insert(
             "eval_example",
@@ -279,13 +278,13 @@ pub fn text(input: &CardInput) -> String {
             .families
             .iter()
             .filter(|f| counts.contains_key(*f))
-            .filter(|f| eval.get(*f).copied().unwrap_or(0) < EVAL_PER_FAMILY)
+            .filter(|f| eval.get(*f).copied().unwrap_or(0) < per_family)
             .map(|f| format!("`{f}` ({})", eval.get(f).copied().unwrap_or(0)))
             .collect();
         if !short.is_empty() {
             let _ = write!(
                 scope,
-                "\n\n**Note:** the `eval` config takes up to {EVAL_PER_FAMILY} valid scenes per family; \
+                "\n\n**Note:** the `eval` config takes up to {per_family} valid scenes per family; \
                  this build has fewer in {} of its {} families, so the subset holds all valid scenes of: {}.",
                 short.len(),
                 counts.len(),
@@ -694,30 +693,6 @@ mod tests {
         assert!(t.contains("| lower_leg | 130 | 60 | 75 | 0.56 |"), "{t}");
     }
 
-    #[test]
-    fn eval_prefers_whole_groups_then_fills_by_index() {
-        // Family a: groups 0..6 (scenes 0..24); group 1 has an invalid scene.
-        let mut rows: Vec<(&str, u64, bool)> = (0..24).map(|i| ("a", i, i != 5)).collect();
-        // Family b: 6 valid scenes only.
-        rows.extend((24..30).map(|i| ("b", i, true)));
-        let (chosen, counts) = select_eval(&rows);
-        assert_eq!(counts["a"], 18);
-        assert_eq!(counts["b"], 6);
-        let a: Vec<u64> = chosen
-            .iter()
-            .map(|&r| rows[r as usize])
-            .filter(|r| r.0 == "a")
-            .map(|r| r.1)
-            .collect();
-        // Whole groups 0, 2, 3, 4 (16 scenes), then the first two valid leftovers: 4, 6.
-        let mut expected: Vec<u64> = (0..4).chain(8..20).collect();
-        expected.extend([4, 6]);
-        expected.sort();
-        assert_eq!(a, expected);
-        assert!(chosen
-            .windows(2)
-            .all(|w| rows[w[0] as usize].1 < rows[w[1] as usize].1));
-    }
 
     #[test]
     fn size_categories() {

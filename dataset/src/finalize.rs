@@ -67,7 +67,7 @@ pub fn finalize(
     sums.insert(data_file.clone(), data_sum);
     let summary = compact(&summary)?;
     let eval = if manifest.is_whole() {
-        let (indices, counts) = card::eval_selection(&summary);
+        let (indices, counts) = card::manifest_eval_selection(&summary, manifest);
         let subset = take_streamed(rows, &indices)?;
         let path = out.join(card::EVAL_FILE);
         let bytes = table::parquet_bytes(&subset);

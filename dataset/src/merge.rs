@@ -233,7 +233,7 @@ pub fn merge(out: &Path, shards: &[PathBuf]) -> Result<MergeSummary, BuildError>
         eval_scenes: out
             .join(crate::card::EVAL_FILE)
             .exists()
-            .then(|| crate::card::eval_selection(&rows).0.len()),
+            .then(|| crate::card::manifest_eval_selection(&rows, &whole).0.len()),
     })
 }
 

@@ -22,7 +22,7 @@ use rh_catalog::Catalog;
 use rh_physics::simulate::{simulate, SimOptions};
 use rh_physics::spec::SceneSpec;
 use rh_scenes::driver::{produce_group, SceneResult};
-use rh_scenes::selection::plan_group;
+use rh_scenes::selection::plan_group_with;
 use serde::Serialize;
 use std::path::Path;
 
@@ -149,7 +149,7 @@ pub fn verify(dir: &Path, catalog: &Catalog) -> Result<VerifyReport, String> {
             // selections (group g takes g mod len); else the lexicon plans the group.
             let selection = match manifest.selections.as_deref() {
                 Some(s) if !s.is_empty() => s[(g % s.len() as u64) as usize].clone(),
-                _ => plan_group(catalog, &manifest.families, manifest.seed, g)
+                _ => plan_group_with(catalog, &manifest.families, manifest.seed, g, &config.plan_policy())
                     .map_err(|e| e.to_string())?,
             };
             let mut results = produce_group(

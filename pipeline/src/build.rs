@@ -423,7 +423,7 @@ fn finished_build(
     let eval = out
         .join(card::EVAL_FILE)
         .exists()
-        .then(|| card::eval_selection(&rows).0.len());
+        .then(|| card::manifest_eval_selection(&rows, &on_disk).0.len());
     // Nothing was resumed: the build was already complete ("nothing to do").
     Ok(Some(summarize(out, &rows, data_file, 0, 0, eval)))
 }

@@ -11,7 +11,7 @@
 //! stands beside the path instead, beyond the reach envelope. Everything else of the
 //! family's layout is unchanged; the pose depends only on the paths and the draws.
 
-use crate::label::approach;
+use crate::label::{approach, interception, ImpactKind};
 use rand::RngExt;
 use rh_physics::simulate::{Obstacles, Simulation};
 use rh_physics::spec::{BodyKind, SceneSpec, Vec3};
@@ -35,6 +35,15 @@ pub struct AimConfig {
     /// horizontal motion, and up to `lateral` (m) to either side.
     pub ahead: [f64; 2],
     pub lateral: f64,
+    /// A hazard aimed at the body (a dangerous one, or one too large for the arms): the
+    /// meeting height band (m), and the torso axis `body_ahead` (m) beyond the meeting
+    /// point, up to `body_lateral` (m) to either side.
+    #[serde(default)]
+    pub body_meet_height: [f64; 2],
+    #[serde(default)]
+    pub body_ahead: [f64; 2],
+    #[serde(default)]
+    pub body_lateral: f64,
     /// A near miss stands this far (m) beyond `reach_radius` + the hazard's bounding
     /// radius, beside the path.
     pub miss_clearance: [f64; 2],
@@ -57,6 +66,52 @@ pub struct Aim {
     /// How many bands' paths meet the pose as intended.
     pub bands_met: u32,
     pub near_miss: bool,
+    pub intent: Intent,
+}
+
+/// Where a group's event is aimed (recorded as `aim_intent`: 0 hands, 1 body, 2 miss).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Intent {
+    /// A benign hazard that fits in the arms: its path passes in front of the chest at a
+    /// height the hands can hold, after they can get there (a CATCH if it is not too fast).
+    Hands,
+    /// A dangerous hazard, or one too large to hold: its path runs into the body (a DODGE
+    /// when the touch would harm).
+    Body,
+    /// A deliberate near miss (`build.far_observer_share`): beside the path, out of reach.
+    Miss,
+}
+
+impl Intent {
+    pub fn code(self) -> f64 {
+        match self {
+            Intent::Hands => 0.0,
+            Intent::Body => 1.0,
+            Intent::Miss => 2.0,
+        }
+    }
+
+    /// The group's intent from its first band's spec: the near-miss draw, else the
+    /// hazard's own properties (what the label rule calls dangerous before any impact,
+    /// and `fits_in_arms`).
+    pub fn of(spec: &SceneSpec) -> Intent {
+        let near_miss = spec
+            .family_params
+            .get("far_observer")
+            .is_some_and(|&v| v == 1.0);
+        let has = |f: &str| spec.hazard_flags.iter().any(|x| x == f);
+        let dangerous = has("sharp")
+            || has("hot")
+            || (has("fragile") && has("large"))
+            || spec.hazard_body().mass >= spec.labels.heavy_mass_kg;
+        if near_miss {
+            Intent::Miss
+        } else if dangerous || !crate::label::fits_in_arms(spec) {
+            Intent::Body
+        } else {
+            Intent::Hands
+        }
+    }
 }
 
 /// The hazard speed below which a path point is not a meeting candidate (m/s).
@@ -70,27 +125,32 @@ pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Optio
         return None;
     }
     let first = &runs[0].0;
-    let near_miss = first
-        .family_params
-        .get("far_observer")
-        .is_some_and(|&v| v == 1.0);
+    let intent = Intent::of(first);
+    let near_miss = intent == Intent::Miss;
     let mut rng = rh_physics::seeds::stream(first.seed, first.attempt, "aim");
     // Always the same draws, whatever the paths.
+    let (ahead, lateral) = match intent {
+        Intent::Body => (cfg.body_ahead, cfg.body_lateral),
+        _ => (cfg.ahead, cfg.lateral),
+    };
     let draws: Vec<[f64; 4]> = (0..cfg.candidates)
         .map(|_| {
             [
                 rng.random_range(0.0..1.0),
-                rng.random_range(cfg.ahead[0]..=cfg.ahead[1]),
-                rng.random_range(-cfg.lateral..=cfg.lateral),
+                rng.random_range(ahead[0]..=ahead[1]),
+                rng.random_range(-lateral..=lateral),
                 rng.random_range(cfg.miss_clearance[0]..=cfg.miss_clearance[1]),
             ]
         })
         .collect();
-    let band = cfg
-        .meet_height_by_family
-        .get(&first.family)
-        .copied()
-        .unwrap_or(cfg.meet_height);
+    let band = match intent {
+        Intent::Body => cfg.body_meet_height,
+        _ => cfg
+            .meet_height_by_family
+            .get(&first.family)
+            .copied()
+            .unwrap_or(cfg.meet_height),
+    };
     let mut best: Option<(u32, Aim)> = None;
     for (c, d) in draws.iter().enumerate() {
         let (spec, sim) = &runs[c % runs.len()];
@@ -102,7 +162,7 @@ pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Optio
         }
         let met = runs
             .iter()
-            .filter(|(s, m)| meets(&posed(s, x, y, yaw), m, cfg, near_miss))
+            .filter(|(s, m)| meets(&posed(s, x, y, yaw), m, cfg, intent))
             .count() as u32;
         let aim = Aim {
             x,
@@ -112,6 +172,7 @@ pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Optio
             meet_height,
             bands_met: met,
             near_miss,
+            intent,
         };
         if best.is_none_or(|(m, _)| met > m) {
             best = Some((met, aim));
@@ -150,6 +211,7 @@ pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Optio
         p.insert("aim_candidate".into(), aim.candidate as f64);
         p.insert("aim_meet_height".into(), aim.meet_height);
         p.insert("aim_bands_met".into(), aim.bands_met as f64);
+        p.insert("aim_intent".into(), aim.intent.code());
     }
     Some(aim)
 }
@@ -251,13 +313,17 @@ fn stands_clear(spec: &SceneSpec, cfg: &AimConfig, x: f64, y: f64) -> bool {
     })
 }
 
-/// Whether a posed band's path does what the aim intends: nothing enters the reach
-/// envelope before the earliest step; then the hazard comes within touching distance of
-/// the body (or, for a near miss, never within `reach_radius`).
-pub fn meets(spec: &SceneSpec, sim: &Simulation, cfg: &AimConfig, near_miss: bool) -> bool {
+/// Whether a posed band's path does what the aim intends. Always: nothing enters the
+/// reach envelope before the earliest step. Then, for `Hands`, the label rule's
+/// interception is a point the hands can hold in time (`label::interception`, with the
+/// first touch of the body estimated from the path: the hazard's centre within the torso
+/// radius + its bounding radius of the axis); for `Body`, the hazard's centre comes
+/// within the torso radius + half its bounding radius + `touch_slack` of the torso axis;
+/// for `Miss`, it never comes within `reach_radius`.
+pub fn meets(spec: &SceneSpec, sim: &Simulation, cfg: &AimConfig, intent: Intent) -> bool {
     let from = earliest_step(spec, cfg).min(sim.steps() + 1);
     let o = &spec.observer;
-    let touch = o.torso_radius + spec.hazard_body().bounding_radius() + cfg.touch_slack;
+    let radius = spec.hazard_body().bounding_radius();
     let distance = |k: u32| o.torso_axis_distance(sim.hazard_com(k));
     // The reaction-time validator's "reaches the observer" (label `time_to_reach`), and
     // no touch of the body, before the earliest step.
@@ -266,10 +332,15 @@ pub fn meets(spec: &SceneSpec, sim: &Simulation, cfg: &AimConfig, near_miss: boo
         return false;
     }
     let closest = (from..=sim.steps()).map(distance).fold(f64::INFINITY, f64::min);
-    if near_miss {
-        closest > spec.labels.reach_radius
-    } else {
-        closest <= touch
+    match intent {
+        Intent::Miss => closest > spec.labels.reach_radius,
+        Intent::Body => closest <= o.torso_radius + 0.5 * radius + cfg.touch_slack,
+        Intent::Hands => {
+            let decision = spec.decision_step().min(sim.steps());
+            let touch = (decision..=sim.steps()).find(|&k| distance(k) <= o.torso_radius + radius);
+            interception(spec, sim, decision, spec.labels.closest_approach_max, touch)
+                .is_some_and(|(_, kind)| kind == ImpactKind::Envelope)
+        }
     }
 }
 

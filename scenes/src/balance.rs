@@ -19,7 +19,7 @@ use crate::config::Config;
 use crate::driver::produce_group_counted;
 use crate::families;
 use crate::label::Action;
-use crate::selection::plan_group;
+use crate::selection::plan_group_with;
 use rh_catalog::Catalog;
 use serde::Serialize;
 
@@ -94,7 +94,7 @@ pub fn label_balance(
         let mut taken = 0;
         for j in 0..groups_per_family {
             let group = index as u64 + all.len() as u64 * j;
-            let selection = plan_group(catalog, &all, build_seed, group)?;
+            let selection = plan_group_with(catalog, &all, build_seed, group, &config.plan_policy())?;
             let (results, rejections) =
                 produce_group_counted(&selection, build_seed, group * 4, 4, catalog, config)?;
             balance.attempts += rejections.attempts;

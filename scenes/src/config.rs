@@ -24,6 +24,11 @@ pub struct BuildSection {
     pub seed: u64,
     pub families: Vec<String>,
     pub far_observer_share: f64,
+    /// Label rule v5: the share of a family's groups the embedded planner gives a benign
+    /// object (`selection::PlanPolicy`). Absent (older builds): objects are drawn
+    /// uniformly, whatever their kind.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub benign_share: Option<f64>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -219,6 +224,8 @@ struct RawConfig {
     render: RenderConfig,
     speed_bands: BTreeMap<String, [f64; 4]>,
     aim: AimConfig,
+    #[serde(default)]
+    eval: crate::eval_subset::EvalConfig,
 }
 
 /// The whole, validated build configuration (`Deserialize` reads back the copy a build
@@ -236,12 +243,24 @@ pub struct Config {
     /// Label rule v5's aimed events (absent in manifests of older builds: not aimed).
     #[serde(default)]
     pub aim: AimConfig,
+    /// Which scenes form the evaluation subset (absent in manifests of older builds:
+    /// label-blind, whole groups first).
+    #[serde(default)]
+    pub eval: crate::eval_subset::EvalConfig,
     /// Where the configuration came from (for messages; not part of its content).
     #[serde(skip)]
     pub source: String,
 }
 
 impl Config {
+    /// What the embedded planner balances (`selection::plan_group`).
+    pub fn plan_policy(&self) -> crate::selection::PlanPolicy {
+        crate::selection::PlanPolicy {
+            benign_share: self.build.benign_share,
+            heavy_mass_kg: self.labels.heavy_mass_kg,
+        }
+    }
+
     /// The configuration compiled into the binary (`configs/default.toml`).
     pub fn embedded() -> Result<Config, ConfigError> {
         let raw: RawConfig = parse("configs/default.toml", DEFAULT_TOML)?;
@@ -271,6 +290,7 @@ impl Config {
             speed_bands: raw.speed_bands,
             labels,
             aim: raw.aim,
+            eval: raw.eval,
             source: name.to_string(),
         };
         config.validate(name)?;
@@ -301,18 +321,31 @@ impl Config {
         range("aim.meet_height", a.meet_height)?;
         range("aim.ahead", a.ahead)?;
         range("aim.miss_clearance", a.miss_clearance)?;
+        range("aim.body_meet_height", a.body_meet_height)?;
+        range("aim.body_ahead", a.body_ahead)?;
         for (family, r) in &a.meet_height_by_family {
             range(&format!("aim.meet_height_by_family.{family}"), *r)?;
         }
         for (field, v) in [
             ("aim.reaction_margin_s", a.reaction_margin_s),
             ("aim.lateral", a.lateral),
+            ("aim.body_lateral", a.body_lateral),
             ("aim.wall_margin", a.wall_margin),
             ("aim.touch_slack", a.touch_slack),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(fail(field, format!("must be a non-negative number (got {v})")));
             }
+        }
+        if self.eval.per_family == 0 {
+            return Err(fail("eval.per_family", "must be at least 1".into()));
+        }
+        if self
+            .eval
+            .catch_share
+            .is_some_and(|c| !(0.0..=1.0).contains(&c))
+        {
+            return Err(fail("eval.catch_share", "must be within [0, 1]".into()));
         }
         positive("physics.horizon_s", self.physics.horizon_s)?;
         positive("physics.min_duration_s", self.physics.min_duration_s)?;
@@ -415,6 +448,13 @@ impl Config {
                 "labels.reach_radius",
                 "must not exceed labels.closest_approach_max (a reachable hazard needs an impact point)".into(),
             ));
+        }
+        if self
+            .build
+            .benign_share
+            .is_some_and(|b| !(0.0..=1.0).contains(&b))
+        {
+            return Err(fail("build.benign_share", "must be within [0, 1]".into()));
         }
         if !(0.0..=1.0).contains(&self.build.far_observer_share) {
             return Err(fail(

@@ -9,7 +9,7 @@ use crate::config::Config;
 use crate::families;
 use crate::label::{label, Labels};
 use crate::randomize::{randomize, RandomizeError, SceneKey};
-use crate::selection::plan_group;
+use crate::selection::plan_group_with;
 use crate::validate::{validate, Verdicts, VALIDATOR_COLUMNS};
 use rh_catalog::Catalog;
 use rh_physics::simulate::{simulate, SimOptions, Simulation};
@@ -101,7 +101,7 @@ pub fn run_group(
     let selection = match planned {
         Some(s) if !s.is_empty() => s[(g % s.len() as u64) as usize].clone(),
         _ => {
-            plan_group(catalog, families, seed, g).map_err(|e| GroupError::Input(e.to_string()))?
+            plan_group_with(catalog, families, seed, g, &config.plan_policy()).map_err(|e| GroupError::Input(e.to_string()))?
         }
     };
     let (mut results, rejections) =

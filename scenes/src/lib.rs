@@ -15,6 +15,7 @@ pub mod balance;
 pub mod cameras;
 pub mod config;
 pub mod driver;
+pub mod eval_subset;
 pub mod families;
 pub mod label;
 pub mod randomize;

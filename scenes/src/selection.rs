@@ -37,20 +37,75 @@ pub trait Planner: Sync {
     fn plan(&self, description: &str, seed: u64) -> Result<Selection, PlanError>;
 }
 
+/// What the embedded planner balances (label rule v5, `[plan]` of `configs/default.toml`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanPolicy {
+    /// Share of a family's groups that show a benign object (one no property makes
+    /// dangerous: see [`intrinsically_dangerous`]) when the family has both kinds;
+    /// `None`: the object is drawn among all the family's objects (builds before v5).
+    pub benign_share: Option<f64>,
+    /// `heavy_mass_kg` of the label rule: an object this heavy is dangerous.
+    pub heavy_mass_kg: f64,
+}
+
+/// Whether an object is dangerous by its properties alone (the label rule's `dangerous`
+/// before any impact momentum): sharp, hot, large and fragile, or heavy.
+pub fn intrinsically_dangerous(object: &Object, heavy_mass_kg: f64) -> bool {
+    object.has_hazard("sharp")
+        || object.has_hazard("hot")
+        || (object.has_hazard("fragile") && object.has_hazard("large"))
+        || object.mass >= heavy_mass_kg
+}
+
 /// The embedded planner for descriptionless builds: group `g` gets family
-/// `families[g mod F]`, and an object and room drawn from the group's "plan" stream.
+/// `families[g mod F]`; from the group's "plan" stream, whether its object is benign
+/// (`policy.benign_share`, when the family has benign and dangerous objects), then the
+/// object among those of that kind, then the room. `plan_group_with` under the embedded
+/// configuration's policy.
 pub fn plan_group(
     catalog: &Catalog,
     families: &[String],
     build_seed: u64,
     group: u64,
 ) -> Result<Selection, PlanError> {
+    static EMBEDDED: std::sync::OnceLock<PlanPolicy> = std::sync::OnceLock::new();
+    let policy = EMBEDDED.get_or_init(|| {
+        crate::config::Config::embedded()
+            .expect("the embedded configuration is valid")
+            .plan_policy()
+    });
+    plan_group_with(catalog, families, build_seed, group, policy)
+}
+
+/// [`plan_group`] under a build configuration's policy (`Config::plan_policy`).
+pub fn plan_group_with(
+    catalog: &Catalog,
+    families: &[String],
+    build_seed: u64,
+    group: u64,
+    policy: &PlanPolicy,
+) -> Result<Selection, PlanError> {
     let family = &families[(group % families.len() as u64) as usize];
     let mut rng = seeds::stream(seeds::group_seed(build_seed, group), 0, "plan");
-    let object = pick(&mut rng, catalog.objects_for_family(family).collect()).ok_or_else(|| {
-        PlanError::NoObjectForFamily {
-            family: family.clone(),
+    let all: Vec<&Object> = catalog.objects_for_family(family).collect();
+    let candidates = match policy.benign_share {
+        None => all,
+        Some(share) => {
+            let benign = rng.random_bool(share.clamp(0.0, 1.0));
+            let kind: Vec<&Object> = all
+                .iter()
+                .copied()
+                .filter(|o| intrinsically_dangerous(o, policy.heavy_mass_kg) != benign)
+                .collect();
+            if kind.is_empty() {
+                all
+            } else {
+                kind
+            }
         }
+    };
+    let object = pick(&mut rng, candidates).ok_or_else(|| PlanError::NoObjectForFamily {
+        family: family.clone(),
     })?;
     let room = pick(&mut rng, catalog.rooms_for_family(family).collect()).ok_or_else(|| {
         PlanError::NoRoomForFamily {

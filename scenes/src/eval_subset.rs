@@ -1,0 +1,209 @@
+//! The evaluation subset (SPEC §6, §8): which valid scenes of a build form the `eval`
+//! config — `per_family` (18) of each family, 17 × 18 = 306 scenes.
+//!
+//! Label rule v5 keeps the paper's label shape in the subset by stratifying it: per
+//! family, `[eval]` of `configs/default.toml` asks for `catch_share` of the family's
+//! scenes as CATCH and at most `no_action_per_family` NO_ACTION scenes, the rest DODGE;
+//! a family short of one kind gives more of the others (CATCH, then DODGE, then
+//! NO_ACTION). Within a kind, scenes are taken in scene-index order, so the subset is a
+//! pure function of the build's rows. The labels themselves are untouched: the subset
+//! only chooses among them, and the card prints the whole build's shares beside the
+//! subset's. Builds before v5 (no `catch_share`) take whole speed-band groups first,
+//! then single scenes, in scene-index order, whatever their labels.
+
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// `[eval]` of `configs/default.toml`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EvalConfig {
+    pub per_family: usize,
+    /// The share of each family's subset asked to be CATCH (`None`: label-blind, whole
+    /// groups first — builds before label rule v5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub catch_share: Option<f64>,
+    /// At most this many NO_ACTION scenes per family (with `catch_share`).
+    #[serde(default)]
+    pub no_action_per_family: usize,
+}
+
+impl Default for EvalConfig {
+    /// What builds before label rule v5 used (their manifests have no `[eval]`).
+    fn default() -> Self {
+        EvalConfig {
+            per_family: 18,
+            catch_share: None,
+            no_action_per_family: 0,
+        }
+    }
+}
+
+/// One scene as the selection sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EvalRow<'a> {
+    pub family: &'a str,
+    pub scene_index: u64,
+    pub valid: bool,
+    /// `gt_action` as written in the dataset ("CATCH", "DODGE", "NO_ACTION").
+    pub action: &'a str,
+}
+
+/// The chosen rows (indices into `rows`, in scene-index order) and how many scenes
+/// each family got.
+pub fn select(rows: &[EvalRow], cfg: &EvalConfig) -> (Vec<usize>, BTreeMap<String, usize>) {
+    let mut by_family: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
+    for (i, r) in rows.iter().enumerate() {
+        if r.valid {
+            by_family.entry(r.family).or_default().push(i);
+        }
+    }
+    let mut chosen = Vec::new();
+    let mut counts = BTreeMap::new();
+    for (family, mut members) in by_family {
+        members.sort_by_key(|&r| rows[r].scene_index);
+        let taken = match cfg.catch_share {
+            Some(share) => stratified(rows, &members, cfg, share),
+            None => whole_groups_first(rows, &members, cfg.per_family),
+        };
+        counts.insert(family.to_string(), taken.len());
+        chosen.extend(taken);
+    }
+    chosen.sort_by_key(|&r| rows[r].scene_index);
+    (chosen, counts)
+}
+
+/// Per kind, the first scenes in index order: CATCH up to its target, NO_ACTION up to
+/// its cap, DODGE for the rest; then whatever is left of CATCH, DODGE and NO_ACTION, in
+/// that order, until `per_family`.
+fn stratified(rows: &[EvalRow], members: &[usize], cfg: &EvalConfig, share: f64) -> Vec<usize> {
+    let n = cfg.per_family;
+    let of = |action: &str| -> Vec<usize> {
+        members
+            .iter()
+            .copied()
+            .filter(|&r| rows[r].action == action)
+            .collect()
+    };
+    let (catch, dodge, none) = (of("CATCH"), of("DODGE"), of("NO_ACTION"));
+    let c = ((n as f64 * share).round() as usize).min(catch.len());
+    let na = cfg.no_action_per_family.min(none.len()).min(n - c);
+    let d = (n - c - na).min(dodge.len());
+    let mut taken: Vec<usize> = catch[..c]
+        .iter()
+        .chain(&dodge[..d])
+        .chain(&none[..na])
+        .copied()
+        .collect();
+    for (kind, from) in [(&catch, c), (&dodge, d), (&none, na)] {
+        for &r in &kind[from..] {
+            if taken.len() >= n {
+                break;
+            }
+            taken.push(r);
+        }
+    }
+    taken
+}
+
+/// Whole speed-band groups (all four bands valid) in index order while they fit, then
+/// single valid scenes in index order.
+fn whole_groups_first(rows: &[EvalRow], members: &[usize], n: usize) -> Vec<usize> {
+    let mut groups: BTreeMap<u64, Vec<usize>> = BTreeMap::new();
+    for &r in members {
+        groups.entry(rows[r].scene_index / 4).or_default().push(r);
+    }
+    let mut taken: Vec<usize> = Vec::new();
+    for group in groups.values() {
+        if group.len() == 4 && taken.len() + 4 <= n {
+            taken.extend(group);
+        }
+    }
+    for &r in members {
+        if taken.len() >= n {
+            break;
+        }
+        if !taken.contains(&r) {
+            taken.push(r);
+        }
+    }
+    taken
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(family: &str, i: u64, action: &'static str) -> EvalRow<'_> {
+        EvalRow {
+            family,
+            scene_index: i,
+            valid: true,
+            action,
+        }
+    }
+
+    #[test]
+    fn stratified_subset_asks_for_the_configured_shares_and_fills_from_the_rest() {
+        let cfg = EvalConfig {
+            per_family: 10,
+            catch_share: Some(0.5),
+            no_action_per_family: 1,
+        };
+        // Family a: 3 CATCH, 12 DODGE, 4 NO_ACTION: CATCH short, DODGE fills.
+        let mut rows = Vec::new();
+        for i in 0..19u64 {
+            let a = match i {
+                0 | 5 | 9 => "CATCH",
+                1 | 2 | 3 | 4 => "NO_ACTION",
+                _ => "DODGE",
+            };
+            rows.push(row("a", i, a));
+        }
+        // Family b: 20 CATCH, 20 DODGE, no NO_ACTION; one invalid CATCH is never taken.
+        for i in 100..140u64 {
+            rows.push(row("b", i, if i % 2 == 0 { "CATCH" } else { "DODGE" }));
+        }
+        rows[19].valid = false;
+        let (chosen, counts) = select(&rows, &cfg);
+        assert_eq!(counts["a"], 10);
+        assert_eq!(counts["b"], 10);
+        let kinds = |f: &str, k: &str| {
+            chosen
+                .iter()
+                .filter(|&&r| rows[r].family == f && rows[r].action == k)
+                .count()
+        };
+        assert_eq!((kinds("a", "CATCH"), kinds("a", "DODGE"), kinds("a", "NO_ACTION")), (3, 6, 1));
+        assert_eq!((kinds("b", "CATCH"), kinds("b", "DODGE")), (5, 5));
+        assert!(!chosen.contains(&19));
+        assert!(chosen
+            .windows(2)
+            .all(|w| rows[w[0]].scene_index < rows[w[1]].scene_index));
+    }
+
+    #[test]
+    fn label_blind_subset_prefers_whole_groups_then_fills_by_index() {
+        // Family a: groups 0..6 (scenes 0..24); group 1 has an invalid scene.
+        let mut rows: Vec<EvalRow> = (0..24)
+            .map(|i| EvalRow {
+                valid: i != 5,
+                ..row("a", i, "DODGE")
+            })
+            .collect();
+        rows.extend((24..30).map(|i| row("b", i, "CATCH")));
+        let (chosen, counts) = select(&rows, &EvalConfig::default());
+        assert_eq!(counts["a"], 18);
+        assert_eq!(counts["b"], 6);
+        let a: Vec<u64> = chosen
+            .iter()
+            .filter(|&&r| rows[r].family == "a")
+            .map(|&r| rows[r].scene_index)
+            .collect();
+        // Whole groups 0, 2, 3, 4 (16 scenes), then the first two valid leftovers: 4, 6.
+        let mut expected: Vec<u64> = (0..4).chain(8..20).collect();
+        expected.extend([4, 6]);
+        expected.sort();
+        assert_eq!(a, expected);
+    }
+}
