@@ -17,6 +17,8 @@ pub mod execution;
 pub mod families;
 pub mod fsio;
 pub mod layout;
+#[cfg(feature = "png")]
+pub mod png;
 
 #[cfg(feature = "arrow")]
 pub mod arrow_schema;

@@ -4,11 +4,12 @@
 //! missing required column or one of the wrong type is an input error (exit 2) naming the
 //! file and the column.
 
-use crate::types::FastMap;
-use crate::types::{Action, InputError};
+use crate::error::InputError;
+use crate::fast_map::FastMap;
 use anyhow::Result;
 use arrow::array::{Array, RecordBatch, StringArray};
 use rh_contract::columns::col;
+use rh_contract::Action;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
@@ -138,11 +139,11 @@ impl Dataset {
             .into());
         }
         if !data.is_dir() {
-            return Err(InputError(crate::layout::missing_parquet_message(dir)).into());
+            return Err(InputError(crate::dataset_diagnosis::missing_parquet_message(dir)).into());
         }
         let files = parquet_files(&data)?;
         if files.is_empty() {
-            return Err(InputError(crate::layout::missing_parquet_message(dir)).into());
+            return Err(InputError(crate::dataset_diagnosis::missing_parquet_message(dir)).into());
         }
         let mut ds = Dataset {
             dir: dir.to_path_buf(),

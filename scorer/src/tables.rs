@@ -2,15 +2,15 @@
 //! (Named `tables`, not `render`, which in this project means the video renderer.)
 
 use crate::report::{MetricsRow, ModelReport, Report};
-use crate::types::Rule;
+use crate::safety_rule::SafetyRule;
 use std::fmt::Write as _;
 
-use crate::text_table::{coverage_cell, num, num_ci, pct, pct_ci, Table};
+use crate::text_table::{coverage_cell, csv_field, num, num_ci, pct, pct_ci, Table};
 
 /// The CATCH row of a per-GT-action breakdown.
 fn catch_row(rows: &[MetricsRow]) -> Option<&MetricsRow> {
     rows.iter()
-        .find(|g| g.group == crate::types::Action::Catch.as_str())
+        .find(|g| g.group == rh_contract::Action::Catch.as_str())
 }
 
 const MAIN_NOTE: &str = "d_end and HDE (hand-distance error: d_min and d1-d_min over the keyframes) are over CATCH scenes, \
@@ -195,10 +195,7 @@ fn group_table(
     for m in &models {
         head.push(format!("{} {suffix}", m.model));
     }
-    let mut t = Table {
-        head,
-        rows: Vec::new(),
-    };
+    let mut t = Table::from_head(head);
     let groups: Vec<String> = pick(&r.pooled).iter().map(|g| g.group.clone()).collect();
     for (gi, g) in groups.iter().enumerate() {
         let mut row = vec![g.clone()];
@@ -324,10 +321,10 @@ fn safety_and_reach_tables(r: &Report, out: &mut Vec<TitledTable>) {
             s.decisions.to_string(),
             s.violations.to_string(),
         ];
-        for rule in Rule::ALL {
+        for rule in SafetyRule::ALL {
             row.push(s.first_rule.get(rule).to_string());
         }
-        for rule in Rule::ALL {
+        for rule in SafetyRule::ALL {
             row.push(s.rules_fired.get(rule).to_string());
         }
         row.push(pct(s.unsafe_on_dodge_scenes));
@@ -630,14 +627,6 @@ pub fn markdown(r: &Report) -> String {
         s.push_str(&crate::execution::report::markdown(e));
     }
     s
-}
-
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
 }
 
 /// The CSV report: one row per (model, breakdown, group); rates are fractions; empty

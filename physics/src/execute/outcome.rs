@@ -52,7 +52,7 @@ fn pose_of(p: &crate::body::LinkPose) -> Pose {
 }
 
 fn collider(shape: LinkShape, cfg: &ExecConfig) -> ColliderBuilder {
-    ColliderBuilder::new(crate::simulate::link_shape(shape))
+    ColliderBuilder::new(crate::shapes::link_shape(shape))
         .friction(cfg.link_friction as Real)
         .restitution(cfg.link_restitution as Real)
         .friction_combine_rule(CoefficientCombineRule::Average)

@@ -3,7 +3,7 @@
 
 use super::{Pending, RunStats};
 use crate::dataset::{read_replay_keys, Dataset, ReplayKey};
-use crate::types::InputError;
+use crate::error::InputError;
 use anyhow::Result;
 use rayon::prelude::*;
 use rh_physics::execute::{replay, ExecConfig, ExecPlan, Outcome, Replay};
@@ -139,7 +139,7 @@ pub(crate) fn checked_replay(
 }
 
 pub(crate) fn replay_key<'a>(
-    keys: &'a crate::types::FastMap<String, ReplayKey>,
+    keys: &'a crate::fast_map::FastMap<String, ReplayKey>,
     id: &str,
 ) -> Result<&'a ReplayKey> {
     keys.get(id).ok_or_else(|| {
