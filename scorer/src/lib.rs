@@ -31,6 +31,7 @@
 //!   replaces it.
 
 pub mod aggregate;
+pub mod api;
 pub mod aia;
 pub mod baseline;
 pub mod compare;

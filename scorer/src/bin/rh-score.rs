@@ -392,43 +392,7 @@ fn predict(a: PredictArgs) -> Result<()> {
 /// existing path is used as is; `owner/name[@revision]` is downloaded from the Hub into the
 /// Hugging Face cache (or found there when the Hub is unreachable).
 fn dataset_dir(arg: Option<String>) -> Result<PathBuf> {
-    let given = arg.or_else(|| std::env::var("RH_DATASET").ok().filter(|s| !s.is_empty()));
-    let id = match given {
-        Some(d) => {
-            let path = PathBuf::from(&d);
-            if path.exists() {
-                return Ok(path);
-            }
-            let (repo, _) = d.split_once('@').unwrap_or((&d, ""));
-            if !rh_hub::is_repo_id(repo) {
-                return Err(InputError(format!(
-                    "dataset directory {d} does not exist (nor is it a Hub dataset id owner/name)"
-                ))
-                .into());
-            }
-            d
-        }
-        None => rh_hub::RELEASED_DATASET.to_string(),
-    };
-    let (repo, revision) = match id.split_once('@') {
-        Some((r, rev)) => (r, Some(rev)),
-        None => (id.as_str(), None),
-    };
-    match rh_hub::fetch(repo, revision) {
-        Ok(snapshot) => {
-            if snapshot.from_cache_only {
-                eprintln!(
-                    "rh-score: the Hub at {} was not used ({}); {repo} comes from the Hugging Face cache, all {} files checked",
-                    rh_hub::endpoint(),
-                    snapshot.cache_reason.as_deref().unwrap_or("offline"),
-                    snapshot.files
-                );
-            }
-            Ok(snapshot.path)
-        }
-        Err(e) if e.exit_code() == 2 => Err(InputError(e.to_string()).into()),
-        Err(e) => Err(anyhow::anyhow!("{e}")),
-    }
+    rh_score::dataset::resolve_dir(arg)
 }
 
 fn load_config(path: Option<&Path>) -> Result<Config> {
