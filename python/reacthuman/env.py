@@ -32,7 +32,8 @@ Reward: at the end, ``rewards[outcome]`` (``struck`` −1; ``caught`` +1 on CATC
 plus ``shaping(obs, action, info)`` if given. ``terminated`` when the outcome is settled
 (struck, caught, or the hazard at rest on the floor after the last moving command),
 ``truncated`` at the executor's horizon; ``info`` has the scene's labels and, at the
-end, the executor-format ``outcome``.
+end, ``outcome`` (the kind) and ``outcome_detail`` (the executor's outcome, flattened to
+fixed types so vectorized infos stack: :func:`flat_outcome`).
 """
 
 from __future__ import annotations
@@ -194,7 +195,6 @@ class ReactHumanEnv(gym.Env):
             "scene_id": self.scene_id,
             "labels": dict(self._labels[self.scene_id]),
             "t": self._session.time(),
-            "outcome": None,
         }
 
     def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
@@ -223,7 +223,8 @@ class ReactHumanEnv(gym.Env):
         reward = -self.step_cost
         if end is not None:
             outcome = json.loads(self._session.outcome())
-            info["outcome"] = outcome
+            info["outcome"] = outcome["outcome"]
+            info["outcome_detail"] = flat_outcome(outcome)
             kind = outcome["outcome"]
             if kind == "caught" and info["labels"].get("gt_action") != "CATCH":
                 kind = "caught_other"
@@ -231,6 +232,31 @@ class ReactHumanEnv(gym.Env):
         if self.shaping is not None:
             reward += float(self.shaping(obs, a, info))
         return obs, float(reward), end == "terminated", end == "truncated", info
+
+
+def flat_outcome(o: Mapping[str, Any]) -> dict:
+    """The executor's outcome with fixed types, for vectorized infos (Gymnasium stacks
+    each key across environments): no ``None``, no nested dict. Absent numbers are NaN,
+    absent names ``""``; ``strike`` becomes ``strike_part``, ``strike_impulse``,
+    ``strike_speed``, ``strike_t``."""
+    nan = float("nan")
+    strike = o.get("strike") or {}
+    return {
+        "outcome": o["outcome"],
+        "strike_part": strike.get("part", ""),
+        "strike_impulse": strike.get("impulse", nan),
+        "strike_speed": strike.get("speed", nan),
+        "strike_t": strike.get("t", nan),
+        "first_contact_t": nan if o.get("first_contact_t") is None else o["first_contact_t"],
+        "first_contact_part": o.get("first_contact_part") or "",
+        "min_hand_distance": o["min_hand_distance"],
+        "base_end": np.asarray(o["base_end"], dtype=np.float64),
+        "floor_t": nan if o.get("floor_t") is None else o["floor_t"],
+        "catch_attempted": bool(o["catch_attempted"]),
+        "limits_hit": np.asarray(o["limits_hit"], dtype=bool),
+        "steps": int(o["steps"]),
+        "state_hash": o["state_hash"],
+    }
 
 
 class PlanPolicy:

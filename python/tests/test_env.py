@@ -33,10 +33,17 @@ def test_make_vec(ds68):
     envs = gym.make_vec("ReactHuman-v0", num_envs=3, vectorization_mode="sync", dataset=ds68)
     obs, info = envs.reset(seed=11)
     assert obs["robot"].shape == (3, 14) and obs["hazard"].shape == (3, 9)
-    acts = np.stack([rest_action(envs.envs[0])] * 3)
-    for _ in range(5):
-        obs, rew, term, trunc, info = envs.step(acts)
-    assert rew.shape == (3,)
+    rng = np.random.default_rng(0)
+    ended, outcomes = 0, []
+    for _ in range(300):  # long enough for episodes to end (and autoreset) at different steps
+        obs, rew, term, trunc, info = envs.step(rng.uniform(-1, 1, (3, 10)))
+        done = term | trunc
+        ended += int(done.sum())
+        if done.any():
+            assert (info["_outcome"] == done).all()
+            outcomes += list(info["outcome"][done])
+    assert rew.shape == (3,) and ended >= 3
+    assert set(outcomes) <= {"caught", "missed", "struck", "clear"} and len(outcomes) == ended
     envs.close()
 
 
@@ -82,7 +89,8 @@ def test_the_oracle_stepped_through_reaches_the_executors_outcome(ds68, oracle_p
             if term or trunc:
                 break
         want = executed[sid]["execution"]["outcome"]
-        got = info["outcome"]["outcome"]
+        got = info["outcome"]
+        assert info["outcome_detail"]["outcome"] == got
         assert got == want, (sid, got, want)
         assert got == rh.execute(env.dataset, sid, p["plan"])["outcome"]
         kinds[got] = kinds.get(got, 0) + 1
@@ -107,7 +115,7 @@ def test_standing_still_ends_and_scores_the_freeze(ds68, executed):
             n += 1
             if term or trunc:
                 break
-        assert info["outcome"]["outcome"] == rh.execute(ds, sid, freeze)["outcome"], sid
+        assert info["outcome"] == rh.execute(ds, sid, freeze)["outcome"], sid
         assert n <= env._session.horizon_periods()
         if trunc:
             assert n == env._session.horizon_periods()

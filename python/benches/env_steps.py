@@ -1,7 +1,7 @@
 """Environment steps per second of ReactHuman-v0 (state observations), single and
 vectorized (Gymnasium's SyncVectorEnv: one process, one core).
 
-    python python/bench.py DATASET [--steps N] [--num-envs K] [--control-hz HZ]
+    python python/benches/env_steps.py DATASET [--steps N] [--num-envs K] [--control-hz HZ]
 
 Reports steps per CPU-second of this process (user + sys, `time.process_time`), which is
 steps per second per core, and the wall-clock rate; a wall rate below the CPU rate means
