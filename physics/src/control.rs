@@ -142,13 +142,19 @@ impl Session {
         cfg.validate()?;
         let dt = replay.spec().physics.dt;
         let ratio = 1.0 / (dt * control_hz);
-        if !control_hz.is_finite() || control_hz <= 0.0 || ratio < 0.5 {
+        if !control_hz.is_finite() || control_hz <= 0.0 || ratio < 1.0 - 1e-9 {
             return Err(format!(
                 "control_hz must be in (0, {}] (the physics rate), got {control_hz}",
                 1.0 / dt
             ));
         }
-        let substeps = ratio.round().max(1.0) as u32;
+        if (ratio - ratio.round()).abs() > 1e-6 {
+            return Err(format!(
+                "control_hz must divide the physics rate {} Hz (a whole number of physics steps per command), got {control_hz}",
+                1.0 / dt
+            ));
+        }
+        let substeps = ratio.round() as u32;
         let ex = replay.start(cfg);
         let start = ex.motion().pose.base;
         let rest = (REST_LEFT, REST_RIGHT, 0.0);

@@ -46,6 +46,14 @@ fn execution_config() -> PyResult<String> {
     })
 }
 
+/// Panics in Rust (for the tests: a panic becomes `RuntimeError`, the interpreter lives).
+#[pyfunction]
+fn _panic_for_tests(py: Python<'_>) -> PyResult<()> {
+    errors::run(py, || -> errors::Result<()> {
+        panic!("a deliberate panic")
+    })
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<dataset::NativeDataset>()?;
@@ -53,6 +61,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(classify_plan, m)?)?;
     m.add_function(wrap_pyfunction!(versions, m)?)?;
     m.add_function(wrap_pyfunction!(execution_config, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     m.add_function(wrap_pyfunction!(session::plan_action, m)?)?;
     m.add_function(wrap_pyfunction!(session::rest_action, m)?)?;
     m.add_function(wrap_pyfunction!(session::state_lengths, m)?)?;

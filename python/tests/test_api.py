@@ -175,3 +175,12 @@ def test_the_gil_is_released_during_long_calls(ds68, preds, tmp_path):
     # returns: it ran in the middle of the call.
     middle = [s for s in stamps if t0 + 0.25 * elapsed < s < t0 + 0.75 * elapsed]
     assert elapsed > 0.01 and middle, (elapsed, len(stamps))
+
+
+def test_a_rust_panic_is_a_runtime_error():
+    from reacthuman import _native
+
+    with pytest.raises(RuntimeError, match="deliberate panic"):
+        _native._panic_for_tests()
+    # The interpreter and the module still work.
+    assert rh.classify({"walking_cmd": [0, 0, 0], "walking_duration": 0, "keyframes": []})["action"] == "NO_ACTION"

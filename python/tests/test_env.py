@@ -102,8 +102,8 @@ def test_the_oracle_stepped_through_reaches_the_executors_outcome(ds68, oracle_p
 
 
 def test_standing_still_ends_and_scores_the_freeze(ds68, executed):
-    """The freeze plan (no motion) in physics: standing still in the environment ends with
-    the executor's verdict on the freeze (struck where the label says danger_present)."""
+    """The freeze plan (no motion) in physics: standing still in the environment is the
+    executor's run of the freeze plan, bit for bit (same steps, same state hash)."""
     ds = rh.Dataset(ds68)
     env = ReactHumanEnv(ds)
     freeze = {"walking_cmd": [0, 0, 0], "walking_duration": 0, "keyframes": []}
@@ -115,7 +115,11 @@ def test_standing_still_ends_and_scores_the_freeze(ds68, executed):
             n += 1
             if term or trunc:
                 break
-        assert info["outcome"] == rh.execute(ds, sid, freeze)["outcome"], sid
+        want = rh.execute(ds, sid, freeze)
+        assert info["outcome"] == want["outcome"], sid
+        # Standing still is the freeze plan exactly: the same steps, bit for bit.
+        assert info["outcome_detail"]["state_hash"] == want["state_hash"], sid
+        assert info["outcome_detail"]["steps"] == want["steps"], sid
         assert n <= env._session.horizon_periods()
         if trunc:
             assert n == env._session.horizon_periods()
@@ -137,6 +141,12 @@ def test_bad_actions_and_options_raise(ds68):
         env.reset(options={"scene_id": "nope"})
     with pytest.raises(ValueError, match="control_hz"):
         ReactHumanEnv(ds68, control_hz=1000.0).reset(seed=0)
+    with pytest.raises(ValueError, match="divide"):
+        ReactHumanEnv(ds68, control_hz=50.0).reset(seed=0)
+    # 60 Hz: 4 physics steps per command.
+    env60 = ReactHumanEnv(ds68, control_hz=60.0)
+    env60.reset(seed=0)
+    assert env60.period == pytest.approx(1 / 60)
     with pytest.raises(ValueError, match="rewards"):
         ReactHumanEnv(ds68, rewards={"win": 1})
     with pytest.raises(FileNotFoundError):
