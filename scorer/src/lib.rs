@@ -32,6 +32,7 @@
 
 pub mod action_rule;
 pub mod aggregate;
+pub mod api;
 pub mod aia;
 pub mod analyses;
 pub mod baseline;

@@ -27,7 +27,7 @@ pub use report::ExecutionReport;
 #[cfg(feature = "execute")]
 pub use run::{cache_key, execute_all};
 #[cfg(feature = "execute")]
-pub(crate) use run::{checked_replay, replay_key};
+pub use run::{checked_replay, replay_key};
 pub use scored::execute_scored;
 
 /// One scored decision waiting for execution.

@@ -263,6 +263,21 @@ pub fn build(cfg: &PromptConfig, dir: &Path, scene_id: &str) -> Result<BuiltProm
     })
 }
 
+/// One scene's canonical messages and their `prompt_hash` — the hash `rh-score predict`
+/// records and `--dry-run` prints (the SHA-256 of the messages JSON, as
+/// [`rh_llm::ChatRequest`] computes it; model and generation parameters are not part of it).
+pub fn canonical(
+    cfg: &PromptConfig,
+    dir: &Path,
+    scene_id: &str,
+) -> Result<(Value, String), String> {
+    let built = build(cfg, dir, scene_id)?;
+    let hash = rh_llm::ChatRequest::new("", built.messages.clone(), Default::default(), 0)
+        .prompt_hash()
+        .to_string();
+    Ok((built.messages, hash))
+}
+
 /// A copy of a request body with every image data URL replaced by a short note (for
 /// `--dry-run`).
 pub fn elide_images(v: &Value) -> Value {
