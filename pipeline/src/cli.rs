@@ -75,6 +75,10 @@ pub enum Command {
         /// No progress output.
         #[arg(long)]
         quiet: bool,
+        /// When stderr is not a terminal (a log file, CI): seconds between progress lines
+        /// (scenes done of total, rate, ETA). A terminal gets a progress bar instead.
+        #[arg(long, value_name = "SECONDS", default_value_t = rh_contract::progress::LOG_EVERY_S)]
+        progress_every: f64,
     },
     /// Map a free-text description to a validated selection (family, object, room); prints JSON.
     Plan {
@@ -587,7 +591,13 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             jobs,
             json,
             quiet,
+            progress_every,
         } => {
+            if !(progress_every.is_finite() && progress_every > 0.0) {
+                return Err(input(format!(
+                    "--progress-every {progress_every}: must be a positive number of seconds"
+                )));
+            }
             let seed = seed.unwrap_or(config.build.seed);
             let selections = match &descriptions {
                 None => None,
@@ -636,6 +646,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                 render: !no_render,
                 masks,
                 progress: !quiet,
+                progress_every_s: progress_every,
             };
             run_build(&opts, &catalog, &config, json)
         }
