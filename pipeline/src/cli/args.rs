@@ -180,6 +180,10 @@ pub struct BuildArgs {
     /// No progress output.
     #[arg(long)]
     pub quiet: bool,
+    /// When stderr is not a terminal (a log file, CI): seconds between progress lines
+    /// (scenes done of total, rate, ETA). A terminal gets a progress bar instead.
+    #[arg(long, value_name = "SECONDS", default_value_t = rh_contract::progress::LOG_EVERY_S)]
+    pub progress_every: f64,
 }
 
 /// `--shard i/N` as (i, N), 0 ≤ i < N.

@@ -26,7 +26,13 @@ pub fn run(args: BuildArgs, catalog: &Catalog, config: &Config) -> Result<(), Fa
         jobs,
         json,
         quiet,
+        progress_every,
     } = args;
+    if !(progress_every.is_finite() && progress_every > 0.0) {
+        return Err(input(format!(
+            "--progress-every {progress_every}: must be a positive number of seconds"
+        )));
+    }
     let seed = seed.unwrap_or(config.build.seed);
     let selections = match &descriptions {
         None => None,
@@ -74,6 +80,7 @@ pub fn run(args: BuildArgs, catalog: &Catalog, config: &Config) -> Result<(), Fa
         render: !no_render,
         masks,
         progress: !quiet,
+        progress_every_s: progress_every,
     };
     build_and_print(&opts, catalog, config, json)
 }
