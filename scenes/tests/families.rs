@@ -84,9 +84,9 @@ fn travelled(sim: &Simulation, k: u32) -> f64 {
     ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt()
 }
 
-/// A hazard that creeps down a tilted board (`families::TiltedLaunch`) travels
+/// A hazard that creeps down a tilted board (`families::launch::TiltedLaunch`) travels
 /// `v0 t + a t²/2` in its first `t` seconds, `a` the creep acceleration its tilt was
-/// chosen for (`families::creep_tilt`: sliding against the combined friction, or a ball
+/// chosen for (`families::launch::creep_tilt`: sliding against the combined friction, or a ball
 /// rolling).
 fn assert_creeps_at_the_designed_acceleration(r: &SceneResult, t: f64) {
     let sim = plain(&r.spec);
