@@ -43,6 +43,7 @@ pub mod coverage;
 pub mod dataset;
 pub mod dataset_diagnosis;
 pub mod error;
+pub mod execute_scored;
 pub mod execution;
 pub mod explain;
 pub mod fast_map;

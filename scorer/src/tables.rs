@@ -5,7 +5,17 @@ use crate::report::{MetricsRow, ModelReport, Report};
 use crate::safety_rule::SafetyRule;
 use std::fmt::Write as _;
 
-use crate::text_table::{coverage_cell, csv_field, num, num_ci, pct, pct_ci, Table};
+use crate::text_table::{csv_field, num, num_ci, pct, pct_ci, Table};
+
+/// "answered/expected", marked when incomplete.
+fn coverage_cell(m: &ModelReport) -> String {
+    let c = &m.coverage;
+    if c.complete {
+        format!("{}/{}", c.answered, c.expected)
+    } else {
+        format!("{}/{} INCOMPLETE", c.answered, c.expected)
+    }
+}
 
 /// The CATCH row of a per-GT-action breakdown.
 fn catch_row(rows: &[MetricsRow]) -> Option<&MetricsRow> {

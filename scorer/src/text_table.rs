@@ -1,7 +1,5 @@
-//! A plain text table, written aligned for a terminal or as Markdown, and the number
-//! formats of the report's cells (percentages, intervals, coverage).
-
-use crate::report::ModelReport;
+//! A plain text table, written aligned for a terminal, as Markdown or as CSV, and the
+//! number formats of the report's cells (percentages, intervals).
 
 pub(crate) fn pct(v: Option<f64>) -> String {
     v.map_or("—".into(), |x| format!("{:.1}", 100.0 * x))
@@ -21,16 +19,6 @@ pub(crate) fn pct_ci(v: Option<[f64; 2]>) -> String {
 /// A 95% interval of a mean: "0.12–0.30".
 pub(crate) fn num_ci(v: Option<[f64; 2]>, digits: usize) -> String {
     v.map_or("—".into(), |[a, b]| format!("{a:.digits$}–{b:.digits$}"))
-}
-
-/// "answered/expected", marked when incomplete.
-pub(crate) fn coverage_cell(m: &ModelReport) -> String {
-    let c = &m.coverage;
-    if c.complete {
-        format!("{}/{}", c.answered, c.expected)
-    } else {
-        format!("{}/{} INCOMPLETE", c.answered, c.expected)
-    }
 }
 
 /// How a column's cells sit in its width.
@@ -223,10 +211,7 @@ mod tests {
     #[test]
     fn text_markdown_and_csv() {
         let t = sample();
-        assert_eq!(
-            t.text(),
-            "model     n\n----------\na|b      12\nx,\"y\"     3\n"
-        );
+        assert_eq!(t.text(), "model   n\n---------\na|b    12\nx,\"y\"   3\n");
         assert_eq!(
             t.markdown(),
             "| model | n |\n| --- | ---: |\n| a\\|b | 12 |\n| x,\"y\" | 3 |\n"

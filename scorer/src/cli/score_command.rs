@@ -1,5 +1,5 @@
 //! `rh-score PREDS`: scoring a predictions file ([`crate::score::Scoring`]), the report
-//! ([`crate::report::Report`]), `--execute` ([`crate::execution::execute_scored`]) and the
+//! ([`crate::report::Report`]), `--execute` ([`crate::execute_scored::execute_scored`]) and the
 //! output files and terminal tables the arguments ask for.
 
 use super::args::Cli;
@@ -80,7 +80,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 tiled_scene: cli.tiled_scene.as_deref(),
                 progress: !cli.quiet,
             });
-        report.execution = Some(crate::execution::execute_scored(
+        report.execution = Some(crate::execute_scored::execute_scored(
             &mut scoring,
             &ds,
             &cfg,

@@ -14,7 +14,6 @@
 pub mod report;
 #[cfg(feature = "execute")]
 mod run;
-mod scored;
 #[cfg(feature = "videos")]
 pub mod videos;
 
@@ -28,7 +27,6 @@ pub use report::ExecutionReport;
 pub use run::{cache_key, execute_all};
 #[cfg(feature = "execute")]
 pub use run::{checked_replay, replay_key};
-pub use scored::execute_scored;
 
 /// One scored decision waiting for execution.
 #[derive(Debug, Clone)]

@@ -1,10 +1,10 @@
-//! `--execute` after scoring: runs the decisions a [`Scoring`] collected, draws their
+//! `--execute` after scoring (beside `score` and `execution`, which it joins): runs the decisions a [`Scoring`] collected, draws their
 //! videos when asked, completes the held-back `--decisions` lines with each outcome, and
 //! builds the report's execution part.
 
-use super::{ExecutionReport, VideoRequest};
 use crate::config::Config;
 use crate::dataset::Dataset;
+use crate::execution::{ExecutionReport, VideoRequest};
 use crate::score::Scoring;
 use anyhow::Result;
 use std::path::Path;
@@ -19,7 +19,7 @@ pub fn execute_scored(
     cache: Option<&Path>,
     videos: Option<VideoRequest>,
 ) -> Result<ExecutionReport> {
-    use super::execute_all;
+    use crate::execution::execute_all;
     let (collected, names) = scoring
         .take_execution()
         .expect("execution was enabled before scoring");
@@ -80,14 +80,14 @@ pub fn execute_scored(
 #[cfg(feature = "videos")]
 fn write_videos(
     ds: &Dataset,
-    pending: &[super::Pending],
+    pending: &[crate::execution::Pending],
     outcomes: &[Option<rh_contract::execution::Outcome>],
     names: &[String],
     cfg: &Config,
     req: VideoRequest,
 ) -> Result<()> {
     let started = std::time::Instant::now();
-    let index = super::videos::write_videos(
+    let index = crate::execution::videos::write_videos(
         ds,
         pending,
         outcomes,
@@ -112,7 +112,7 @@ fn write_videos(
 #[cfg(all(feature = "execute", not(feature = "videos")))]
 fn write_videos(
     _: &Dataset,
-    _: &[super::Pending],
+    _: &[crate::execution::Pending],
     _: &[Option<rh_contract::execution::Outcome>],
     _: &[String],
     _: &Config,
