@@ -31,8 +31,8 @@ Reward: at the end, ``rewards[outcome]`` (``struck`` −1; ``caught`` +1 on CATC
 ``caught_other`` 0 elsewhere; ``missed`` and ``clear`` 0) minus ``step_cost`` per step,
 plus ``shaping(obs, action, info)`` if given. ``terminated`` when the outcome is settled
 (struck, caught, or the hazard at rest on the floor after the last moving command),
-``truncated`` at the executor's horizon; ``info`` has the scene's labels and, at the
-end, ``outcome`` (the kind) and ``outcome_detail`` (the executor's outcome, flattened to
+``truncated`` at the executor's horizon; ``info`` has the scene id and time, and, from
+``reset`` and at the end, the scene's ``labels``; at the end also ``outcome`` (the kind) and ``outcome_detail`` (the executor's outcome, flattened to
 fixed types so vectorized infos stack: :func:`flat_outcome`).
 """
 
@@ -190,12 +190,11 @@ class ReactHumanEnv(gym.Env):
             obs["hazard"] = np.asarray(s.hazard_state(), dtype=np.float64)
         return obs
 
-    def _info(self) -> dict:
-        return {
-            "scene_id": self.scene_id,
-            "labels": dict(self._labels[self.scene_id]),
-            "t": self._session.time(),
-        }
+    def _info(self, labels: bool) -> dict:
+        info = {"scene_id": self.scene_id, "t": self._session.time()}
+        if labels:
+            info["labels"] = dict(self._labels[self.scene_id])
+        return info
 
     def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
         super().reset(seed=seed)
@@ -208,7 +207,7 @@ class ReactHumanEnv(gym.Env):
         self.scene_id = scene_id
         self._session = _native.NativeSession(self.dataset._native, scene_id, self.control_hz)
         self.steps = 0
-        return self._obs(), self._info()
+        return self._obs(), self._info(labels=True)
 
     def step(self, action):
         if self._session is None:
@@ -219,7 +218,7 @@ class ReactHumanEnv(gym.Env):
         end = self._session.step(self.command(a).tolist())
         self.steps += 1
         obs = self._obs()
-        info = self._info()
+        info = self._info(labels=end is not None)
         reward = -self.step_cost
         if end is not None:
             outcome = json.loads(self._session.outcome())
