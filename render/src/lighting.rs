@@ -105,7 +105,7 @@ const SHADOW_NORMAL_OFFSET: f64 = 0.025;
 /// The shader's largest slope-scaled extra normal offset, in shadow-map texels (on
 /// surfaces the light grazes).
 const SHADOW_SLOPE_OFFSET: f64 = 2.5;
-/// How far (texels) the shader's filter reads from the lookup point: one bilinear
-/// comparison tap reads the 2×2 texels around it, at most 1 texel per axis, √2 along
-/// the diagonal, which 1.5 bounds.
-const SHADOW_PCF_TEXELS: f64 = 1.5;
+/// How far (texels) the shader's filter reads from the lookup point: four bilinear
+/// taps half a texel off diagonally each read one more texel: 1.5 texels per axis,
+/// 1.5·√2 along the diagonal, which 2.5 bounds.
+const SHADOW_PCF_TEXELS: f64 = 2.5;
