@@ -23,10 +23,18 @@ pub fn encode_png(
     color: PngColor,
 ) -> Result<Vec<u8>, String> {
     use image::ImageEncoder;
-    let color = match color {
-        PngColor::Rgb8 => image::ExtendedColorType::Rgb8,
-        PngColor::L16 => image::ExtendedColorType::L16,
+    let (color, bytes_per_pixel) = match color {
+        PngColor::Rgb8 => (image::ExtendedColorType::Rgb8, 3),
+        PngColor::L16 => (image::ExtendedColorType::L16, 2),
     };
+    // The encoder asserts the length; a wrong one is an error here, not a panic.
+    let expected = width as usize * height as usize * bytes_per_pixel;
+    if pixels.len() != expected {
+        return Err(format!(
+            "{} bytes of pixels for a {width}x{height} image, expected {expected}",
+            pixels.len()
+        ));
+    }
     let mut bytes = Vec::new();
     image::codecs::png::PngEncoder::new_with_quality(
         &mut bytes,
