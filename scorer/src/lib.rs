@@ -32,9 +32,9 @@
 
 pub mod action_rule;
 pub mod aggregate;
-pub mod api;
 pub mod aia;
 pub mod analyses;
+pub mod api;
 pub mod baseline;
 pub mod cli;
 pub mod compare;

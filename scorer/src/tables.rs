@@ -7,6 +7,14 @@ use std::fmt::Write as _;
 
 use crate::text_table::{csv_field, num, num_ci, pct, pct_ci, Table};
 
+/// The report's models, then the pooled row when there is more than one model (the
+/// order of every per-model table).
+fn model_rows(r: &Report) -> impl Iterator<Item = &ModelReport> {
+    r.models
+        .iter()
+        .chain((r.models.len() > 1).then_some(&r.pooled))
+}
+
 /// "answered/expected", marked when incomplete.
 fn coverage_cell(m: &ModelReport) -> String {
     let c = &m.coverage;
@@ -129,11 +137,7 @@ fn distance_table(r: &Report) -> Table {
         "HDE d1-d_min (m)",
         "n/missing",
     ]);
-    for m in r
-        .models
-        .iter()
-        .chain((r.models.len() > 1).then_some(&r.pooled))
-    {
+    for m in model_rows(r) {
         for g in &m.by_gt_action {
             if g.decisions == 0 {
                 continue;
@@ -196,11 +200,7 @@ fn group_table(
     suffix: &str,
     cell: fn(&MetricsRow) -> String,
 ) -> Table {
-    let models: Vec<&ModelReport> = r
-        .models
-        .iter()
-        .chain((r.models.len() > 1).then_some(&r.pooled))
-        .collect();
+    let models: Vec<&ModelReport> = model_rows(r).collect();
     let mut head = vec![title.to_string()];
     for m in &models {
         head.push(format!("{} {suffix}", m.model));
@@ -247,11 +247,7 @@ fn recall_and_comparison_tables(r: &Report, out: &mut Vec<TitledTable>) {
         "CI",
         "SAA %",
     ]);
-    for m in r
-        .models
-        .iter()
-        .chain((r.models.len() > 1).then_some(&r.pooled))
-    {
+    for m in model_rows(r) {
         let mut row = vec![m.model.clone()];
         for c in &m.recall {
             row.push(format!("{} (n={})", pct(c.recall), c.scenes));
@@ -354,11 +350,7 @@ fn safety_and_reach_tables(r: &Report, out: &mut Vec<TitledTable>) {
         "SAA on DODGE scenes %",
         "SAA on NO_ACTION %",
     ]);
-    for m in r
-        .models
-        .iter()
-        .chain((r.models.len() > 1).then_some(&r.pooled))
-    {
+    for m in model_rows(r) {
         let g = &m.by_gt_action;
         t.row(vec![
             m.model.clone(),
