@@ -13,7 +13,10 @@ apt_packages=(
   chromium
   slurm-wlm munge
 )
-python_packages=(pyarrow datasets)
+# Import names. The Python package's build and tests (scripts/test_python.sh) need
+# maturin, numpy, gymnasium and pytest; its wheel's own dependencies are numpy, pyarrow
+# and gymnasium.
+python_packages=(pyarrow datasets maturin numpy gymnasium pytest)
 
 missing=()
 for pkg in "${apt_packages[@]}"; do

@@ -5,7 +5,8 @@
 //! * [`families`] — the seventeen event families, in canonical order;
 //! * [`columns`] — the scene table's columns, their types, nullability and meaning;
 //! * [`action`] — the three action primitives;
-//! * [`layout`] — where files live in a dataset directory (specs, videos, frames, data).
+//! * [`layout`] — where files live in a dataset directory (specs, videos, frames, data);
+//! * [`fsio`] — atomic file writing; [`progress`] — progress lines for logs (both programs).
 //!
 //! With the `arrow` feature, [`arrow_schema`] gives the Arrow schema of the scene table.
 //! The crate has no heavy dependencies (serde; Arrow only behind the feature), so both
@@ -17,6 +18,9 @@ pub mod execution;
 pub mod families;
 pub mod fsio;
 pub mod layout;
+#[cfg(feature = "png")]
+pub mod png;
+pub mod progress;
 
 #[cfg(feature = "arrow")]
 pub mod arrow_schema;

@@ -147,6 +147,22 @@ pub struct Snapshot {
     pub downloaded: usize,
 }
 
+impl Snapshot {
+    /// When the snapshot came from the cache alone, the note that says so (for stderr):
+    /// "the Hub at URL was not used (why); REPO comes from the Hugging Face cache, all N
+    /// files checked".
+    pub fn cache_note(&self, repo: &str) -> Option<String> {
+        self.from_cache_only.then(|| {
+            format!(
+                "the Hub at {} was not used ({}); {repo} comes from the Hugging Face cache, all {} files checked",
+                endpoint(),
+                self.cache_reason.as_deref().unwrap_or("offline"),
+                self.files
+            )
+        })
+    }
+}
+
 /// Whether `text` has the form of a Hub repository id, `owner/name`.
 pub fn is_repo_id(text: &str) -> bool {
     let Some((owner, name)) = text.split_once('/') else {

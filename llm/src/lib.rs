@@ -54,6 +54,23 @@ pub struct ClientConfig {
     pub api_key: Option<String>,
 }
 
+impl ClientConfig {
+    /// The endpoint and key a command line gives: `base_url` (`--base-url`), else
+    /// `$OPENAI_BASE_URL` when set, else the configured one; the key from the environment
+    /// variable `api_key_env` (unset or empty: none, fine for local servers).
+    pub fn with_endpoint(mut self, base_url: Option<String>, api_key_env: &str) -> Self {
+        if let Some(u) = base_url.or_else(|| {
+            std::env::var("OPENAI_BASE_URL")
+                .ok()
+                .filter(|s| !s.is_empty())
+        }) {
+            self.base_url = u;
+        }
+        self.api_key = std::env::var(api_key_env).ok().filter(|k| !k.is_empty());
+        self
+    }
+}
+
 impl std::fmt::Debug for ClientConfig {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("ClientConfig")

@@ -4,17 +4,25 @@
 //!   label rule's thresholds it was labelled under, `LabelConfig`);
 //! * [`simulate`] — the deterministic rapier world built from a spec (dt 1/240,
 //!   enhanced determinism) and its per-step state hash;
+//! * [`shapes`] — the spec's shapes and the humanoid's links as rapier shapes;
+//! * [`obstacles`] — line-of-sight queries against the fixed bodies (cameras, visibility);
 //! * [`body`] — the humanoid observer's links (pure geometry);
 //! * [`strike`] — the strike test shared by the label's counterfactual and the executor;
 //! * [`execute`] — replay to the decision moment and execution of a plan by the humanoid;
+//! * [`control`] — closed-loop control of the same humanoid from Δ: whole-body commands at
+//!   a control rate over the executor's physics, limits and outcome rule;
 //! * [`seeds`] — the named `rand_chacha` sub-streams.
 //!
-//! Module graph (`A → B`: A uses B): `execute → simulate → body, strike → spec`;
+//! Module graph (`A → B`: A uses B): `control → execute → simulate → shapes, body, strike
+//! → spec`; `obstacles → shapes`;
 //! `seeds` and `spec` use nothing in the crate.
 
 pub mod body;
+pub mod control;
 pub mod execute;
+pub mod obstacles;
 pub mod seeds;
+pub mod shapes;
 pub mod simulate;
 pub mod spec;
 pub mod strike;

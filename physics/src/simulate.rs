@@ -7,7 +7,8 @@
 //! scene is simulated single-threaded, and nothing here reads a clock or a hash map.
 
 use crate::body::{Geometry, LinkShape, Part, BODY_FRICTION, BODY_RESTITUTION};
-use crate::spec::{BodyKind, JointKind, ObserverSpec, PartSpec, SceneSpec, ShapeSpec};
+use crate::shapes::{collider_for, link_shape, posed_parts, rot, v3};
+use crate::spec::{BodyKind, JointKind, ObserverSpec, SceneSpec};
 use crate::strike::{touch_at, HarmRule, Region, StrikeMonitor};
 use rapier3d::prelude::*;
 use sha2::{Digest, Sha256};
@@ -150,130 +151,6 @@ impl Simulation {
                 && self.hazard_contacts[k as usize] & TOUCH_FLOOR != 0
         })
     }
-}
-
-fn v3(a: [f64; 3]) -> Vector {
-    Vector::new(a[0] as Real, a[1] as Real, a[2] as Real)
-}
-
-fn rot(q: [f64; 4]) -> Rotation {
-    Rotation::from_xyzw(q[0] as Real, q[1] as Real, q[2] as Real, q[3] as Real).normalize()
-}
-
-fn shared_shape(shape: &ShapeSpec) -> SharedShape {
-    match *shape {
-        ShapeSpec::Box { half_extents: h } => {
-            SharedShape::cuboid(h[0] as Real, h[1] as Real, h[2] as Real)
-        }
-        ShapeSpec::Sphere { radius } => SharedShape::ball(radius as Real),
-        // rapier's cylinders and capsules are along local y; the spec's are along z.
-        ShapeSpec::Cylinder {
-            half_height,
-            radius,
-        } => SharedShape::cylinder(half_height as Real, radius as Real),
-        ShapeSpec::Capsule {
-            half_height,
-            radius,
-        } => SharedShape::capsule_y(half_height as Real, radius as Real),
-    }
-}
-
-/// Extra rotation taking a y-axis primitive to the spec's z axis.
-fn axis_fix(shape: &ShapeSpec) -> Rotation {
-    match shape {
-        ShapeSpec::Cylinder { .. } | ShapeSpec::Capsule { .. } => {
-            Rotation::from_axis_angle(Vector::X, std::f32::consts::FRAC_PI_2 as Real)
-        }
-        _ => Rotation::IDENTITY,
-    }
-}
-
-/// A body's parts as (pose in the body frame, shape) pairs.
-fn posed_parts(parts: &[PartSpec]) -> Vec<(Pose, SharedShape)> {
-    parts
-        .iter()
-        .map(|p| {
-            let pose = Pose::from_parts(v3(p.offset), rot(p.rotation) * axis_fix(&p.shape));
-            (pose, shared_shape(&p.shape))
-        })
-        .collect()
-}
-
-fn collider_for(parts: &[PartSpec]) -> ColliderBuilder {
-    let posed = posed_parts(parts);
-    if posed.len() == 1 {
-        let (pose, shape) = posed.into_iter().next().expect("one part");
-        ColliderBuilder::new(shape).position(pose)
-    } else {
-        ColliderBuilder::compound(posed)
-    }
-}
-
-/// The spec's fixed bodies (furniture, walls, stairs) as world-posed shapes, for line-of-
-/// sight queries: `Obstacles::blocks` says whether a segment passes through any of them.
-pub struct Obstacles {
-    parts: Vec<(Pose, SharedShape)>,
-}
-
-impl Obstacles {
-    pub fn of(spec: &SceneSpec) -> Obstacles {
-        let parts = spec
-            .bodies
-            .iter()
-            .filter(|b| b.kind == BodyKind::Fixed)
-            .flat_map(|b| {
-                let body_pose = Pose::from_parts(v3(b.position), rot(b.rotation));
-                posed_parts(&b.parts)
-                    .into_iter()
-                    .map(move |(pose, shape)| (body_pose * pose, shape))
-            })
-            .collect();
-        Obstacles { parts }
-    }
-
-    /// Adds the observer's collision capsule (see `observer_capsule`), its radius widened
-    /// by `inflate` (m), as one more obstacle.
-    pub fn with_observer(mut self, observer: &ObserverSpec, inflate: f64) -> Obstacles {
-        let (centre, half, radius) = observer_capsule(observer, inflate);
-        self.parts.push((
-            Pose::from_parts(centre, Rotation::IDENTITY),
-            SharedShape::capsule_z(half, radius),
-        ));
-        self
-    }
-
-    /// Whether `p` lies inside one of the obstacles.
-    pub fn contains(&self, p: [f64; 3]) -> bool {
-        self.parts
-            .iter()
-            .any(|(pose, shape)| shape.contains_point(pose, v3(p)))
-    }
-
-    /// Whether the straight segment from `a` to `b` passes through a fixed body.
-    pub fn blocks(&self, a: [f64; 3], b: [f64; 3]) -> bool {
-        let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        if length < 1e-9 {
-            return false;
-        }
-        let ray = rapier3d::parry::query::Ray::new(v3(a), v3(d.map(|c| c / length)));
-        self.parts
-            .iter()
-            .any(|(pose, shape)| shape.cast_ray(pose, &ray, length as Real, true).is_some())
-    }
-}
-
-/// The observer's *sight envelope* for line-of-sight queries (the visibility validator):
-/// a vertical capsule of the torso radius from the floor to the top of the head, as
-/// (centre, half height of the segment, radius), `inflate` widening the radius to cover
-/// the drawn mesh's limbs. It answers "could the drawn observer hide the hazard from a
-/// camera", not "does the hazard hit the body": the body that is struck is
-/// [`observer_links`] (the humanoid of `execute::humanoid`).
-fn observer_capsule(o: &ObserverSpec, inflate: f64) -> (Vector, Real, Real) {
-    let radius = o.torso_radius as Real;
-    let half = ((o.height as Real) / 2.0 - radius).max(0.0);
-    let centre = Vector::new(o.x as Real, o.y as Real, (o.height / 2.0) as Real);
-    (centre, half, radius + inflate as Real)
 }
 
 /// Height of a collider's lowest point: the tightest of its parts' bounding boxes (a
@@ -678,19 +555,6 @@ pub(crate) fn contact_impulse(world: &PhysicsWorld, a: ColliderHandle, b: Collid
         .contact_pair(a, b)
         .filter(|pair| pair.has_any_active_contact())
         .map_or(0.0, |pair| pair.total_impulse_magnitude() as f64)
-}
-
-/// The collision shape of one of the humanoid's links (the label's standing body and the
-/// executor's moving one alike).
-pub fn link_shape(shape: LinkShape) -> SharedShape {
-    match shape {
-        LinkShape::Box(h) => SharedShape::cuboid(h[0] as Real, h[1] as Real, h[2] as Real),
-        LinkShape::Capsule {
-            half_height,
-            radius,
-        } => SharedShape::capsule_z(half_height as Real, radius as Real),
-        LinkShape::Sphere(r) => SharedShape::ball(r as Real),
-    }
 }
 
 /// The contact pairs of collider `c` with an active contact this step, each with the

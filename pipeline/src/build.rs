@@ -37,7 +37,6 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 
 #[derive(Debug, Clone)]
 pub struct BuildOptions {
@@ -55,6 +54,8 @@ pub struct BuildOptions {
     /// Also write the observation frames' instance-id and depth PNGs (needs `render`).
     pub masks: bool,
     pub progress: bool,
+    /// Seconds between progress lines when stderr is not a terminal.
+    pub progress_every_s: f64,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -135,14 +136,15 @@ pub fn check_options(
     Ok(())
 }
 
+/// Build progress: a bar on a terminal; in a log (CI, a file) a line every
+/// `progress_every_s` — scenes done of total, rate, ETA (`rh_contract::progress`).
 struct Progress {
     bar: Option<indicatif::ProgressBar>,
-    done: AtomicU64,
-    total: u64,
+    log: rh_contract::progress::ProgressLog,
 }
 
 impl Progress {
-    fn new(total: u64, enabled: bool) -> Progress {
+    fn new(total: u64, enabled: bool, every_s: f64) -> Progress {
         let bar = (enabled && std::io::stderr().is_terminal()).then(|| {
             let bar = indicatif::ProgressBar::new(total);
             bar.set_style(
@@ -154,28 +156,21 @@ impl Progress {
             );
             bar
         });
-        Progress {
-            bar,
-            done: AtomicU64::new(0),
+        let log = rh_contract::progress::ProgressLog::start(
+            enabled,
+            "building",
+            "scenes",
             total,
-        }
+            std::time::Duration::from_secs_f64(every_s),
+        );
+        Progress { bar, log }
     }
 
-    fn advance(&self, scenes: u64, enabled: bool) {
-        let before = self.done.fetch_add(scenes, Ordering::Relaxed);
-        let after = before + scenes;
-        match &self.bar {
-            Some(bar) => bar.inc(scenes),
-            // Not a terminal (CI logs): a line at every tenth.
-            None if enabled => {
-                if (before * 10 / self.total.max(1)) != (after * 10 / self.total.max(1))
-                    || after == self.total
-                {
-                    eprintln!("built {after}/{} scenes", self.total);
-                }
-            }
-            None => {}
+    fn advance(&self, scenes: u64) {
+        if let Some(bar) = &self.bar {
+            bar.inc(scenes);
         }
+        self.log.add(scenes);
     }
 
     fn finish(&self) {
@@ -497,7 +492,7 @@ pub fn build(
     if let (Some(banner), true) = (&render_banner, opts.progress && scenes_todo > 0) {
         eprintln!("{banner}");
     }
-    let progress = Progress::new(scenes_todo, opts.progress);
+    let progress = Progress::new(scenes_todo, opts.progress, opts.progress_every_s);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs)
         .build()
@@ -526,7 +521,7 @@ pub fn build(
                 let files = group_files(out, g, &results, &rejections, catalog)
                     .map_err(BuildError::Internal)?;
                 syncer.submit(files)?;
-                progress.advance(count, opts.progress);
+                progress.advance(count);
                 Ok(())
             })
     });

@@ -10,7 +10,9 @@
 //! the post-process anti-aliasing pass; default: the configuration's `fxaa`).
 //!
 //! Prints each scene's own time and the figure that matters for a build: wall-clock
-//! seconds per scene with every worker busy.
+//! seconds per scene with every worker busy; and, independent of other load on the
+//! machine, the CPU seconds per scene with the encoder threads' share (the encode-only
+//! bound).
 //!
 //! `RH_BENCH_MASKS=1` also writes the mask and depth PNGs (as `build --masks`). The
 //! instance-id pass alone (`Renderer::measure_hazard`: the five observation frames of
@@ -24,6 +26,15 @@ use rh_scenes::config::Config;
 use rh_scenes::driver::produce_group;
 use rh_scenes::selection::plan_group;
 use std::time::Instant;
+
+/// User + system CPU seconds of this process, all threads (`/proc/self/stat`).
+fn process_cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let rest = stat.rsplit(')').next().unwrap_or("");
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    (ticks(11) + ticks(12)) / 100.0
+}
 
 fn env_parse<T: std::str::FromStr>(name: &str) -> Option<T> {
     std::env::var(name).ok().and_then(|v| v.parse().ok())
@@ -84,6 +95,10 @@ fn main() {
             .expect("a Vulkan adapter")
     });
     let setup = t.elapsed().as_secs_f64();
+    let (cpu0, enc0) = (
+        process_cpu_seconds(),
+        rh_render::encode::encode_cpu_seconds(),
+    );
     let t = Instant::now();
     let times: Vec<(f64, String)> = pool.install(|| {
         scenes
@@ -112,6 +127,8 @@ fn main() {
             .collect()
     });
     let wall = t.elapsed().as_secs_f64();
+    let cpu = process_cpu_seconds() - cpu0;
+    let enc = rh_render::encode::encode_cpu_seconds() - enc0;
     let _ = std::fs::remove_dir_all(&dir);
     // The id pass alone, one scene after another on this thread.
     let t = Instant::now();
@@ -141,5 +158,17 @@ fn main() {
     println!(
         "render_throughput: masks {}; instance-id pass alone {id_pass:.3} s/scene on one worker",
         opts.masks
+    );
+    // CPU time does not depend on what else runs on the machine (wall time does): the
+    // process's CPU per scene, and the encoder threads' share of it — the encode-only
+    // bound, what a scene costs if drawing were free.
+    println!(
+        "render_throughput: {:.2} CPU-s/scene (process, user + system), of which encoding \
+         {:.2} CPU-s/scene: encode-only bound {:.2} s/scene wall on {jobs} cores; all of it \
+         on {jobs} idle cores: {:.2} s/scene",
+        cpu / count,
+        enc / count,
+        enc / count / jobs as f64,
+        cpu / count / jobs as f64
     );
 }

@@ -3,6 +3,7 @@
 
 use ffmpeg_next as ff;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{sync_channel, SyncSender};
 use std::sync::Once;
 use std::thread::JoinHandle;
@@ -233,8 +234,10 @@ impl Drop for Mp4Writer {
 pub struct FramePool(std::sync::Arc<std::sync::Mutex<Vec<Vec<u8>>>>);
 
 impl FramePool {
-    /// Most buffers kept (a few frames in flight per video).
-    const KEEP: usize = 48;
+    /// Most buffers kept: what is in flight (per video `QUEUED` + one being encoded, three
+    /// cameras) with a few to spare. Each kept 720p buffer is 3.7 MB of resident memory
+    /// per worker (48 of them were 177 MB).
+    const KEEP: usize = 16;
 
     /// A buffer of `len` bytes (contents unspecified: the caller overwrites all of it).
     pub fn take(&self, len: usize) -> Vec<u8> {
@@ -253,6 +256,32 @@ impl FramePool {
     }
 }
 
+/// CPU time spent by encoder threads (RGBA → YUV conversion, libx264, MP4 writing), in
+/// microseconds, summed over every video this process finished.
+static ENCODE_CPU_US: AtomicU64 = AtomicU64::new(0);
+
+/// CPU seconds the encoder threads of this process have spent so far (the render bench's
+/// encode-only bound). Linux only (`/proc`); 0 elsewhere.
+pub fn encode_cpu_seconds() -> f64 {
+    ENCODE_CPU_US.load(Ordering::Relaxed) as f64 / 1e6
+}
+
+/// This thread's user + system CPU time (s), from `/proc/thread-self/stat` (clock ticks).
+fn thread_cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/thread-self/stat") else {
+        return 0.0;
+    };
+    // Fields after the command name in parentheses: utime and stime are the 12th and 13th.
+    let rest = stat.rsplit(')').next().unwrap_or("");
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    (ticks(11) + ticks(12)) / 100.0
+}
+
+/// Frames queued per video beyond the one being encoded: enough to keep the encoder
+/// busy while the next frames are drawn; each is 3.7 MB at 720p.
+const QUEUED: usize = 2;
+
 /// A video encoded on its own thread: frames are sent through a bounded channel, so
 /// rendering (this thread) overlaps with encoding (that one).
 pub struct VideoJob {
@@ -269,16 +298,22 @@ impl VideoJob {
         settings: EncodeSettings,
         pool: FramePool,
     ) -> VideoJob {
-        let (tx, rx) = sync_channel::<Vec<u8>>(8);
+        let (tx, rx) = sync_channel::<Vec<u8>>(QUEUED);
         let handle = std::thread::Builder::new()
             .name("rh-encode".into())
             .spawn(move || {
-                let mut writer = Mp4Writer::create(&path, width, height, fps, &settings)?;
-                for frame in rx {
-                    writer.push(&frame)?;
-                    pool.give(frame);
-                }
-                writer.finish()
+                let start = thread_cpu_seconds();
+                let written = (|| {
+                    let mut writer = Mp4Writer::create(&path, width, height, fps, &settings)?;
+                    for frame in rx {
+                        writer.push(&frame)?;
+                        pool.give(frame);
+                    }
+                    writer.finish()
+                })();
+                let spent = (thread_cpu_seconds() - start).max(0.0);
+                ENCODE_CPU_US.fetch_add((spent * 1e6) as u64, Ordering::Relaxed);
+                written
             })
             .expect("spawn encoder thread");
         VideoJob {

@@ -1,8 +1,8 @@
 // FXAA-style post-process anti-aliasing (after Lottes' FXAA, the compact variant):
 // a full-screen pass over a resolved frame, in display (sRGB-encoded) values. Pixels
 // whose four neighbours differ little in luma are copied unchanged (most pixels: five
-// texel loads); on an edge, the blur direction is taken from the luma gradient and the
-// frame is sampled along it (four more filtered taps).
+// texel loads); on an edge, the blur direction is taken from the luma gradient (four
+// diagonal loads) and the frame is sampled along it (four filtered taps).
 
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var smp: sampler;
@@ -17,6 +17,11 @@ fn vs_post(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
 
 fn luma(c: vec3<f32>) -> f32 {
     return dot(c, vec3<f32>(0.299, 0.587, 0.114));
+}
+
+// The texel at `p + o`, clamped to the frame (what a clamped sample at its centre reads).
+fn near(p: vec2<i32>, dims: vec2<i32>, o: vec2<i32>) -> vec3<f32> {
+    return textureLoad(src, clamp(p + o, vec2<i32>(0, 0), dims - vec2<i32>(1, 1)), 0).rgb;
 }
 
 fn tap(uv: vec2<f32>) -> vec3<f32> {
@@ -34,13 +39,12 @@ const SPAN_MAX: f32 = 8.0;
 fn fs_fxaa(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let dims = vec2<i32>(textureDimensions(src));
     let p = vec2<i32>(pos.xy);
-    let hi = dims - vec2<i32>(1, 1);
     let m = textureLoad(src, p, 0).rgb;
     let lm = luma(m);
-    let ln = luma(textureLoad(src, clamp(p + vec2<i32>(0, -1), vec2<i32>(0, 0), hi), 0).rgb);
-    let ls = luma(textureLoad(src, clamp(p + vec2<i32>(0, 1), vec2<i32>(0, 0), hi), 0).rgb);
-    let lw = luma(textureLoad(src, clamp(p + vec2<i32>(-1, 0), vec2<i32>(0, 0), hi), 0).rgb);
-    let le = luma(textureLoad(src, clamp(p + vec2<i32>(1, 0), vec2<i32>(0, 0), hi), 0).rgb);
+    let ln = luma(near(p, dims, vec2<i32>(0, -1)));
+    let ls = luma(near(p, dims, vec2<i32>(0, 1)));
+    let lw = luma(near(p, dims, vec2<i32>(-1, 0)));
+    let le = luma(near(p, dims, vec2<i32>(1, 0)));
     let lmin = min(lm, min(min(ln, ls), min(lw, le)));
     let lmax = max(lm, max(max(ln, ls), max(lw, le)));
     if (lmax - lmin < max(EDGE_MIN, lmax * EDGE_REL)) {
@@ -48,11 +52,13 @@ fn fs_fxaa(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     }
     let inv = 1.0 / vec2<f32>(dims);
     let uv = pos.xy * inv;
-    // Diagonal neighbours: the gradient's direction.
-    let lnw = luma(tap(uv + vec2<f32>(-1.0, -1.0) * inv));
-    let lne = luma(tap(uv + vec2<f32>(1.0, -1.0) * inv));
-    let lsw = luma(tap(uv + vec2<f32>(-1.0, 1.0) * inv));
-    let lse = luma(tap(uv + vec2<f32>(1.0, 1.0) * inv));
+    // Diagonal neighbours: the gradient's direction. Texel centres, so loads (a CPU
+    // rasterizer runs both sides of the branch above, and a load costs a fraction of a
+    // filtered sample).
+    let lnw = luma(near(p, dims, vec2<i32>(-1, -1)));
+    let lne = luma(near(p, dims, vec2<i32>(1, -1)));
+    let lsw = luma(near(p, dims, vec2<i32>(-1, 1)));
+    let lse = luma(near(p, dims, vec2<i32>(1, 1)));
     var dir = vec2<f32>(-((lnw + lne) - (lsw + lse)), (lnw + lsw) - (lne + lse));
     let reduce = max((lnw + lne + lsw + lse) * 0.25 * REDUCE_MUL, REDUCE_MIN);
     let scale = 1.0 / (min(abs(dir.x), abs(dir.y)) + reduce);

@@ -156,20 +156,11 @@ pub(super) fn write_pngs(pngs: Vec<Png16>) -> std::thread::JoinHandle<Result<(),
 
 /// A 16-bit greyscale PNG, written atomically.
 fn write_png16(p: &Png16) -> Result<(), String> {
-    use image::ImageEncoder;
-    let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", p.path.display());
-    let mut bytes = Vec::new();
-    image::codecs::png::PngEncoder::new_with_quality(
-        &mut bytes,
-        image::codecs::png::CompressionType::Fast,
-        image::codecs::png::FilterType::Sub,
-    )
-    .write_image(
+    rh_contract::png::write_png(
+        &p.path,
         bytemuck::cast_slice(&p.pixels),
         p.width,
         p.height,
-        image::ExtendedColorType::L16,
+        rh_contract::png::PngColor::L16,
     )
-    .map_err(|e| fail(&e))?;
-    rh_contract::fsio::write_atomic(&p.path, &bytes).map_err(|e| fail(&e))
 }

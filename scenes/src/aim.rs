@@ -13,7 +13,8 @@
 
 use crate::label::{approach, interception, ImpactKind};
 use rand::RngExt;
-use rh_physics::simulate::{Obstacles, Simulation};
+use rh_physics::obstacles::Obstacles;
+use rh_physics::simulate::Simulation;
 use rh_physics::spec::{BodyKind, SceneSpec, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -44,6 +45,10 @@ pub struct AimConfig {
     pub body_ahead: [f64; 2],
     #[serde(default)]
     pub body_lateral: f64,
+    /// Aimed at the body, the meeting point is one where the hazard moves at least this
+    /// share of its top speed after the earliest step.
+    #[serde(default)]
+    pub body_speed_share: f64,
     /// A near miss stands this far (m) beyond `reach_radius` + the hazard's bounding
     /// radius, beside the path.
     pub miss_clearance: [f64; 2],
@@ -154,12 +159,10 @@ pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Optio
     let mut best: Option<(u32, Aim)> = None;
     for (c, d) in draws.iter().enumerate() {
         let (spec, sim) = &runs[c % runs.len()];
-        let Some((x, y, yaw, meet_height)) = candidate(spec, sim, cfg, band, near_miss, d) else {
+        let Some((x, y, yaw, meet_height)) = clear_candidate(spec, sim, cfg, band, intent, d)
+        else {
             continue;
         };
-        if !stands_clear(spec, cfg, x, y) {
-            continue;
-        }
         let met = runs
             .iter()
             .filter(|(s, m)| meets(&posed(s, x, y, yaw), m, cfg, intent))
@@ -186,14 +189,13 @@ pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Optio
         let with_point = (0..tried)
             .filter(|&c| {
                 let (spec, sim) = &runs[c % runs.len()];
-                candidate(spec, sim, cfg, band, near_miss, &draws[c]).is_some()
+                candidate(spec, sim, cfg, band, intent, &draws[c], 0).is_some()
             })
             .count();
         let clear = (0..tried)
             .filter(|&c| {
                 let (spec, sim) = &runs[c % runs.len()];
-                candidate(spec, sim, cfg, band, near_miss, &draws[c])
-                    .is_some_and(|(x, y, _, _)| stands_clear(spec, cfg, x, y))
+                clear_candidate(spec, sim, cfg, band, intent, &draws[c]).is_some()
             })
             .count();
         eprintln!(
@@ -231,20 +233,48 @@ fn earliest_step(spec: &SceneSpec, cfg: &AimConfig) -> u32 {
     (t / spec.physics.dt).ceil() as u32
 }
 
+/// The first of draw `d`'s candidate poses (the offset along the hazard's motion, then
+/// turned to its left, its right and back) that stands clear ([`stands_clear`]): a fall
+/// beside a wall or a cabinet is met from the open side.
+fn clear_candidate(
+    spec: &SceneSpec,
+    sim: &Simulation,
+    cfg: &AimConfig,
+    band: [f64; 2],
+    intent: Intent,
+    d: &[f64; 4],
+) -> Option<(f64, f64, f64, f64)> {
+    (0..4)
+        .filter_map(|turn| candidate(spec, sim, cfg, band, intent, d, turn))
+        .find(|&(x, y, _, _)| stands_clear(spec, cfg, x, y))
+}
+
 /// A candidate pose from draw `d` = [time fraction, ahead, lateral, miss clearance] on
 /// one band's path: the meeting point is the `d[0]` fraction of the moving path points
-/// after the earliest step whose centre height is in `band`.
+/// after the earliest step whose centre height is in `band`; the offset runs along the
+/// hazard's horizontal motion there, turned by `turn` quarter turns (0, left, right, back).
 fn candidate(
     spec: &SceneSpec,
     sim: &Simulation,
     cfg: &AimConfig,
     band: [f64; 2],
-    near_miss: bool,
+    intent: Intent,
     d: &[f64; 4],
+    turn: usize,
 ) -> Option<(f64, f64, f64, f64)> {
     let from = earliest_step(spec, cfg);
+    let fastest = (from..=sim.steps())
+        .map(|k| norm(sim.hazard_velocity(k)))
+        .fold(0.0, f64::max);
+    // Aimed at the body, the meeting point is where the hazard still moves at least
+    // `body_speed_share` of its top speed (not the slow end of its path).
+    let slowest = if intent == Intent::Body {
+        MOVING.max(cfg.body_speed_share * fastest)
+    } else {
+        MOVING
+    };
     let moving: Vec<u32> = (from..=sim.steps())
-        .filter(|&k| norm(sim.hazard_velocity(k)) > MOVING)
+        .filter(|&k| norm(sim.hazard_velocity(k)) > slowest)
         .collect();
     let in_band: Vec<u32> = moving
         .iter()
@@ -252,6 +282,7 @@ fn candidate(
         .filter(|&k| (band[0]..=band[1]).contains(&sim.hazard_com(k)[2]))
         .collect();
     // A path that never passes at a height of the band meets the body where it can.
+    let near_miss = intent == Intent::Miss;
     let points = if near_miss || in_band.is_empty() {
         moving
     } else {
@@ -271,6 +302,12 @@ fn candidate(
         .or_else(|| unit2([p[0] - start[0], p[1] - start[1]]))
         .or_else(|| unit2([o.x - p[0], o.y - p[1]]))
         .unwrap_or([1.0, 0.0]);
+    let u = match turn {
+        0 => u,
+        1 => [-u[1], u[0]],
+        2 => [u[1], -u[0]],
+        _ => [-u[0], -u[1]],
+    };
     let side = [-u[1], u[0]];
     let (along, across) = if near_miss {
         let r = spec.hazard_body().bounding_radius();

@@ -1,36 +1,41 @@
-//! Label balance over the evaluation-sized subset (SPEC §8: 18 scenes per family).
+//! Label balance of the evaluation subset (SPEC §6, §8: 18 scenes per family).
 //!
-//! `label_balance` builds, for each family, the first five scene groups that a full
-//! build with the same seed would give that family (the embedded planner deals groups to
-//! families round-robin), takes 18 of their 20 scenes, and counts the ground-truth
-//! actions. `rh-pipeline balance` prints the table.
+//! `label_balance` builds, for each family, the scene groups that a full build of `pool`
+//! scenes (680 by default) with the same seed would give that family (the embedded
+//! planner deals groups to families round-robin), chooses that family's evaluation
+//! subset exactly as the dataset's `eval` config does (`eval_subset::select`), and counts
+//! the ground-truth actions of the subset and of the whole pool. `rh-pipeline balance`
+//! prints the table (or JSON with the shares).
 //!
-//! Families whose label is (almost) always one action, and why the physics demands it:
-//! * `furniture_tip`, `ladder_slip`, `door_swing`: nearly every catalog entry is a heavy
-//!   (≥ 2 kg) piece of furniture, ladder or door, so an event that reaches the observer
-//!   is DODGE; CATCH comes only from the light props (styrofoam TV, prop ladder, hollow
-//!   prop door) when they are slow enough.
-//! * `pendulum_swing`: the swinging masses are heavy or large-and-fragile except the
-//!   foam wrecking ball and the glass pendant lamp at low speed, so DODGE dominates.
-//!
-//! Every family also has far-observer groups (about 4%), which are NO_ACTION.
+//! Families that cannot give a CATCH, and why the physics demands it: `furniture_tip`
+//! (every catalog entry is heavy furniture), `ladder_slip` and `door_swing` (the light
+//! props — a prop ladder, a hollow prop door — are longer than the arms can hold:
+//! `catch_radius_max`).
 
 use crate::config::Config;
 use crate::driver::produce_group_counted;
 use crate::families;
+use crate::eval_subset::{EvalConfig, EvalRow};
 use crate::label::Action;
+use rayon::prelude::*;
 use crate::selection::plan_group_with;
 use rh_catalog::Catalog;
 use serde::Serialize;
+use std::fmt::Write;
 
-/// Counts of ground-truth actions among one family's scenes.
+/// Counts of ground-truth actions among one family's evaluation subset and pool.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct FamilyBalance {
     pub family: String,
+    /// The evaluation subset's labels.
     pub catch: usize,
     pub dodge: usize,
     pub no_action: usize,
-    /// Scenes that failed a validator after every resampling attempt.
+    /// The pool's (every scene of the family's groups, valid or not).
+    pub pool_catch: usize,
+    pub pool_dodge: usize,
+    pub pool_no_action: usize,
+    /// Pool scenes that failed a validator after every resampling attempt.
     pub invalid: usize,
     /// Group attempts made (one per group when nothing is rejected).
     pub attempts: u32,
@@ -47,24 +52,88 @@ impl FamilyBalance {
             .expect("a validator column");
         self.rejected_by[i] as f64 / self.attempts.max(1) as f64
     }
-}
 
-impl FamilyBalance {
+    /// Scenes in the evaluation subset.
     pub fn total(&self) -> usize {
         self.catch + self.dodge + self.no_action
     }
 }
 
-/// Builds `per_family` scenes (18 for the evaluation subset) of each family in
-/// `families` (canonical names; all implemented families if empty) with `build_seed`,
-/// and counts their labels. Groups are those a full build over all families would give
-/// each family, so the counts match what the dataset holds.
+/// Label counts and shares (`share_*` = count / total).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Shares {
+    pub scenes: usize,
+    pub catch: usize,
+    pub dodge: usize,
+    pub no_action: usize,
+    pub share_catch: f64,
+    pub share_dodge: f64,
+    pub share_no_action: f64,
+}
+
+impl Shares {
+    pub fn of(catch: usize, dodge: usize, no_action: usize) -> Shares {
+        let scenes = catch + dodge + no_action;
+        let share = |n: usize| n as f64 / scenes.max(1) as f64;
+        Shares {
+            scenes,
+            catch,
+            dodge,
+            no_action,
+            share_catch: share(catch),
+            share_dodge: share(dodge),
+            share_no_action: share(no_action),
+        }
+    }
+}
+
+/// What `balance --json` prints.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Balance {
+    pub seed: u64,
+    /// The full build whose groups form the pool (scenes).
+    pub pool: u64,
+    pub per_family: usize,
+    /// The evaluation subset's labels, and the pool's.
+    pub eval: Shares,
+    pub pool_labels: Shares,
+    /// Families with at least 3 CATCH (and 3 DODGE) in the subset.
+    pub families_with_3_catch: usize,
+    pub families_with_3_dodge: usize,
+    pub families: Vec<FamilyBalance>,
+}
+
+impl Balance {
+    pub fn of(seed: u64, pool: u64, per_family: usize, families: Vec<FamilyBalance>) -> Balance {
+        let sum = |f: fn(&FamilyBalance) -> usize| families.iter().map(f).sum::<usize>();
+        Balance {
+            seed,
+            pool,
+            per_family,
+            eval: Shares::of(sum(|f| f.catch), sum(|f| f.dodge), sum(|f| f.no_action)),
+            pool_labels: Shares::of(
+                sum(|f| f.pool_catch),
+                sum(|f| f.pool_dodge),
+                sum(|f| f.pool_no_action),
+            ),
+            families_with_3_catch: families.iter().filter(|f| f.catch >= 3).count(),
+            families_with_3_dodge: families.iter().filter(|f| f.dodge >= 3).count(),
+            families,
+        }
+    }
+}
+
+/// Builds the pool of each family in `families` (canonical names; all implemented
+/// families if empty) — the groups a full build of `pool` scenes over all families gives
+/// it, with `build_seed` — and counts the labels of its evaluation subset of
+/// `per_family` scenes (`eval_subset::select` under `[eval]`) and of the whole pool.
 pub fn label_balance(
     catalog: &Catalog,
     config: &Config,
     build_seed: u64,
     families: &[String],
     per_family: usize,
+    pool: u64,
 ) -> anyhow::Result<Vec<FamilyBalance>> {
     let all: Vec<String> = families::all()
         .iter()
@@ -75,45 +144,70 @@ pub fn label_balance(
     } else {
         families.to_vec()
     };
-    let groups_per_family = per_family.div_ceil(4) as u64;
+    let n_groups = pool.div_ceil(4).max(all.len() as u64);
+    let eval_cfg = EvalConfig {
+        per_family,
+        ..config.eval.clone()
+    };
     let mut out = Vec::new();
     for family in &wanted {
         let index = all
             .iter()
             .position(|f| f == family)
             .ok_or_else(|| anyhow::anyhow!("unknown or unimplemented family '{family}'"))?;
+        let groups: Vec<u64> = (index as u64..n_groups).step_by(all.len()).collect();
+        let built: Vec<anyhow::Result<_>> = groups
+            .par_iter()
+            .map(|&group| {
+                let selection = plan_group_with(catalog, &all, build_seed, group, &config.plan_policy())?;
+                Ok(produce_group_counted(&selection, build_seed, group * 4, 4, catalog, config)?)
+            })
+            .collect();
         let mut balance = FamilyBalance {
             family: family.clone(),
             catch: 0,
             dodge: 0,
             no_action: 0,
+            pool_catch: 0,
+            pool_dodge: 0,
+            pool_no_action: 0,
             invalid: 0,
             attempts: 0,
             rejected_by: vec![0; crate::validate::VALIDATOR_COLUMNS.len()],
         };
-        let mut taken = 0;
-        for j in 0..groups_per_family {
-            let group = index as u64 + all.len() as u64 * j;
-            let selection = plan_group_with(catalog, &all, build_seed, group, &config.plan_policy())?;
-            let (results, rejections) =
-                produce_group_counted(&selection, build_seed, group * 4, 4, catalog, config)?;
+        let mut scenes = Vec::new();
+        for result in built {
+            let (results, rejections) = result?;
             balance.attempts += rejections.attempts;
             for (total, n) in balance.rejected_by.iter_mut().zip(rejections.rejected_by) {
                 *total += n;
             }
             for r in results {
-                if taken == per_family {
-                    break;
-                }
-                taken += 1;
                 if !r.verdicts.all() {
                     balance.invalid += 1;
                 }
                 match r.labels.gt_action {
-                    Action::Catch => balance.catch += 1,
-                    Action::Dodge => balance.dodge += 1,
-                    Action::NoAction => balance.no_action += 1,
+                    Action::Catch => balance.pool_catch += 1,
+                    Action::Dodge => balance.pool_dodge += 1,
+                    Action::NoAction => balance.pool_no_action += 1,
                 }
+                scenes.push((r.spec.scene_index, r.verdicts.all(), r.labels.gt_action));
+            }
+        }
+        let rows: Vec<EvalRow> = scenes
+            .iter()
+            .map(|&(scene_index, valid, action)| EvalRow {
+                family,
+                scene_index,
+                valid,
+                action: action.as_str(),
+            })
+            .collect();
+        for i in crate::eval_subset::select(&rows, &eval_cfg).0 {
+            match scenes[i].2 {
+                Action::Catch => balance.catch += 1,
+                Action::Dodge => balance.dodge += 1,
+                Action::NoAction => balance.no_action += 1,
             }
         }
         out.push(balance);
@@ -126,8 +220,8 @@ pub fn label_balance(
 /// label rule v2; `other`: any other validator).
 pub fn format_table(rows: &[FamilyBalance]) -> String {
     let header = format!(
-        "{:<16} {:>6} {:>6} {:>9} {:>7} {:>8} {:>9} {:>7}\n",
-        "family", "CATCH", "DODGE", "NO_ACTION", "invalid", "attempts", "reaction", "other"
+        "{:<16} {:>6} {:>6} {:>9}   {:>15} {:>7} {:>8} {:>9} {:>7}\n",
+        "family", "CATCH", "DODGE", "NO_ACTION", "pool C/D/N", "invalid", "attempts", "reaction", "other"
     );
     let mut s = header;
     let reaction = crate::validate::VALIDATOR_COLUMNS
@@ -139,6 +233,9 @@ pub fn format_table(rows: &[FamilyBalance]) -> String {
         catch: 0,
         dodge: 0,
         no_action: 0,
+        pool_catch: 0,
+        pool_dodge: 0,
+        pool_no_action: 0,
         invalid: 0,
         attempts: 0,
         rejected_by: vec![0; crate::validate::VALIDATOR_COLUMNS.len()],
@@ -153,11 +250,12 @@ pub fn format_table(rows: &[FamilyBalance]) -> String {
             .sum();
         let pct = |n: u32| format!("{:.0}%", 100.0 * n as f64 / r.attempts.max(1) as f64);
         format!(
-            "{:<16} {:>6} {:>6} {:>9} {:>7} {:>8} {:>9} {:>7}\n",
+            "{:<16} {:>6} {:>6} {:>9}   {:>15} {:>7} {:>8} {:>9} {:>7}\n",
             r.family,
             r.catch,
             r.dodge,
             r.no_action,
+            format!("{}/{}/{}", r.pool_catch, r.pool_dodge, r.pool_no_action),
             r.invalid,
             r.attempts,
             pct(r.rejected_by[reaction]),
@@ -169,6 +267,9 @@ pub fn format_table(rows: &[FamilyBalance]) -> String {
         total.catch += r.catch;
         total.dodge += r.dodge;
         total.no_action += r.no_action;
+        total.pool_catch += r.pool_catch;
+        total.pool_dodge += r.pool_dodge;
+        total.pool_no_action += r.pool_no_action;
         total.invalid += r.invalid;
         total.attempts += r.attempts;
         for (t, n) in total.rejected_by.iter_mut().zip(&r.rejected_by) {
@@ -176,5 +277,17 @@ pub fn format_table(rows: &[FamilyBalance]) -> String {
         }
     }
     s.push_str(&line(&total));
+    let share = |n: usize, of: usize| 100.0 * n as f64 / of.max(1) as f64;
+    let (e, p) = (total.total(), total.pool_catch + total.pool_dodge + total.pool_no_action);
+    let _ = writeln!(
+        s,
+        "shares: evaluation subset CATCH {:.1}%, DODGE {:.1}%, NO_ACTION {:.1}% of {e}; pool CATCH {:.1}%, DODGE {:.1}%, NO_ACTION {:.1}% of {p}",
+        share(total.catch, e),
+        share(total.dodge, e),
+        share(total.no_action, e),
+        share(total.pool_catch, p),
+        share(total.pool_dodge, p),
+        share(total.pool_no_action, p)
+    );
     s
 }

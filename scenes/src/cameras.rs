@@ -8,7 +8,8 @@
 use crate::view::{complete_basis, window_steps, View};
 use crate::visibility;
 use rand::RngExt;
-use rh_physics::simulate::{Obstacles, Simulation};
+use rh_physics::obstacles::Obstacles;
+use rh_physics::simulate::Simulation;
 use rh_physics::spec::vec3::{add, cross, dot, norm, scale, sub};
 use rh_physics::spec::{CameraSpec, SceneSpec, Vec3};
 
@@ -344,7 +345,7 @@ mod tests {
     use crate::config::Config;
     use crate::randomize::{randomize, SceneKey};
     use rh_catalog::Catalog;
-    use rh_physics::simulate::Obstacles;
+    use rh_physics::obstacles::Obstacles;
     use rh_physics::spec::{Selection, ShapeSpec};
 
     #[test]

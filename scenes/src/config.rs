@@ -29,6 +29,9 @@ pub struct BuildSection {
     /// uniformly, whatever their kind.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub benign_share: Option<f64>,
+    /// Per family, instead of `benign_share`.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub benign_share_by_family: BTreeMap<String, f64>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -257,6 +260,7 @@ impl Config {
     pub fn plan_policy(&self) -> crate::selection::PlanPolicy {
         crate::selection::PlanPolicy {
             benign_share: self.build.benign_share,
+            benign_share_by_family: self.build.benign_share_by_family.clone(),
             heavy_mass_kg: self.labels.heavy_mass_kg,
         }
     }
@@ -455,6 +459,14 @@ impl Config {
             .is_some_and(|b| !(0.0..=1.0).contains(&b))
         {
             return Err(fail("build.benign_share", "must be within [0, 1]".into()));
+        }
+        for (family, b) in &self.build.benign_share_by_family {
+            if !(0.0..=1.0).contains(b) {
+                return Err(fail(
+                    &format!("build.benign_share_by_family.{family}"),
+                    "must be within [0, 1]".into(),
+                ));
+            }
         }
         if !(0.0..=1.0).contains(&self.build.far_observer_share) {
             return Err(fail(

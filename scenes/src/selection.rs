@@ -38,12 +38,14 @@ pub trait Planner: Sync {
 }
 
 /// What the embedded planner balances (label rule v5, `[plan]` of `configs/default.toml`).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct PlanPolicy {
     /// Share of a family's groups that show a benign object (one no property makes
     /// dangerous: see [`intrinsically_dangerous`]) when the family has both kinds;
     /// `None`: the object is drawn among all the family's objects (builds before v5).
     pub benign_share: Option<f64>,
+    /// Per family, instead of `benign_share` (with it set).
+    pub benign_share_by_family: std::collections::BTreeMap<String, f64>,
     /// `heavy_mass_kg` of the label rule: an object this heavy is dangerous.
     pub heavy_mass_kg: f64,
 }
@@ -91,6 +93,11 @@ pub fn plan_group_with(
     let candidates = match policy.benign_share {
         None => all,
         Some(share) => {
+            let share = policy
+                .benign_share_by_family
+                .get(family)
+                .copied()
+                .unwrap_or(share);
             let benign = rng.random_bool(share.clamp(0.0, 1.0));
             let kind: Vec<&Object> = all
                 .iter()

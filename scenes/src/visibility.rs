@@ -17,7 +17,8 @@
 
 use crate::config::FramingRules;
 use crate::view::View;
-use rh_physics::simulate::{Obstacles, Simulation};
+use rh_physics::obstacles::Obstacles;
+use rh_physics::simulate::Simulation;
 use rh_physics::spec::vec3::{add, dot, sub};
 use rh_physics::spec::{quat, CameraSpec, Quat, SceneSpec, ShapeSpec, Vec3};
 

@@ -84,9 +84,9 @@ fn travelled(sim: &Simulation, k: u32) -> f64 {
     ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt()
 }
 
-/// A hazard that creeps down a tilted board (`families::TiltedLaunch`) travels
+/// A hazard that creeps down a tilted board (`families::launch::TiltedLaunch`) travels
 /// `v0 t + a t²/2` in its first `t` seconds, `a` the creep acceleration its tilt was
-/// chosen for (`families::creep_tilt`: sliding against the combined friction, or a ball
+/// chosen for (`families::launch::creep_tilt`: sliding against the combined friction, or a ball
 /// rolling).
 fn assert_creeps_at_the_designed_acceleration(r: &SceneResult, t: f64) {
     let sim = plain(&r.spec);
@@ -569,7 +569,7 @@ fn surface_cascade_touches_the_stool_between_table_and_floor() {
 #[test]
 fn label_balance_covers_every_family() {
     let (catalog, config) = setup();
-    let rows = rh_scenes::balance::label_balance(&catalog, &config, 0, &[], 18).unwrap();
+    let rows = rh_scenes::balance::label_balance(&catalog, &config, 0, &[], 18, 680).unwrap();
     assert_eq!(rows.len(), 17);
     let mut totals = [0usize; 3];
     for r in &rows {

@@ -101,24 +101,10 @@ fn start_server(delay: f64) -> Server {
     Server(child, port)
 }
 
-/// Writes a frame as the pipeline does (`render::renderer::write_png`: RGB, fast deflate,
-/// Sub filter).
+/// Writes a frame as the pipeline does (`rh_contract::png::write_png`).
 fn write_png_like_pipeline(img: &image::RgbImage, path: &Path) {
-    use image::ImageEncoder;
-    let mut bytes = Vec::new();
-    image::codecs::png::PngEncoder::new_with_quality(
-        &mut bytes,
-        image::codecs::png::CompressionType::Fast,
-        image::codecs::png::FilterType::Sub,
-    )
-    .write_image(
-        img,
-        img.width(),
-        img.height(),
-        image::ExtendedColorType::Rgb8,
-    )
-    .unwrap();
-    std::fs::write(path, bytes).unwrap();
+    let (w, h) = img.dimensions();
+    rh_contract::png::write_png(path, img, w, h, rh_contract::png::PngColor::Rgb8).unwrap();
 }
 
 /// A synthetic 1280×720 frame like a render: shaded floor and wall, a box with flat faces,
@@ -148,8 +134,8 @@ fn synthetic_frame(k: usize) -> image::RgbImage {
 }
 
 fn make_dataset(dir: &Path, n: usize, frames: Option<&Path>) -> Vec<String> {
-    let rows = rh_score::fixture::synth_rows(n, 7);
-    rh_score::fixture::write_dataset(dir, &rows, &[]).unwrap();
+    let rows = rh_score::synthetic::synth_rows(n, 7);
+    rh_score::synthetic::write_dataset(dir, &rows, &[]).unwrap();
     let prompt = PromptConfig::load(None).unwrap();
     let proto = dir.join("proto");
     std::fs::create_dir_all(&proto).unwrap();

@@ -7,7 +7,7 @@
 //! errors and malformed lines. The file is written to a temp dir first (not timed).
 //! Memory is reported as the process's peak RSS (VmHWM) before and after scoring.
 
-use rh_score::fixture::{dataset_of, synth_rows};
+use rh_score::synthetic::{dataset_of, synth_rows};
 use rh_score::{Config, Report, Scoring};
 use std::io::{BufWriter, Write};
 use std::time::Instant;

@@ -4,7 +4,8 @@
 
 use crate::dataset::{Dataset, Scene};
 use crate::metrics::DecisionResult;
-use crate::types::{Action, Rule};
+use crate::safety_rule::SafetyRule;
+use rh_contract::Action;
 
 /// A running mean that counts missing values.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -60,7 +61,7 @@ impl Acc {
         if let Some(f) = r.first_rule {
             self.first[f.index()] += 1;
         }
-        for rule in Rule::ALL {
+        for rule in SafetyRule::ALL {
             self.fired[rule.index()] += r.fired(rule) as u64;
         }
         self.predicted[r.action.map_or(3, |a| a.index())] += 1;

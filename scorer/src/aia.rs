@@ -15,8 +15,8 @@
 //! match, 0 otherwise (including an empty intent).
 
 use crate::config::AiaConfig;
-use crate::types::Action;
-use crate::types::FastMap;
+use crate::fast_map::FastMap;
+use rh_contract::Action;
 
 #[derive(Debug, Clone)]
 struct Word {

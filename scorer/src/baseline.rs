@@ -16,10 +16,10 @@ use crate::dataset::{Dataset, Scene};
 use crate::oracle::{oracle_plan, OracleHints};
 use crate::plan_json::freeze_template;
 use crate::plan_json::{kf, plan, rest_kf};
-use crate::types::Action;
 use anyhow::Result;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rh_contract::Action;
 use serde_json::Value;
 use std::io::Write;
 
@@ -215,9 +215,9 @@ pub fn write_baseline(
 mod tests {
     use super::*;
     use crate::aia::AiaMatcher;
-    use crate::fixture::{dataset_of, synth_rows};
     use crate::metrics::score_decision;
     use crate::plan::plan_from_value;
+    use crate::synthetic::{dataset_of, synth_rows};
     use std::f64::consts::PI;
 
     #[test]
@@ -276,7 +276,7 @@ mod tests {
                 pose[1] + s * rel[0] + c * rel[1],
                 rel[2],
             ];
-            let mut sc = crate::rule::tests::scene(pose, Some(p));
+            let mut sc = crate::action_rule::tests::scene(pose, Some(p));
             sc.gt_action = Action::Catch;
             let v = crate::oracle::catch(&sc, &cfg);
             let pl = plan_from_value(&v, &cfg).unwrap();

@@ -4,11 +4,12 @@
 //! McNemar's exact p-value (see [`crate::stats`]).
 
 use crate::dataset::Dataset;
+use crate::error::InputError;
 use crate::metrics::safety_rules;
 use crate::score::Scoring;
 use crate::stats::{mcnemar_exact, newcombe_paired};
-use crate::types::{Action, InputError};
 use anyhow::Result;
+use rh_contract::Action;
 use serde::Serialize;
 
 /// One metric compared on paired scenes.

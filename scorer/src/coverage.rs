@@ -10,7 +10,7 @@
 use crate::aggregate::Rec;
 use crate::dataset::Dataset;
 use crate::dataset::Subset;
-use crate::types::InputError;
+use crate::error::InputError;
 use anyhow::Result;
 use serde::Serialize;
 
@@ -172,11 +172,11 @@ mod tests {
     use super::*;
     use crate::baseline::{baseline_plan, majority_action, BaselineKind};
     use crate::config::Config;
-    use crate::fixture::{dataset_of, synth_rows};
     use crate::refusal::check_scored;
     use crate::report::Report;
     use crate::score::Scoring;
-    use crate::types::Action;
+    use crate::synthetic::{dataset_of, synth_rows};
+    use rh_contract::Action;
 
     fn lines(ds: &Dataset, kind: BaselineKind, model: &str, take: usize) -> String {
         let cfg = Config::default();
@@ -281,7 +281,7 @@ mod tests {
         ] {
             let sc = score(&ds, &cfg, &text);
             let e = check_scored(&sc, "p.jsonl").unwrap_err();
-            assert!(crate::types::is_input_error(&e), "{e}");
+            assert!(crate::error::is_input_error(&e), "{e}");
             assert!(e.to_string().contains(needle), "{text:?}: {e}");
         }
         // One good line is enough.

@@ -4,11 +4,12 @@
 //! missing required column or one of the wrong type is an input error (exit 2) naming the
 //! file and the column.
 
-use crate::types::FastMap;
-use crate::types::{Action, InputError};
+use crate::error::InputError;
+use crate::fast_map::FastMap;
 use anyhow::Result;
 use arrow::array::{Array, RecordBatch, StringArray};
 use rh_contract::columns::col;
+use rh_contract::Action;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
@@ -138,11 +139,11 @@ impl Dataset {
             .into());
         }
         if !data.is_dir() {
-            return Err(InputError(crate::layout::missing_parquet_message(dir)).into());
+            return Err(InputError(crate::dataset_diagnosis::missing_parquet_message(dir)).into());
         }
         let files = parquet_files(&data)?;
         if files.is_empty() {
-            return Err(InputError(crate::layout::missing_parquet_message(dir)).into());
+            return Err(InputError(crate::dataset_diagnosis::missing_parquet_message(dir)).into());
         }
         let mut ds = Dataset {
             dir: dir.to_path_buf(),
@@ -379,4 +380,42 @@ pub fn eval_scene_ids(dir: &Path) -> Result<Option<BTreeSet<String>>> {
         }
     }
     Ok(Some(ids))
+}
+
+/// The dataset directory of `--dataset` (also the Python package's `Dataset(...)`): an
+/// existing directory, else a Hugging Face Hub dataset id `owner/name[@revision]`
+/// downloaded once into the HF cache; `None`: `$RH_DATASET`, else the released dataset.
+pub fn resolve_dir(arg: Option<String>) -> Result<PathBuf> {
+    let given = arg.or_else(|| std::env::var("RH_DATASET").ok().filter(|s| !s.is_empty()));
+    let id = match given {
+        Some(d) => {
+            let path = PathBuf::from(&d);
+            if path.exists() {
+                return Ok(path);
+            }
+            let (repo, _) = d.split_once('@').unwrap_or((&d, ""));
+            if !rh_hub::is_repo_id(repo) {
+                return Err(InputError(format!(
+                    "dataset directory {d} does not exist (nor is it a Hub dataset id owner/name)"
+                ))
+                .into());
+            }
+            d
+        }
+        None => rh_hub::RELEASED_DATASET.to_string(),
+    };
+    let (repo, revision) = match id.split_once('@') {
+        Some((r, rev)) => (r, Some(rev)),
+        None => (id.as_str(), None),
+    };
+    match rh_hub::fetch(repo, revision) {
+        Ok(snapshot) => {
+            if let Some(note) = snapshot.cache_note(repo) {
+                eprintln!("rh-score: {note}");
+            }
+            Ok(snapshot.path)
+        }
+        Err(e) if e.exit_code() == 2 => Err(InputError(e.to_string()).into()),
+        Err(e) => Err(anyhow::anyhow!("{e}")),
+    }
 }

@@ -10,7 +10,7 @@
 //! `epaint_default_fonts` crate), so no system fonts or fontconfig are needed.
 
 use crate::report::Report;
-use crate::types::Rule;
+use crate::safety_rule::SafetyRule;
 use anyhow::{anyhow, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -319,7 +319,7 @@ fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -
         .iter()
         .map(|s| format!("{} n={}", s.model, s.decisions))
         .collect();
-    let legend_items: Vec<(String, RGBColor)> = Rule::ALL
+    let legend_items: Vec<(String, RGBColor)> = SafetyRule::ALL
         .iter()
         .map(|r| {
             (
@@ -353,7 +353,7 @@ fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -
             )))
             .map_err(e)?;
     }
-    for rule in Rule::ALL {
+    for rule in SafetyRule::ALL {
         let c = color(rule.index() + 3);
         let bars: Vec<_> = rows
             .iter()
@@ -361,7 +361,7 @@ fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -
             .filter(|(_, s)| s.decisions > 0)
             .map(|(i, s)| {
                 let d = s.decisions as f64;
-                let before: u64 = Rule::ALL[..rule.index()]
+                let before: u64 = SafetyRule::ALL[..rule.index()]
                     .iter()
                     .map(|r| s.first_rule.get(*r))
                     .sum();
@@ -525,7 +525,7 @@ mod tests {
     use super::*;
     use crate::baseline::{baseline_plan, majority_action, BaselineKind};
     use crate::config::Config;
-    use crate::fixture::{dataset_of, synth_rows};
+    use crate::synthetic::{dataset_of, synth_rows};
 
     #[test]
     fn bars_carry_value_and_n_and_meshes_have_no_fine_grid() {

@@ -5,7 +5,7 @@
 use crate::aggregate::Rec;
 use crate::dataset::Dataset;
 use crate::stats::{bootstrap_mean, seed_for, StatsConfig};
-use crate::types::Action;
+use rh_contract::Action;
 
 /// The intervals `[d_end, d_min, aia]` of row `group` of model `name` over the
 /// expected scenes of `recs` (one slice per model; several for the pooled row) whose

@@ -7,7 +7,7 @@
 //! by name; a missing or mistyped column is an input error naming file and column) →
 //! [`score::Scoring::score_path`] streams `preds.jsonl` line by line (capped length), parses
 //! batches in parallel with rayon ([`preds::process_line`]: lenient plan extraction in
-//! [`plan`], action rule and world-frame kinematics in [`rule`], metrics in [`metrics`],
+//! [`plan`], action rule and world-frame kinematics in [`action_rule`], metrics in [`metrics`],
 //! AIA in [`aia`]) and folds results in file order into per-model accumulators
 //! ([`aggregate`]) → [`report::Report::build`] computes breakdowns and the paper's analyses →
 //! [`tables`] (terminal, Markdown, CSV), `serde_json` (JSON) and [`figures`] (SVG + PNG).
@@ -30,20 +30,26 @@
 //! * Thresholds live in `configs/scoring.toml`, embedded as the default; `--config`
 //!   replaces it.
 
+pub mod action_rule;
 pub mod aggregate;
 pub mod aia;
+pub mod analyses;
+pub mod api;
 pub mod baseline;
+pub mod cli;
 pub mod compare;
 pub mod config;
 pub mod coverage;
 pub mod dataset;
+pub mod dataset_diagnosis;
+pub mod error;
+pub mod execute_scored;
 pub mod execution;
 pub mod explain;
+pub mod fast_map;
 pub mod figures;
-pub mod fixture;
 pub mod html;
 pub mod intervals;
-pub mod layout;
 pub mod metrics;
 pub mod metrics_row;
 pub mod oracle;
@@ -55,15 +61,18 @@ pub mod preds;
 pub mod progress;
 pub mod refusal;
 pub mod report;
-pub mod rule;
+pub mod safety_rule;
 pub mod score;
 pub mod stats;
+#[cfg(any(test, feature = "synthetic"))]
+pub mod synthetic;
 pub mod tables;
 pub mod text_table;
-pub mod types;
 
 pub use config::Config;
 pub use dataset::Dataset;
+pub use error::InputError;
 pub use report::Report;
+pub use rh_contract::Action;
+pub use safety_rule::SafetyRule;
 pub use score::Scoring;
-pub use types::{Action, InputError, Rule};

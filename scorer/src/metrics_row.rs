@@ -3,7 +3,7 @@
 //! per-class action counts.
 
 use crate::aggregate::Acc;
-use crate::types::Rule;
+use crate::safety_rule::SafetyRule;
 use serde::Serialize;
 
 #[derive(Debug, Clone, Serialize)]
@@ -28,7 +28,7 @@ impl RuleCounts {
         }
     }
 
-    pub fn get(&self, r: Rule) -> u64 {
+    pub fn get(&self, r: SafetyRule) -> u64 {
         [self.r1, self.r2, self.r3, self.r4][r.index()]
     }
 }

@@ -26,9 +26,9 @@
 use crate::config::Config;
 use crate::dataset::{open_parquet, parquet_files, read_replay_keys, Dataset, Scene};
 use crate::plan_json::{kf, plan, solve_walk, wrap_angle};
-use crate::types::Action;
 use anyhow::Result;
 use arrow::array::{Array, FixedSizeListArray, Float32Array, Float64Array, ListArray};
+use rh_contract::Action;
 use serde_json::Value;
 use std::collections::BTreeMap;
 
@@ -115,7 +115,7 @@ pub fn catch(scene: &Scene, cfg: &Config) -> Value {
     let knee = drop / max_drop;
     // The hands on the point in the crouched body frame, where action rule v2 (and the
     // executor) put them: the oracle's d_end is exactly 0.
-    let z_rule = p[2] - crate::rule::pelvis_height(knee, cfg);
+    let z_rule = p[2] - crate::action_rule::pelvis_height(knee, cfg);
     let at = |x: f64| {
         (
             [x, hand[1] + HAND_HALF_GAP, z_rule],
@@ -207,7 +207,7 @@ pub fn load_hints(ds: &Dataset, cfg: &Config) -> Result<BTreeMap<String, OracleH
     #[cfg(not(feature = "execute"))]
     if ds.dir.join("specs").is_dir() {
         let _ = cfg;
-        return Err(crate::types::InputError(
+        return Err(crate::error::InputError(
             "the oracle checks its dodges in physics, but this rh-score was built without the `execute` feature; rebuild with default features".into(),
         )
         .into());

@@ -4,8 +4,8 @@
 //! (every dropped line named, incomplete models).
 
 use crate::coverage::skip_reason;
+use crate::error::InputError;
 use crate::score::Scoring;
-use crate::types::InputError;
 use anyhow::Result;
 
 /// Refuses (exit 2) a predictions file from which no decision was scored: empty, a JSON

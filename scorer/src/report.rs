@@ -1,13 +1,20 @@
 //! The report: aggregated metrics per model and breakdown, and the paper's analyses.
 
 use crate::aggregate::{Acc, ModelAgg, Rec};
+use crate::analyses::{
+    lookalikes, out_of_reach, ratio, safety_breakdown, speed_analysis, speed_groups, voting,
+};
 use crate::config::Config;
 use crate::dataset::{Dataset, SPEED_BANDS};
 use crate::score::{Scoring, WarningAcc};
-use crate::types::Action;
+use rh_contract::Action;
 use serde::Serialize;
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 
+pub use crate::analyses::{
+    AdversarialProbe, Analyses, LookalikeComparison, OutOfReach, SafetyBreakdown, SpeedAnalysis,
+    Voting,
+};
 pub use crate::metrics_row::{ActionCounts, ClassRecall, Interval, MetricsRow, RuleCounts};
 
 #[derive(Debug, Clone, Serialize)]
@@ -84,94 +91,6 @@ pub struct ActionRuleSummary {
     pub move_threshold: f64,
 }
 
-/// Safety-rule breakdown for one model (or pooled).
-#[derive(Debug, Clone, Serialize)]
-pub struct SafetyBreakdown {
-    pub model: String,
-    pub decisions: u64,
-    pub violations: u64,
-    pub first_rule: RuleCounts,
-    pub rules_fired: RuleCounts,
-    /// Share of decisions on DODGE scenes that broke a rule.
-    pub unsafe_on_dodge_scenes: Option<f64>,
-    /// Wrong decisions (SAA = 0) and how many of them were NO_ACTION (freezing).
-    pub mistakes: u64,
-    pub freeze_mistakes: u64,
-}
-
-/// "Correct but out of reach" (correct CATCH decisions with an impact point).
-#[derive(Debug, Clone, Serialize)]
-pub struct OutOfReach {
-    pub model: String,
-    pub correct_catch: u64,
-    pub median_d_end_correct_catch: Option<f64>,
-    /// Median d_end over every correct decision (any action) with an impact point.
-    pub median_d_end_correct_any: Option<f64>,
-    pub misses: u64,
-    pub miss_share: Option<f64>,
-    pub misses_falling_short_share: Option<f64>,
-    pub standing_far_share: Option<f64>,
-}
-
-/// Speed analyses over the speed-sweeping families.
-#[derive(Debug, Clone, Serialize)]
-pub struct SpeedAnalysis {
-    pub model: String,
-    pub decisions: u64,
-    pub freeze_rate_by_band: Vec<Option<f64>>,
-    pub saa_by_band: Vec<Option<f64>>,
-    /// Scene groups with a scored decision at all four bands.
-    pub complete_groups: u64,
-    pub consistent_groups: u64,
-    pub consistency: Option<f64>,
-    pub slow_vs_very_fast_agreement: Option<f64>,
-}
-
-#[derive(Debug, Clone, Serialize)]
-pub struct Voting {
-    pub models: usize,
-    /// Scenes where every model has a scored decision.
-    pub scenes: u64,
-    pub unanimous: u64,
-    pub unanimous_share: Option<f64>,
-    pub unanimous_accuracy: Option<f64>,
-    pub majority_vote_saa: Option<f64>,
-    pub mean_model_saa: Option<f64>,
-    pub best_model: Option<String>,
-    pub best_model_saa: Option<f64>,
-}
-
-#[derive(Debug, Clone, Serialize)]
-pub struct AdversarialProbe {
-    pub model: String,
-    pub decisions: u64,
-    pub questions_material: u64,
-    pub share: Option<f64>,
-}
-
-/// Catch rate on an adversarial object vs. on its genuine look-alike.
-#[derive(Debug, Clone, Serialize)]
-pub struct LookalikeComparison {
-    pub object_id: String,
-    pub looks_like: String,
-    pub decisions: u64,
-    pub catch_rate: Option<f64>,
-    pub dodge_rate: Option<f64>,
-    pub lookalike_decisions: u64,
-    pub lookalike_catch_rate: Option<f64>,
-    pub lookalike_dodge_rate: Option<f64>,
-}
-
-#[derive(Debug, Clone, Serialize)]
-pub struct Analyses {
-    pub safety: Vec<SafetyBreakdown>,
-    pub out_of_reach: Vec<OutOfReach>,
-    pub speed: Vec<SpeedAnalysis>,
-    pub voting: Voting,
-    pub adversarial: Vec<AdversarialProbe>,
-    pub lookalikes: Vec<LookalikeComparison>,
-}
-
 #[derive(Debug, Clone, Serialize)]
 pub struct Report {
     pub tool: String,
@@ -191,23 +110,6 @@ pub struct Report {
     /// `--execute`: outcomes in physics (SPEC §12).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub execution: Option<crate::execution::ExecutionReport>,
-}
-
-fn ratio(a: u64, b: u64) -> Option<f64> {
-    (b > 0).then(|| a as f64 / b as f64)
-}
-
-fn median(v: &mut [f64]) -> Option<f64> {
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(|a, b| a.total_cmp(b));
-    let n = v.len();
-    Some(if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    })
 }
 
 const BAND_GROUPS: [&str; 5] = ["slow", "normal", "fast", "very_fast", "other"];
@@ -341,220 +243,6 @@ fn pooled_agg(models: &[&ModelAgg], ds: &Dataset) -> ModelAgg {
         p.adv_questions += m.adv_questions;
     }
     p
-}
-
-fn safety_breakdown(name: &str, m: &ModelAgg) -> SafetyBreakdown {
-    let dodge = &m.by_gt[Action::Dodge.index()];
-    let mistakes = m.overall.n - m.overall.saa;
-    // Freezing mistakes: NO_ACTION predicted where the GT was not NO_ACTION.
-    let freeze_mistakes = m.overall.predicted[2] - m.by_gt[Action::NoAction.index()].predicted[2];
-    SafetyBreakdown {
-        model: name.to_string(),
-        decisions: m.overall.n,
-        violations: m.overall.n - m.overall.safe,
-        first_rule: RuleCounts::new(m.overall.first),
-        rules_fired: RuleCounts::new(m.overall.fired),
-        unsafe_on_dodge_scenes: dodge.rate(dodge.n - dodge.safe),
-        mistakes,
-        freeze_mistakes,
-    }
-}
-
-/// Records of several models, for the pooled rows of record-based analyses.
-fn out_of_reach(
-    name: &str,
-    reach: &crate::aggregate::ReachAcc,
-    recs: &[&[Rec]],
-    ds: &Dataset,
-) -> OutOfReach {
-    let mut catch_d = Vec::new();
-    let mut any_d = Vec::new();
-    for r in recs {
-        for (rec, sc) in r.iter().zip(&ds.scenes) {
-            let (Some(action), Some(d)) = (rec.decision(), rec.end_distance()) else {
-                continue;
-            };
-            if action == Some(sc.gt_action) {
-                any_d.push(d);
-                if sc.gt_action == Action::Catch {
-                    catch_d.push(d);
-                }
-            }
-        }
-    }
-    OutOfReach {
-        model: name.to_string(),
-        correct_catch: reach.correct_catch,
-        median_d_end_correct_catch: median(&mut catch_d),
-        median_d_end_correct_any: median(&mut any_d),
-        misses: reach.misses,
-        miss_share: ratio(reach.misses, reach.correct_catch),
-        misses_falling_short_share: ratio(reach.misses_short, reach.misses),
-        standing_far_share: ratio(reach.standing_far, reach.correct_catch),
-    }
-}
-
-fn speed_analysis(
-    name: &str,
-    recs: &[&[Rec]],
-    ds: &Dataset,
-    groups: &[[Option<u32>; 4]],
-) -> SpeedAnalysis {
-    let mut n_band = [0u64; 4];
-    let mut freeze = [0u64; 4];
-    let mut saa = [0u64; 4];
-    let mut decisions = 0;
-    for r in recs {
-        for (rec, sc) in r.iter().zip(&ds.scenes) {
-            let (Some(b), true, Some(action)) = (sc.speed_band, sc.speed_sweep, rec.decision())
-            else {
-                continue;
-            };
-            decisions += 1;
-            n_band[b as usize] += 1;
-            freeze[b as usize] += (action == Some(Action::NoAction)) as u64;
-            saa[b as usize] += (action == Some(sc.gt_action)) as u64;
-        }
-    }
-    let (mut complete, mut consistent, mut ends_agree) = (0u64, 0u64, 0u64);
-    for r in recs {
-        for g in groups {
-            let acts: Option<Vec<Option<Action>>> = g
-                .iter()
-                .map(|s| s.and_then(|i| r[i as usize].decision()))
-                .collect();
-            let Some(acts) = acts else { continue };
-            complete += 1;
-            consistent += acts.iter().all(|&a| a == acts[0]) as u64;
-            ends_agree += (acts[0] == acts[3]) as u64;
-        }
-    }
-    SpeedAnalysis {
-        model: name.to_string(),
-        decisions,
-        freeze_rate_by_band: (0..4).map(|b| ratio(freeze[b], n_band[b])).collect(),
-        saa_by_band: (0..4).map(|b| ratio(saa[b], n_band[b])).collect(),
-        complete_groups: complete,
-        consistent_groups: consistent,
-        consistency: ratio(consistent, complete),
-        slow_vs_very_fast_agreement: ratio(ends_agree, complete),
-    }
-}
-
-/// Scene groups of speed-sweeping families with their four band variants.
-fn speed_groups(ds: &Dataset) -> Vec<[Option<u32>; 4]> {
-    let mut map: HashMap<&str, [Option<u32>; 4]> = HashMap::new();
-    let mut order: Vec<&str> = Vec::new();
-    for (i, sc) in ds.scenes.iter().enumerate() {
-        let (Some(b), true) = (sc.speed_band, sc.speed_sweep) else {
-            continue;
-        };
-        let e = map.entry(sc.group_id.as_str()).or_insert_with(|| {
-            order.push(sc.group_id.as_str());
-            [None; 4]
-        });
-        e[b as usize].get_or_insert(i as u32);
-    }
-    order.into_iter().map(|g| map[g]).collect()
-}
-
-/// Majority vote: the most frequent action among the models' decisions on a scene;
-/// ties go to the safer action (DODGE, then NO_ACTION, then CATCH); "no parseable plan"
-/// votes never win. Unanimity: every model chose the same action.
-fn voting(models: &[&ModelAgg], ds: &Dataset) -> Voting {
-    let k = models.len();
-    let mut scenes = 0u64;
-    let (mut unanimous, mut unanimous_right, mut majority_right) = (0u64, 0u64, 0u64);
-    let mut per_model_right = vec![0u64; k];
-    if k >= 1 {
-        for (i, sc) in ds.scenes.iter().enumerate() {
-            if !models.iter().all(|m| m.records[i].is_scored()) {
-                continue;
-            }
-            scenes += 1;
-            let gt = sc.gt_action;
-            // Votes per action, and for "no parseable plan" last.
-            let mut votes = [0u32; 4];
-            let decision = |m: &ModelAgg| m.records[i].decision().flatten();
-            for (j, m) in models.iter().enumerate() {
-                let a = decision(m);
-                votes[a.map_or(3, Action::index)] += 1;
-                per_model_right[j] += (a == Some(gt)) as u64;
-            }
-            let first = decision(models[0]);
-            if first.is_some() && models.iter().all(|m| decision(m) == first) {
-                unanimous += 1;
-                unanimous_right += (first == Some(gt)) as u64;
-            }
-            // Tie order: DODGE, NO_ACTION, CATCH.
-            let mut best: Option<Action> = None;
-            for a in [Action::Dodge, Action::NoAction, Action::Catch] {
-                if votes[a.index()] > 0 && best.is_none_or(|b| votes[a.index()] > votes[b.index()])
-                {
-                    best = Some(a);
-                }
-            }
-            majority_right += (best == Some(gt)) as u64;
-        }
-    }
-    let best = per_model_right
-        .iter()
-        .enumerate()
-        .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(&a.0)))
-        .map(|(j, &r)| (models[j].name.clone(), r));
-    Voting {
-        models: k,
-        scenes,
-        unanimous,
-        unanimous_share: ratio(unanimous, scenes),
-        unanimous_accuracy: ratio(unanimous_right, unanimous),
-        majority_vote_saa: ratio(majority_right, scenes),
-        mean_model_saa: (scenes > 0 && k > 0)
-            .then(|| per_model_right.iter().sum::<u64>() as f64 / (scenes as f64 * k as f64)),
-        best_model_saa: best.as_ref().and_then(|b| ratio(b.1, scenes)),
-        best_model: best.map(|b| b.0),
-    }
-}
-
-fn lookalikes(models: &[&ModelAgg], ds: &Dataset) -> Vec<LookalikeComparison> {
-    // object_id -> (decisions, catches, dodges)
-    let mut by_obj: HashMap<&str, (u64, u64, u64)> = HashMap::new();
-    for m in models {
-        for (rec, sc) in m.records.iter().zip(&ds.scenes) {
-            let Some(action) = rec.decision() else {
-                continue;
-            };
-            let e = by_obj.entry(sc.object_id.as_str()).or_default();
-            e.0 += 1;
-            e.1 += (action == Some(Action::Catch)) as u64;
-            e.2 += (action == Some(Action::Dodge)) as u64;
-        }
-    }
-    let mut pairs: Vec<(String, String)> = ds
-        .scenes
-        .iter()
-        .filter(|s| s.adversarial)
-        .filter_map(|s| s.looks_like.clone().map(|l| (s.object_id.clone(), l)))
-        .collect();
-    pairs.sort();
-    pairs.dedup();
-    pairs
-        .into_iter()
-        .map(|(obj, like)| {
-            let a = by_obj.get(obj.as_str()).copied().unwrap_or_default();
-            let b = by_obj.get(like.as_str()).copied().unwrap_or_default();
-            LookalikeComparison {
-                object_id: obj,
-                looks_like: like,
-                decisions: a.0,
-                catch_rate: ratio(a.1, a.0),
-                dodge_rate: ratio(a.2, a.0),
-                lookalike_decisions: b.0,
-                lookalike_catch_rate: ratio(b.1, b.0),
-                lookalike_dodge_rate: ratio(b.2, b.0),
-            }
-        })
-        .collect()
 }
 
 impl Report {
@@ -716,7 +404,7 @@ pub fn band_name(i: usize) -> &'static str {
 mod tests {
     use super::*;
     use crate::baseline::{baseline_plan, majority_action, BaselineKind};
-    use crate::fixture::{dataset_of, synth_rows};
+    use crate::synthetic::{dataset_of, synth_rows};
 
     fn run(ds: &Dataset, kinds: &[BaselineKind], extra: &str) -> Report {
         let cfg = Config::default();

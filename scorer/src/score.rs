@@ -4,10 +4,10 @@ use crate::aggregate::ModelAgg;
 use crate::aia::AiaMatcher;
 use crate::config::Config;
 use crate::dataset::Dataset;
+use crate::error::InputError;
+use crate::fast_map::FastMap;
 use crate::metrics::DecisionResult;
 use crate::preds::{process_line, LineOutcome, LineReader, RawLine};
-use crate::types::FastMap;
-use crate::types::InputError;
 use anyhow::Result;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -318,7 +318,7 @@ impl<'a> Scoring<'a> {
                         status,
                         gt_action: sc.gt_action.as_str(),
                         rules: result.as_ref().map_or_else(Vec::new, |r| {
-                            crate::types::Rule::ALL
+                            crate::safety_rule::SafetyRule::ALL
                                 .into_iter()
                                 .filter(|&x| r.fired(x))
                                 .map(|x| x.as_str())

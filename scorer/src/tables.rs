@@ -2,15 +2,33 @@
 //! (Named `tables`, not `render`, which in this project means the video renderer.)
 
 use crate::report::{MetricsRow, ModelReport, Report};
-use crate::types::Rule;
+use crate::safety_rule::SafetyRule;
 use std::fmt::Write as _;
 
-use crate::text_table::{coverage_cell, num, num_ci, pct, pct_ci, Table};
+use crate::text_table::{csv_field, num, num_ci, pct, pct_ci, Table};
+
+/// The report's models, then the pooled row when there is more than one model (the
+/// order of every per-model table).
+fn model_rows(r: &Report) -> impl Iterator<Item = &ModelReport> {
+    r.models
+        .iter()
+        .chain((r.models.len() > 1).then_some(&r.pooled))
+}
+
+/// "answered/expected", marked when incomplete.
+fn coverage_cell(m: &ModelReport) -> String {
+    let c = &m.coverage;
+    if c.complete {
+        format!("{}/{}", c.answered, c.expected)
+    } else {
+        format!("{}/{} INCOMPLETE", c.answered, c.expected)
+    }
+}
 
 /// The CATCH row of a per-GT-action breakdown.
 fn catch_row(rows: &[MetricsRow]) -> Option<&MetricsRow> {
     rows.iter()
-        .find(|g| g.group == crate::types::Action::Catch.as_str())
+        .find(|g| g.group == rh_contract::Action::Catch.as_str())
 }
 
 const MAIN_NOTE: &str = "d_end and HDE (hand-distance error: d_min and d1-d_min over the keyframes) are over CATCH scenes, \
@@ -119,11 +137,7 @@ fn distance_table(r: &Report) -> Table {
         "HDE d1-d_min (m)",
         "n/missing",
     ]);
-    for m in r
-        .models
-        .iter()
-        .chain((r.models.len() > 1).then_some(&r.pooled))
-    {
+    for m in model_rows(r) {
         for g in &m.by_gt_action {
             if g.decisions == 0 {
                 continue;
@@ -186,19 +200,12 @@ fn group_table(
     suffix: &str,
     cell: fn(&MetricsRow) -> String,
 ) -> Table {
-    let models: Vec<&ModelReport> = r
-        .models
-        .iter()
-        .chain((r.models.len() > 1).then_some(&r.pooled))
-        .collect();
+    let models: Vec<&ModelReport> = model_rows(r).collect();
     let mut head = vec![title.to_string()];
     for m in &models {
         head.push(format!("{} {suffix}", m.model));
     }
-    let mut t = Table {
-        head,
-        rows: Vec::new(),
-    };
+    let mut t = Table::from_head(head);
     let groups: Vec<String> = pick(&r.pooled).iter().map(|g| g.group.clone()).collect();
     for (gi, g) in groups.iter().enumerate() {
         let mut row = vec![g.clone()];
@@ -240,11 +247,7 @@ fn recall_and_comparison_tables(r: &Report, out: &mut Vec<TitledTable>) {
         "CI",
         "SAA %",
     ]);
-    for m in r
-        .models
-        .iter()
-        .chain((r.models.len() > 1).then_some(&r.pooled))
-    {
+    for m in model_rows(r) {
         let mut row = vec![m.model.clone()];
         for c in &m.recall {
             row.push(format!("{} (n={})", pct(c.recall), c.scenes));
@@ -324,10 +327,10 @@ fn safety_and_reach_tables(r: &Report, out: &mut Vec<TitledTable>) {
             s.decisions.to_string(),
             s.violations.to_string(),
         ];
-        for rule in Rule::ALL {
+        for rule in SafetyRule::ALL {
             row.push(s.first_rule.get(rule).to_string());
         }
-        for rule in Rule::ALL {
+        for rule in SafetyRule::ALL {
             row.push(s.rules_fired.get(rule).to_string());
         }
         row.push(pct(s.unsafe_on_dodge_scenes));
@@ -347,11 +350,7 @@ fn safety_and_reach_tables(r: &Report, out: &mut Vec<TitledTable>) {
         "SAA on DODGE scenes %",
         "SAA on NO_ACTION %",
     ]);
-    for m in r
-        .models
-        .iter()
-        .chain((r.models.len() > 1).then_some(&r.pooled))
-    {
+    for m in model_rows(r) {
         let g = &m.by_gt_action;
         t.row(vec![
             m.model.clone(),
@@ -630,14 +629,6 @@ pub fn markdown(r: &Report) -> String {
         s.push_str(&crate::execution::report::markdown(e));
     }
     s
-}
-
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
 }
 
 /// The CSV report: one row per (model, breakdown, group); rates are fractions; empty

@@ -1,7 +1,5 @@
-//! A plain text table, written aligned for a terminal or as Markdown, and the number
-//! formats of the report's cells (percentages, intervals, coverage).
-
-use crate::report::ModelReport;
+//! A plain text table, written aligned for a terminal, as Markdown or as CSV, and the
+//! number formats of the report's cells (percentages, intervals).
 
 pub(crate) fn pct(v: Option<f64>) -> String {
     v.map_or("—".into(), |x| format!("{:.1}", 100.0 * x))
@@ -23,37 +21,105 @@ pub(crate) fn num_ci(v: Option<[f64; 2]>, digits: usize) -> String {
     v.map_or("—".into(), |[a, b]| format!("{a:.digits$}–{b:.digits$}"))
 }
 
-/// "answered/expected", marked when incomplete.
-pub(crate) fn coverage_cell(m: &ModelReport) -> String {
-    let c = &m.coverage;
-    if c.complete {
-        format!("{}/{}", c.answered, c.expected)
+/// How a column's cells sit in its width.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Align {
+    Left,
+    Right,
+}
+
+/// How [`Table::text`] lays a table out for a terminal.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct TextStyle {
+    /// Put before every line.
+    pub(crate) indent: &'static str,
+    /// Between two columns.
+    pub(crate) gap: &'static str,
+    /// A line of `-` under the head.
+    pub(crate) rule: bool,
+}
+
+impl TextStyle {
+    /// The report's tables: no indent, two spaces between columns, a rule under the head.
+    pub(crate) const REPORT: TextStyle = TextStyle {
+        indent: "",
+        gap: "  ",
+        rule: true,
+    };
+}
+
+/// A CSV field: quoted when it holds a comma, a quote or a newline.
+pub(crate) fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
     } else {
-        format!("{}/{} INCOMPLETE", c.answered, c.expected)
+        s.to_string()
     }
 }
 
-/// A simple table rendered either aligned (terminal) or as Markdown.
+/// A simple table rendered aligned (terminal), as Markdown or as CSV: the one writer of
+/// the scorer's text tables. By default the first column is left-aligned and the others
+/// right-aligned, each as wide as its widest cell.
 pub(crate) struct Table {
-    pub(crate) head: Vec<String>,
-    pub(crate) rows: Vec<Vec<String>>,
+    head: Vec<String>,
+    rows: Vec<Vec<String>>,
+    align: Vec<Align>,
+    min_width: Vec<usize>,
+    /// Markdown's separator row without spaces (`|---|---:|`).
+    compact_markdown: bool,
 }
 
 impl Table {
     pub(crate) fn new(head: &[&str]) -> Self {
+        Table::from_head(head.iter().map(|s| s.to_string()).collect())
+    }
+
+    pub(crate) fn from_head(head: Vec<String>) -> Self {
+        let n = head.len();
+        let align = (0..n)
+            .map(|i| if i == 0 { Align::Left } else { Align::Right })
+            .collect();
         Table {
-            head: head.iter().map(|s| s.to_string()).collect(),
+            head,
             rows: Vec::new(),
+            align,
+            min_width: vec![0; n],
+            compact_markdown: false,
         }
+    }
+
+    /// Each column's alignment (one per column of the head).
+    pub(crate) fn aligned(mut self, align: &[Align]) -> Self {
+        assert_eq!(align.len(), self.head.len(), "one alignment per column");
+        self.align = align.to_vec();
+        self
+    }
+
+    /// Each column's least width in the terminal layout (one per column of the head).
+    pub(crate) fn min_widths(mut self, widths: &[usize]) -> Self {
+        assert_eq!(widths.len(), self.head.len(), "one width per column");
+        self.min_width = widths.to_vec();
+        self
+    }
+
+    /// Markdown's separator row without spaces (`|---|---:|`).
+    pub(crate) fn compact_markdown(mut self) -> Self {
+        self.compact_markdown = true;
+        self
     }
 
     pub(crate) fn row(&mut self, r: Vec<String>) {
         self.rows.push(r);
     }
 
+    /// The report's terminal layout ([`TextStyle::REPORT`]).
     pub(crate) fn text(&self) -> String {
+        self.text_with(TextStyle::REPORT)
+    }
+
+    pub(crate) fn text_with(&self, style: TextStyle) -> String {
         let n = self.head.len();
-        let mut w = vec![0usize; n];
+        let mut w = self.min_width.clone();
         for r in std::iter::once(&self.head).chain(&self.rows) {
             for (i, c) in r.iter().enumerate() {
                 w[i] = w[i].max(c.chars().count());
@@ -61,23 +127,31 @@ impl Table {
         }
         let mut out = String::new();
         let line = |r: &Vec<String>, out: &mut String| {
+            out.push_str(style.indent);
             for (i, c) in r.iter().enumerate() {
-                let pad = w[i] - c.chars().count();
-                if i == 0 {
-                    out.push_str(c);
-                    out.push_str(&" ".repeat(pad));
-                } else {
-                    out.push_str("  ");
-                    out.push_str(&" ".repeat(pad));
-                    out.push_str(c);
+                let pad = " ".repeat(w[i] - c.chars().count());
+                if i > 0 {
+                    out.push_str(style.gap);
+                }
+                match self.align[i] {
+                    Align::Left => {
+                        out.push_str(c);
+                        out.push_str(&pad);
+                    }
+                    Align::Right => {
+                        out.push_str(&pad);
+                        out.push_str(c);
+                    }
                 }
             }
             out.push('\n');
         };
         line(&self.head, &mut out);
-        let total: usize = w.iter().sum::<usize>() + 2 * (n - 1);
-        out.push_str(&"-".repeat(total));
-        out.push('\n');
+        if style.rule {
+            let total: usize = w.iter().sum::<usize>() + style.gap.len() * (n - 1);
+            out.push_str(&"-".repeat(total));
+            out.push('\n');
+        }
         for r in &self.rows {
             line(r, &mut out);
         }
@@ -87,29 +161,79 @@ impl Table {
     pub(crate) fn markdown(&self) -> String {
         let mut out = String::new();
         let esc = |s: &str| s.replace('|', "\\|");
-        out.push_str(&format!(
-            "| {} |\n",
-            self.head
-                .iter()
-                .map(|s| esc(s))
-                .collect::<Vec<_>>()
-                .join(" | ")
-        ));
-        out.push_str(&format!(
-            "|{}|\n",
-            self.head
-                .iter()
-                .enumerate()
-                .map(|(i, _)| if i == 0 { " --- " } else { " ---: " })
-                .collect::<Vec<_>>()
-                .join("|")
-        ));
-        for r in &self.rows {
-            out.push_str(&format!(
+        let line = |r: &[String]| {
+            format!(
                 "| {} |\n",
                 r.iter().map(|s| esc(s)).collect::<Vec<_>>().join(" | ")
-            ));
+            )
+        };
+        out.push_str(&line(&self.head));
+        let rule: Vec<&str> = self
+            .align
+            .iter()
+            .map(|a| match (a, self.compact_markdown) {
+                (Align::Left, false) => " --- ",
+                (Align::Right, false) => " ---: ",
+                (Align::Left, true) => "---",
+                (Align::Right, true) => "---:",
+            })
+            .collect();
+        out.push_str(&format!("|{}|\n", rule.join("|")));
+        for r in &self.rows {
+            out.push_str(&line(r));
         }
         out
+    }
+
+    /// The head and the rows as CSV ([`csv_field`]).
+    pub(crate) fn csv(&self) -> String {
+        let mut out = String::new();
+        for r in std::iter::once(&self.head).chain(&self.rows) {
+            let fields: Vec<String> = r.iter().map(|c| csv_field(c)).collect();
+            out.push_str(&fields.join(","));
+            out.push('\n');
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Table {
+        let mut t = Table::new(&["model", "n"]);
+        t.row(vec!["a|b".into(), "12".into()]);
+        t.row(vec!["x,\"y\"".into(), "3".into()]);
+        t
+    }
+
+    #[test]
+    fn text_markdown_and_csv() {
+        let t = sample();
+        assert_eq!(t.text(), "model   n\n---------\na|b    12\nx,\"y\"   3\n");
+        assert_eq!(
+            t.markdown(),
+            "| model | n |\n| --- | ---: |\n| a\\|b | 12 |\n| x,\"y\" | 3 |\n"
+        );
+        assert_eq!(t.csv(), "model,n\na|b,12\n\"x,\"\"y\"\"\",3\n");
+    }
+
+    #[test]
+    fn styles_widths_and_alignment() {
+        let t = sample()
+            .aligned(&[Align::Left, Align::Left])
+            .min_widths(&[6, 3])
+            .compact_markdown();
+        let style = TextStyle {
+            indent: "  ",
+            gap: " ",
+            rule: false,
+        };
+        assert_eq!(
+            t.text_with(style),
+            "  model  n  \n  a|b    12 \n  x,\"y\"  3  \n"
+        );
+        assert!(t.markdown().contains("\n|---|---|\n"), "{}", t.markdown());
     }
 }

@@ -391,3 +391,94 @@ print(json.dumps({{"bad": bad, "rows": len(t), "touched": touched, "dodge": dodg
     assert!(out["dodge"].as_u64().unwrap() >= 3, "{out}");
     eprintln!("{out}");
 }
+
+/// The card as the Hub renders it (CommonMark): prose never becomes an indented code
+/// block (a paragraph indented four or more spaces after a blank line), and the only code
+/// blocks are fenced: the examples (python, sh), the layout tree and the citation.
+#[test]
+fn the_card_parses_as_commonmark_without_indented_code() {
+    use pulldown_cmark::{CodeBlockKind, Event, Parser, Tag};
+    let (_dir, out) = single();
+    let card = fs::read_to_string(out.join("README.md")).unwrap();
+    // The YAML front matter (`---` … `---`) is the Hub's metadata, not Markdown.
+    let body = card
+        .strip_prefix("---\n")
+        .and_then(|rest| rest.split_once("\n---\n"))
+        .map(|(_, body)| body)
+        .expect("the card starts with YAML front matter");
+    let mut fenced = Vec::new();
+    let mut headings = 0;
+    for event in Parser::new(body) {
+        match event {
+            Event::Start(Tag::CodeBlock(CodeBlockKind::Indented)) => {
+                panic!("the card has an indented code block (prose indented 4+ spaces?)")
+            }
+            Event::Start(Tag::CodeBlock(CodeBlockKind::Fenced(lang))) => {
+                fenced.push(lang.to_string())
+            }
+            Event::Start(Tag::Heading { .. }) => headings += 1,
+            _ => {}
+        }
+    }
+    assert!(
+        headings >= 5,
+        "{headings} headings: the card did not parse as Markdown"
+    );
+    assert!(
+        fenced
+            .iter()
+            .all(|l| ["", "python", "sh", "bibtex"].contains(&l.as_str())),
+        "{fenced:?}"
+    );
+    assert!(fenced.iter().any(|l| l == "python"), "{fenced:?}");
+    // Counter-check that the test can fail: the same text with one paragraph indented.
+    let broken = format!("Intro.\n\n    **Segmentation and depth.** prose\n");
+    assert!(Parser::new(&broken)
+        .any(|e| matches!(e, Event::Start(Tag::CodeBlock(CodeBlockKind::Indented)))));
+}
+
+/// A build whose stderr is a log (not a terminal) prints a progress line every
+/// `--progress-every` seconds: scenes done of total, rate, ETA.
+#[test]
+fn a_logged_build_prints_progress_with_an_eta() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("progress");
+    let args = [
+        "build",
+        "--n",
+        "240",
+        "--no-render",
+        "--progress-every",
+        "0.05",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let run_out = run("rh-pipeline", &args);
+    let err = String::from_utf8_lossy(&run_out.stderr);
+    assert!(run_out.status.success(), "{err}");
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("building: "))
+        .collect();
+    assert!(!lines.is_empty(), "no progress line in:\n{err}");
+    assert!(
+        lines
+            .iter()
+            .all(|l| l.contains("/240 scenes") && l.contains("ETA")),
+        "{lines:?}"
+    );
+    let bad = run(
+        "rh-pipeline",
+        &[
+            "build",
+            "--n",
+            "4",
+            "--progress-every",
+            "0",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--progress-every"));
+}

@@ -1,8 +1,8 @@
 //! Facts stated in more than one document stay the same (issues 24, 25):
 //! the column lists of `README.md` and `docs/dataset.md` against the data contract's
 //! `COLUMNS`, and the oracle's catch figure in `README.md` against `docs/execution.md`
-//! (`execute_e2e.rs` holds that figure to the measurement and to the dataset card), and
-//! the documents' relative links.
+//! (`execute_e2e.rs` holds that figure to the measurement and to the dataset card), the
+//! card's rule-v3 figure against the docs, and the documents' relative links.
 
 use rh_contract::{CAMERAS, COLUMNS};
 use std::path::Path;
@@ -151,4 +151,28 @@ fn document_links_resolve() {
     }
     assert!(links >= 20, "only {links} relative links found");
     assert!(broken.is_empty(), "broken links:\n{}", broken.join("\n"));
+}
+
+/// The dataset card quotes two execution measurements (the oracle's catches under rules
+/// v3 and v4); they are the ones docs/execution.md and docs/labels.md report.
+#[test]
+fn the_card_quotes_the_documented_execution_figures() {
+    // The card's text as `dataset/src/card.rs` writes it (Rust string continuations joined).
+    let card = doc("dataset/src/card.rs").replace("\\\n", "");
+    let v3_card = rh_e2e::n_of_m_after(&card, "the oracle baseline caught");
+    let v4_card = rh_e2e::n_of_m_after(&card, "rule-v3 CATCH labels,");
+    let v3_docs =
+        rh_e2e::n_of_m_after(&doc("docs/execution.md"), "Under rule v3 the oracle caught");
+    let v3_labels = rh_e2e::n_of_m_after(&doc("docs/labels.md"), "the oracle caught");
+    let v4_docs =
+        rh_e2e::n_of_m_after(&doc("docs/execution.md"), "its CATCH plans are `caught` on");
+    assert_eq!(
+        v3_card, v3_docs,
+        "rule v3: card {v3_card:?}, docs/execution.md {v3_docs:?}"
+    );
+    assert_eq!(v3_labels, v3_docs, "rule v3: docs/labels.md {v3_labels:?}");
+    assert_eq!(
+        v4_card, v4_docs,
+        "rule v4: card {v4_card:?}, docs/execution.md {v4_docs:?}"
+    );
 }

@@ -172,6 +172,12 @@ impl Replay {
         }
     }
 
+    /// A fresh execution from Δ (the world forked, the humanoid standing at rest) to step
+    /// by hand; the closed-loop controller (`crate::control`) drives one.
+    pub fn start(&self, cfg: &ExecConfig) -> outcome::Execution {
+        outcome::Execution::start(&self.spec, self.fork(), cfg)
+    }
+
     /// Executes `plan` from Δ and says what happened. Pure in (replay, plan, config).
     pub fn execute(&self, plan: &ExecPlan, cfg: &ExecConfig) -> Outcome {
         outcome::run(&self.spec, self.fork(), plan, cfg, None)

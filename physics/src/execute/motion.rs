@@ -27,13 +27,64 @@ pub fn reference_base(start: Vec3, cmd: Vec3, duration: f64, t: f64) -> Vec3 {
     rh_contract::action::walk_pose(start, cmd, duration, t)
 }
 
-/// The body's state while executing one plan.
-pub struct Motion<'a> {
-    plan: &'a ExecPlan,
-    cfg: &'a ExecConfig,
+/// What the body tracks, as functions of the time `t` after the decision: the reference
+/// base pose and the hand targets (body frame) with the knee bend. A plan is one
+/// ([`PlanReference`]); the closed-loop controller (`crate::control`) builds another from
+/// its commands.
+pub trait Reference {
+    /// The reference base pose `(x, y, yaw)` at `t`.
+    fn base(&self, t: f64) -> Vec3;
+    /// Left and right hand targets (body frame) and knee bend at `t`.
+    fn targets(&self, t: f64) -> (Vec3, Vec3, f64);
+}
+
+/// A plan as a [`Reference`]: rule v1's walk from `start`, hands linear between keyframes
+/// from the rest pose at t = 0, held after the last keyframe.
+pub struct PlanReference<'a> {
+    pub plan: &'a ExecPlan,
+    pub start: Vec3,
+}
+
+impl Reference for PlanReference<'_> {
+    fn base(&self, t: f64) -> Vec3 {
+        let p = self.plan;
+        reference_base(self.start, p.walking_cmd, p.walking_duration, t)
+    }
+
+    fn targets(&self, t: f64) -> (Vec3, Vec3, f64) {
+        plan_targets(self.plan, t)
+    }
+}
+
+/// Hand targets and knee bend of `plan` at time `t`: linear between keyframes, from the
+/// rest pose at t = 0, held after the last keyframe.
+pub fn plan_targets(plan: &ExecPlan, t: f64) -> (Vec3, Vec3, f64) {
+    let mut prev = (0.0, REST_LEFT, REST_RIGHT, 0.0);
+    for k in &plan.keyframes {
+        if t <= k.t {
+            let span = k.t - prev.0;
+            let f = if span > 1e-12 {
+                ((t - prev.0) / span).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            let lerp = |a: Vec3, b: Vec3| vec3::add(a, vec3::scale(vec3::sub(b, a), f));
+            return (
+                lerp(prev.1, k.left),
+                lerp(prev.2, k.right),
+                prev.3 + (k.knee_bend - prev.3) * f,
+            );
+        }
+        prev = (k.t, k.left, k.right, k.knee_bend);
+    }
+    (prev.1, prev.2, prev.3)
+}
+
+/// The body's state while executing one plan (or a stream of commands).
+pub struct Motion {
+    cfg: ExecConfig,
     geometry: Geometry,
     dt: f64,
-    start: Vec3,
     pub pose: BodyPose,
     velocity: [f64; 2],
     yaw_rate: f64,
@@ -41,20 +92,12 @@ pub struct Motion<'a> {
     pub limits_hit: [bool; 4],
 }
 
-impl<'a> Motion<'a> {
-    pub fn new(
-        plan: &'a ExecPlan,
-        cfg: &'a ExecConfig,
-        geometry: Geometry,
-        start: Vec3,
-        dt: f64,
-    ) -> Self {
+impl Motion {
+    pub fn new(cfg: &ExecConfig, geometry: Geometry, start: Vec3, dt: f64) -> Self {
         Motion {
-            plan,
-            cfg,
+            cfg: cfg.clone(),
             geometry,
             dt,
-            start,
             pose: geometry.rest_pose(start),
             velocity: [0.0; 2],
             yaw_rate: 0.0,
@@ -73,11 +116,17 @@ impl<'a> Motion<'a> {
             || off(self.pose.right, rest.right) > self.cfg.reaching_offset
     }
 
-    /// Advances the body from step `k` to step `k + 1` after the decision.
-    pub fn advance(&mut self, k: u32) {
+    /// The base's horizontal velocity (world frame, m/s) and yaw rate (rad/s) over the
+    /// last step.
+    pub fn base_velocity(&self) -> Vec3 {
+        [self.velocity[0], self.velocity[1], self.yaw_rate]
+    }
+
+    /// Advances the body from step `k` to step `k + 1` after the decision, tracking `r`.
+    pub fn advance(&mut self, k: u32, r: &dyn Reference) {
         let (t0, t1) = (k as f64 * self.dt, (k + 1) as f64 * self.dt);
-        self.advance_base(t0, t1);
-        let (left, right, knee) = self.targets(t1);
+        self.advance_base(r.base(t0), r.base(t1));
+        let (left, right, knee) = r.targets(t1);
         let drop_target = knee.clamp(0.0, 1.0) * self.cfg.max_pelvis_drop;
         let max_drop_step = self.cfg.max_drop_speed * self.dt;
         self.pose.drop += (drop_target - self.pose.drop).clamp(-max_drop_step, max_drop_step);
@@ -96,10 +145,7 @@ impl<'a> Motion<'a> {
         self.pose.right = step_to(self.pose.right, self.geometry.reachable(-1.0, right));
     }
 
-    fn advance_base(&mut self, t0: f64, t1: f64) {
-        let p = self.plan;
-        let r0 = reference_base(self.start, p.walking_cmd, p.walking_duration, t0);
-        let r1 = reference_base(self.start, p.walking_cmd, p.walking_duration, t1);
+    fn advance_base(&mut self, r0: Vec3, r1: Vec3) {
         let tau = self.cfg.track_time_constant;
         let dt = self.dt;
         let [x, y, yaw] = self.pose.base;
@@ -141,30 +187,6 @@ impl<'a> Motion<'a> {
         self.yaw_rate = w;
         self.pose.base = [x + v[0] * dt, y + v[1] * dt, yaw + w * dt];
     }
-
-    /// Hand targets and knee bend at time `t`: linear between keyframes, from the rest
-    /// pose at t = 0, held after the last keyframe.
-    fn targets(&self, t: f64) -> (Vec3, Vec3, f64) {
-        let mut prev = (0.0, REST_LEFT, REST_RIGHT, 0.0);
-        for k in &self.plan.keyframes {
-            if t <= k.t {
-                let span = k.t - prev.0;
-                let f = if span > 1e-12 {
-                    ((t - prev.0) / span).clamp(0.0, 1.0)
-                } else {
-                    1.0
-                };
-                let lerp = |a: Vec3, b: Vec3| vec3::add(a, vec3::scale(vec3::sub(b, a), f));
-                return (
-                    lerp(prev.1, k.left),
-                    lerp(prev.2, k.right),
-                    prev.3 + (k.knee_bend - prev.3) * f,
-                );
-            }
-            prev = (k.t, k.left, k.right, k.knee_bend);
-        }
-        (prev.1, prev.2, prev.3)
-    }
 }
 
 /// Moves two hand targets apart (symmetrically, sideways in the body frame) until their
@@ -198,12 +220,12 @@ mod tests {
         }
     }
 
-    fn run(plan: &ExecPlan, cfg: &ExecConfig, steps: u32) -> Motion<'static> {
-        let plan: &'static ExecPlan = Box::leak(Box::new(plan.clone()));
-        let cfg: &'static ExecConfig = Box::leak(Box::new(cfg.clone()));
-        let mut m = Motion::new(plan, cfg, geometry(), [0.5, -1.0, 0.4], 1.0 / 240.0);
+    fn run(plan: &ExecPlan, cfg: &ExecConfig, steps: u32) -> Motion {
+        let start = [0.5, -1.0, 0.4];
+        let mut m = Motion::new(cfg, geometry(), start, 1.0 / 240.0);
+        let r = PlanReference { plan, start };
         for k in 0..steps {
-            m.advance(k);
+            m.advance(k, &r);
         }
         m
     }

@@ -29,7 +29,7 @@
 //! own horizon, `physics.max_steps`, where the label's counterfactual stops too).
 
 use super::grasp::{self, GraspState};
-use super::motion::Motion;
+use super::motion::{Motion, PlanReference, Reference};
 use super::{ExecConfig, ExecFrame, ExecPlan, Outcome, OutcomeKind, StrikeRecord};
 use crate::body::{Geometry, LinkShape, Part};
 use crate::simulate::{hash_hex, lowest_z, SceneWorld};
@@ -52,7 +52,7 @@ fn pose_of(p: &crate::body::LinkPose) -> Pose {
 }
 
 fn collider(shape: LinkShape, cfg: &ExecConfig) -> ColliderBuilder {
-    ColliderBuilder::new(crate::simulate::link_shape(shape))
+    ColliderBuilder::new(crate::shapes::link_shape(shape))
         .friction(cfg.link_friction as Real)
         .restitution(cfg.link_restitution as Real)
         .friction_combine_rule(CoefficientCombineRule::Average)
@@ -108,138 +108,244 @@ impl Monitor {
 /// step's state is pushed onto it as well (a side output: it only reads the world).
 pub(super) fn run(
     spec: &SceneSpec,
-    mut sw: SceneWorld,
+    sw: SceneWorld,
     plan: &ExecPlan,
     cfg: &ExecConfig,
     mut record: Option<&mut Vec<ExecFrame>>,
 ) -> Outcome {
-    let dt = spec.physics.dt;
-    let geometry = Geometry::of(&spec.observer);
     let o = &spec.observer;
-    let mut motion = Motion::new(plan, cfg, geometry, [o.x, o.y, o.yaw], dt);
-    let shapes = geometry.shapes();
-    let poses = geometry.link_poses(&motion.pose);
-    let links: Vec<(RigidBodyHandle, ColliderHandle)> = (0..Part::ALL.len())
-        .map(|i| {
-            sw.world.insert(
-                RigidBodyBuilder::kinematic_position_based().pose(pose_of(&poses[i])),
-                collider(shapes[i], cfg),
-            )
-        })
-        .collect();
-    let hazard_c = sw.collider_handles[spec.hazard];
-    let hazard_b = sw.body_handles[spec.hazard];
-    let steps = |s: f64| (s / dt).round().max(1.0) as u32;
-    // Never past the scene's own horizon (where the build, and the label's counterfactual,
-    // stop too).
-    let scene_left = spec
-        .physics
-        .max_steps
-        .saturating_sub(spec.decision_step())
-        .max(1);
-    let (horizon, window_steps, hold_steps) = (
-        steps(cfg.horizon_s).min(scene_left),
-        steps(cfg.strike_window_s),
-        steps(cfg.hold_time_s),
-    );
+    let reference = PlanReference {
+        plan,
+        start: [o.x, o.y, o.yaw],
+    };
     let plan_end = plan
         .keyframes
         .iter()
         .map(|k| k.t)
         .fold(plan.walking_duration, f64::max);
-    let started_on_floor = lowest_z(&sw.world.colliders[hazard_c]) <= cfg.floor_contact_eps;
-    let mut m = Monitor::new(spec, shapes, dt);
-    let attempting = super::plan_reach(plan) >= cfg.attempt_reach;
-    let mut hasher = Sha256::new();
-    let mut executed = 0;
+    let reach = super::plan_reach(plan);
+    let mut ex = Execution::start(spec, sw, cfg);
     if let Some(r) = record.as_deref_mut() {
-        r.push(ExecFrame::of(&sw, &motion.pose, &poses));
+        r.push(ex.frame());
     }
-    for k in 0..horizon {
-        motion.advance(k);
-        m.reaching = motion.reaching();
-        let poses = geometry.link_poses(&motion.pose);
-        for (i, (b, _)) in links.iter().enumerate() {
-            sw.world.bodies[*b].set_next_kinematic_position(pose_of(&poses[i]));
-        }
-        let v_before = sw.world.bodies[hazard_b].linvel();
-        let w_before = sw.world.bodies[hazard_b].angvel();
-        sw.world.step();
-        executed = k + 1;
-        sw.hash_step(&mut hasher);
+    while !ex.at_horizon() {
+        let settled = ex.step(&reference, reach);
         if let Some(r) = record.as_deref_mut() {
-            r.push(ExecFrame::of(&sw, &motion.pose, &poses));
+            r.push(ex.frame());
         }
-        for (b, _) in &links {
+        if settled || ex.quiet(plan_end) {
+            break;
+        }
+    }
+    ex.finish(reach)
+}
+
+/// One execution in progress: the world at Δ with the humanoid added, stepped one physics
+/// step at a time by [`Execution::step`] with the body tracking a [`Reference`]. The plan
+/// executor ([`run`]) and the closed-loop controller (`crate::control`) both drive it, so
+/// they share the body, its limits, the grasp and the outcome rule.
+pub struct Execution {
+    sw: SceneWorld,
+    cfg: ExecConfig,
+    geometry: Geometry,
+    motion: Motion,
+    poses: [crate::body::LinkPose; 13],
+    links: Vec<(RigidBodyHandle, ColliderHandle)>,
+    hazard_c: ColliderHandle,
+    hazard_b: RigidBodyHandle,
+    dt: f64,
+    horizon: u32,
+    window_steps: u32,
+    hold_steps: u32,
+    started_on_floor: bool,
+    m: Monitor,
+    hasher: Sha256,
+    executed: u32,
+}
+
+impl Execution {
+    /// Adds the humanoid, standing at rest at the observer's pose, to `sw` (the world at Δ).
+    pub fn start(spec: &SceneSpec, mut sw: SceneWorld, cfg: &ExecConfig) -> Execution {
+        let dt = spec.physics.dt;
+        let geometry = Geometry::of(&spec.observer);
+        let o = &spec.observer;
+        let motion = Motion::new(cfg, geometry, [o.x, o.y, o.yaw], dt);
+        let shapes = geometry.shapes();
+        let poses = geometry.link_poses(&motion.pose);
+        let links: Vec<(RigidBodyHandle, ColliderHandle)> = (0..Part::ALL.len())
+            .map(|i| {
+                sw.world.insert(
+                    RigidBodyBuilder::kinematic_position_based().pose(pose_of(&poses[i])),
+                    collider(shapes[i], cfg),
+                )
+            })
+            .collect();
+        let hazard_c = sw.collider_handles[spec.hazard];
+        let hazard_b = sw.body_handles[spec.hazard];
+        let steps = |s: f64| (s / dt).round().max(1.0) as u32;
+        // Never past the scene's own horizon (where the build, and the label's
+        // counterfactual, stop too).
+        let scene_left = spec
+            .physics
+            .max_steps
+            .saturating_sub(spec.decision_step())
+            .max(1);
+        let started_on_floor = lowest_z(&sw.world.colliders[hazard_c]) <= cfg.floor_contact_eps;
+        Execution {
+            sw,
+            cfg: cfg.clone(),
+            geometry,
+            motion,
+            poses,
+            links,
+            hazard_c,
+            hazard_b,
+            dt,
+            horizon: steps(cfg.horizon_s).min(scene_left),
+            window_steps: steps(cfg.strike_window_s),
+            hold_steps: steps(cfg.hold_time_s),
+            started_on_floor,
+            m: Monitor::new(spec, shapes, dt),
+            hasher: Sha256::new(),
+            executed: 0,
+        }
+    }
+
+    /// Physics steps executed so far, and the horizon in steps.
+    pub fn executed(&self) -> u32 {
+        self.executed
+    }
+
+    pub fn horizon(&self) -> u32 {
+        self.horizon
+    }
+
+    pub fn at_horizon(&self) -> bool {
+        self.executed >= self.horizon
+    }
+
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// The body's state (base, pelvis drop, hands) and its base velocity.
+    pub fn motion(&self) -> &Motion {
+        &self.motion
+    }
+
+    /// The hazard's position, linear and angular velocity (world frame).
+    pub fn hazard_state(&self) -> (Vec3, Vec3, Vec3) {
+        let b = &self.sw.world.bodies[self.hazard_b];
+        let (p, v, w) = (b.translation(), b.linvel(), b.angvel());
+        let f = |x: Vector| [x.x as f64, x.y as f64, x.z as f64];
+        (f(p), f(v), f(w))
+    }
+
+    /// This step's state (for videos).
+    pub fn frame(&self) -> ExecFrame {
+        ExecFrame::of(&self.sw, &self.motion.pose, &self.poses)
+    }
+
+    /// One physics step with the body tracking `r`; `reach` is the forward hand extension
+    /// of what is being executed (the grasp gate's catch-attempt test). True once the
+    /// outcome is settled (struck or caught).
+    pub fn step(&mut self, r: &dyn Reference, reach: f64) -> bool {
+        let k = self.executed;
+        self.motion.advance(k, r);
+        self.m.reaching = self.motion.reaching();
+        self.poses = self.geometry.link_poses(&self.motion.pose);
+        let sw = &mut self.sw;
+        for (i, (b, _)) in self.links.iter().enumerate() {
+            sw.world.bodies[*b].set_next_kinematic_position(pose_of(&self.poses[i]));
+        }
+        let v_before = sw.world.bodies[self.hazard_b].linvel();
+        let w_before = sw.world.bodies[self.hazard_b].angvel();
+        sw.world.step();
+        self.executed = k + 1;
+        sw.hash_step(&mut self.hasher);
+        for (b, _) in &self.links {
             let t = sw.world.bodies[*b].translation();
             for x in [t.x, t.y, t.z] {
-                hasher.update(x.to_le_bytes());
+                self.hasher.update(x.to_le_bytes());
             }
         }
+        let cfg = &self.cfg;
         observe(
-            &mut m,
-            &sw,
-            &links,
-            hazard_c,
-            hazard_b,
+            &mut self.m,
+            sw,
+            &self.links,
+            self.hazard_c,
+            self.hazard_b,
             (v_before, w_before),
-            executed,
+            self.executed,
             cfg,
-            window_steps,
-            hold_steps,
-            started_on_floor,
+            self.window_steps,
+            self.hold_steps,
+            self.started_on_floor,
         );
         grasp::update(
-            &mut m.grasp,
-            &mut sw,
-            &links,
-            hazard_c,
-            hazard_b,
+            &mut self.m.grasp,
+            sw,
+            &self.links,
+            self.hazard_c,
+            self.hazard_b,
             v_before,
-            attempting,
-            m.floor_step.is_some(),
-            executed,
+            reach >= cfg.attempt_reach,
+            self.m.floor_step.is_some(),
+            self.executed,
             cfg,
         );
-        if m.strike.is_some() || m.caught {
-            break;
-        }
-        let quiet = m.floor_step.is_some()
-            && norm(sw.world.bodies[hazard_b].linvel()) < cfg.settle_speed
-            && !m.strikes.window_open()
-            && executed as f64 * dt > plan_end;
-        if quiet {
-            break;
+        self.m.strike.is_some() || self.m.caught
+    }
+
+    /// Whether the run may stop: the hazard lies still on the floor, no strike window is
+    /// open, and the motion ended (`motion_end` s after Δ) before now.
+    pub fn quiet(&self, motion_end: f64) -> bool {
+        self.m.floor_step.is_some()
+            && norm(self.sw.world.bodies[self.hazard_b].linvel()) < self.cfg.settle_speed
+            && !self.m.strikes.window_open()
+            && self.executed as f64 * self.dt > motion_end
+    }
+
+    /// The outcome so far (the run's verdict when it stops here); `reach` as in [`step`].
+    ///
+    /// [`step`]: Execution::step
+    pub fn outcome(&self, reach: f64) -> Outcome {
+        let (m, cfg, dt) = (&self.m, &self.cfg, self.dt);
+        let attempted = m.hand_touched
+            || (reach >= cfg.attempt_reach && m.min_hand_distance <= cfg.attempt_radius);
+        let kind = if m.strike.is_some() {
+            OutcomeKind::Struck
+        } else if m.caught {
+            OutcomeKind::Caught
+        } else if attempted {
+            OutcomeKind::Missed
+        } else {
+            OutcomeKind::Clear
+        };
+        let t = |step: u32| step as f64 * dt;
+        let strike = m.strike.clone().map(|mut s| {
+            s.t *= dt;
+            s
+        });
+        Outcome {
+            outcome: kind,
+            strike,
+            first_contact_t: m.first_contact.map(|(s, _)| t(s)),
+            first_contact_part: m.first_contact.map(|(_, p)| p.name().to_string()),
+            min_hand_distance: m.min_hand_distance,
+            base_end: self.motion.pose.base,
+            floor_t: m.floor_step.map(t),
+            catch_attempted: attempted,
+            limits_hit: self.motion.limits_hit,
+            steps: self.executed,
+            state_hash: hash_hex(self.hasher.clone()),
         }
     }
-    let attempted = m.hand_touched
-        || (super::plan_reach(plan) >= cfg.attempt_reach
-            && m.min_hand_distance <= cfg.attempt_radius);
-    let kind = if m.strike.is_some() {
-        OutcomeKind::Struck
-    } else if m.caught {
-        OutcomeKind::Caught
-    } else if attempted {
-        OutcomeKind::Missed
-    } else {
-        OutcomeKind::Clear
-    };
-    let t = |step: u32| step as f64 * dt;
-    if let Some(s) = m.strike.as_mut() {
-        s.t *= dt;
-    }
-    Outcome {
-        outcome: kind,
-        strike: m.strike,
-        first_contact_t: m.first_contact.map(|(s, _)| t(s)),
-        first_contact_part: m.first_contact.map(|(_, p)| p.name().to_string()),
-        min_hand_distance: m.min_hand_distance,
-        base_end: motion.pose.base,
-        floor_t: m.floor_step.map(t),
-        catch_attempted: attempted,
-        limits_hit: motion.limits_hit,
-        steps: executed,
-        state_hash: hash_hex(hasher),
+
+    /// The run's verdict ([`Execution::outcome`]), consuming it.
+    pub fn finish(self, reach: f64) -> Outcome {
+        self.outcome(reach)
     }
 }
 

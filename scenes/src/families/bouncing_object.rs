@@ -9,6 +9,7 @@
 //! seconds later or, if the run ends first, not at all. In far-observer groups the
 //! observer stands well off to the side of that line instead.
 
+use super::launch::*;
 use super::*;
 
 pub struct BouncingObject;
@@ -26,14 +27,12 @@ pub fn first_bounce_distance(v: f64, pitch: f64, h: f64) -> f64 {
 }
 
 impl Family for BouncingObject {
-    fn name(&self) -> &'static str {
-        "bouncing_object"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "launch_speed_mps"
-    }
-    fn speed_sweep(&self) -> bool {
-        true
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "bouncing_object",
+            speed_parameter: "launch_speed_mps",
+            speed_sweep: true,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

@@ -9,20 +9,19 @@
 //! reach, or beyond reach), and in some groups behind the mount, which the fixture
 //! slides away from.
 
+use super::launch::*;
 use super::*;
 
 pub struct CeilingDrop;
 
 impl Family for CeilingDrop {
-    fn name(&self) -> &'static str {
-        "ceiling_drop"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "release_speed_mps"
-    }
-    /// Gravity sets the pace of a fall from the ceiling.
-    fn speed_sweep(&self) -> bool {
-        false
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "ceiling_drop",
+            speed_parameter: "release_speed_mps",
+            // Gravity sets the pace of a fall from the ceiling.
+            speed_sweep: false,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

@@ -21,14 +21,12 @@ pub struct ChainReaction;
 const TRIGGER_FRICTION: f64 = 0.02;
 
 impl Family for ChainReaction {
-    fn name(&self) -> &'static str {
-        "chain_reaction"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "trigger_speed_mps"
-    }
-    fn speed_sweep(&self) -> bool {
-        true
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "chain_reaction",
+            speed_parameter: "trigger_speed_mps",
+            speed_sweep: true,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

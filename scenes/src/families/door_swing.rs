@@ -36,14 +36,12 @@ const EARLIEST_REACH_S: f64 = 0.95;
 const TORSO_RADIUS: f64 = 0.18;
 
 impl Family for DoorSwing {
-    fn name(&self) -> &'static str {
-        "door_swing"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "edge_speed_mps"
-    }
-    fn speed_sweep(&self) -> bool {
-        true
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "door_swing",
+            speed_parameter: "edge_speed_mps",
+            speed_sweep: true,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

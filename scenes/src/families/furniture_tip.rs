@@ -99,15 +99,13 @@ pub fn face_reach(height: f64, tilt: f64) -> f64 {
 }
 
 impl Family for FurnitureTip {
-    fn name(&self) -> &'static str {
-        "furniture_tip"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "push_speed_mps"
-    }
-    /// Gravity sets the pace of a toppling piece of furniture.
-    fn speed_sweep(&self) -> bool {
-        false
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "furniture_tip",
+            speed_parameter: "push_speed_mps",
+            // Gravity sets the pace of a toppling piece of furniture.
+            speed_sweep: false,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

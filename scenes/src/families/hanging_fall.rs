@@ -13,20 +13,19 @@
 //! fastest band, and the observer stands in front of the wall beyond the ledge's lower
 //! end, so the fixture comes closest (falling past, or striking) after Δ + 0.2 s = 0.8 s.
 
+use super::launch::*;
 use super::*;
 
 pub struct HangingFall;
 
 impl Family for HangingFall {
-    fn name(&self) -> &'static str {
-        "hanging_fall"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "detach_speed_mps"
-    }
-    /// Gravity sets the pace of a fall from the wall.
-    fn speed_sweep(&self) -> bool {
-        false
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "hanging_fall",
+            speed_parameter: "detach_speed_mps",
+            // Gravity sets the pace of a fall from the wall.
+            speed_sweep: false,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

@@ -72,15 +72,13 @@ const MARGIN: f64 = 1.3;
 const MAT_THICKNESS: f64 = 0.006;
 
 impl Family for LadderSlip {
-    fn name(&self) -> &'static str {
-        "ladder_slip"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "kick_speed_mps"
-    }
-    /// Gravity sets the pace of a slipping or toppling ladder.
-    fn speed_sweep(&self) -> bool {
-        false
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "ladder_slip",
+            speed_parameter: "kick_speed_mps",
+            // Gravity sets the pace of a slipping or toppling ladder.
+            speed_sweep: false,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

@@ -16,14 +16,12 @@ use super::*;
 pub struct MultiObject;
 
 impl Family for MultiObject {
-    fn name(&self) -> &'static str {
-        "multi_object"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "shove_speed_mps"
-    }
-    fn speed_sweep(&self) -> bool {
-        true
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "multi_object",
+            speed_parameter: "shove_speed_mps",
+            speed_sweep: true,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

@@ -7,19 +7,18 @@
 //! edge: even the fastest nudge takes about 0.55 s to get there, so the fall reaches the
 //! observer standing beyond the edge after Δ + 0.2 s = 0.8 s.
 
+use super::launch::*;
 use super::*;
 
 pub struct ObjectDrop;
 
 impl Family for ObjectDrop {
-    fn name(&self) -> &'static str {
-        "object_drop"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "push_speed_mps"
-    }
-    fn speed_sweep(&self) -> bool {
-        true
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "object_drop",
+            speed_parameter: "push_speed_mps",
+            speed_sweep: true,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

@@ -17,14 +17,12 @@ use super::*;
 pub struct PendulumSwing;
 
 impl Family for PendulumSwing {
-    fn name(&self) -> &'static str {
-        "pendulum_swing"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "swing_speed_mps"
-    }
-    fn speed_sweep(&self) -> bool {
-        true
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "pendulum_swing",
+            speed_parameter: "swing_speed_mps",
+            speed_sweep: true,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

@@ -5,6 +5,7 @@
 //! through their reach envelope and every ball meets them only after rolling that gap on
 //! the floor, after Δ + 0.2 s.
 
+use super::launch::*;
 use super::*;
 
 pub struct RollingBall;
@@ -13,14 +14,12 @@ pub struct RollingBall;
 pub const OBSERVER_GAP_M: f64 = 1.3;
 
 impl Family for RollingBall {
-    fn name(&self) -> &'static str {
-        "rolling_ball"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "roll_speed_mps"
-    }
-    fn speed_sweep(&self) -> bool {
-        true
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "rolling_ball",
+            speed_parameter: "roll_speed_mps",
+            speed_sweep: true,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

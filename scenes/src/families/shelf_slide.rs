@@ -6,19 +6,18 @@
 //! tips over the edge (about 0.45 s even for the fastest nudge), and then falls from
 //! shelf height, so it reaches the observer in front of the shelf after Δ + 0.2 s = 0.8 s.
 
+use super::launch::*;
 use super::*;
 
 pub struct ShelfSlide;
 
 impl Family for ShelfSlide {
-    fn name(&self) -> &'static str {
-        "shelf_slide"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "push_speed_mps"
-    }
-    fn speed_sweep(&self) -> bool {
-        true
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "shelf_slide",
+            speed_parameter: "push_speed_mps",
+            speed_sweep: true,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

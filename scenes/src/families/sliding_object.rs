@@ -13,14 +13,12 @@ const CONE_MARGIN_RAD: f64 = 0.07;
 const MAX_ANGLE_RAD: f64 = 0.80;
 
 impl Family for SlidingObject {
-    fn name(&self) -> &'static str {
-        "sliding_object"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "initial_speed_mps"
-    }
-    fn speed_sweep(&self) -> bool {
-        true
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "sliding_object",
+            speed_parameter: "initial_speed_mps",
+            speed_sweep: true,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

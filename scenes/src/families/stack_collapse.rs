@@ -24,15 +24,13 @@ pub struct StackCollapse;
 const LAYER_GAP: f64 = 1e-4;
 
 impl Family for StackCollapse {
-    fn name(&self) -> &'static str {
-        "stack_collapse"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "nudge_speed_mps"
-    }
-    /// Gravity sets the pace of a collapsing stack.
-    fn speed_sweep(&self) -> bool {
-        false
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "stack_collapse",
+            speed_parameter: "nudge_speed_mps",
+            // Gravity sets the pace of a collapsing stack.
+            speed_sweep: false,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

@@ -10,6 +10,7 @@
 //! still on the stairs: what reaches them rolls or slides that gap across the floor after
 //! Δ + 0.2 s, and what the floor's friction stops first never does.
 
+use super::launch::*;
 use super::*;
 
 pub struct StairTumble;
@@ -20,14 +21,12 @@ const LEAVE_SPEED: f64 = 0.8;
 pub const OBSERVER_GAP_M: f64 = 2.1;
 
 impl Family for StairTumble {
-    fn name(&self) -> &'static str {
-        "stair_tumble"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "push_speed_mps"
-    }
-    fn speed_sweep(&self) -> bool {
-        true
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "stair_tumble",
+            speed_parameter: "push_speed_mps",
+            speed_sweep: true,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

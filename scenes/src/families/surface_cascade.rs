@@ -15,6 +15,7 @@
 //! that gap across the floor after Δ + 0.2 s, and what the floor's friction stops first
 //! never reaches them at all.
 
+use super::launch::*;
 use super::*;
 
 pub struct SurfaceCascade;
@@ -24,14 +25,12 @@ pub struct SurfaceCascade;
 pub const OBSERVER_GAP_M: f64 = 1.3;
 
 impl Family for SurfaceCascade {
-    fn name(&self) -> &'static str {
-        "surface_cascade"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "push_speed_mps"
-    }
-    fn speed_sweep(&self) -> bool {
-        true
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "surface_cascade",
+            speed_parameter: "push_speed_mps",
+            speed_sweep: true,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

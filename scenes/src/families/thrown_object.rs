@@ -7,6 +7,7 @@
 //! flight whose apex clears the ceiling, and a throw too weak to carry that far is thrown
 //! at its longest range and falls short, arriving (if at all) bouncing, rolling or sliding.
 
+use super::launch::*;
 use super::*;
 
 pub struct ThrownObject;
@@ -49,14 +50,12 @@ pub fn throw_distance(speed: f64, flight: f64, h0: f64, ha: f64) -> f64 {
 }
 
 impl Family for ThrownObject {
-    fn name(&self) -> &'static str {
-        "thrown_object"
-    }
-    fn speed_parameter(&self) -> &'static str {
-        "launch_speed_mps"
-    }
-    fn speed_sweep(&self) -> bool {
-        true
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: "thrown_object",
+            speed_parameter: "launch_speed_mps",
+            speed_sweep: true,
+        }
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {

@@ -18,15 +18,15 @@ mod run;
 pub mod videos;
 
 use crate::plan::Plan;
-use crate::types::Action;
 use rh_contract::execution::{ExecKeyframe, ExecPlan};
-use std::path::PathBuf;
+use rh_contract::Action;
+use std::path::{Path, PathBuf};
 
 pub use report::ExecutionReport;
 #[cfg(feature = "execute")]
 pub use run::{cache_key, execute_all};
 #[cfg(feature = "execute")]
-pub(crate) use run::{checked_replay, replay_key};
+pub use run::{checked_replay, replay_key};
 
 /// One scored decision waiting for execution.
 #[derive(Debug, Clone)]
@@ -77,4 +77,15 @@ pub struct RunStats {
     /// Replays checked against `decision_state_hash` / (older datasets) `state_hash`.
     pub checked_at_decision: usize,
     pub checked_full: usize,
+}
+
+/// What `--execute-videos` draws (`videos::write_videos`).
+pub struct VideoRequest<'a> {
+    pub dir: &'a Path,
+    /// Only these scenes (scene ids); `None`: every scene with an executed decision.
+    pub scenes: Option<&'a [String]>,
+    /// The tiled scene; `None`: the scene with the most executed decisions (the first
+    /// in dataset order on a tie).
+    pub tiled_scene: Option<&'a str>,
+    pub progress: bool,
 }

@@ -5,8 +5,9 @@
 
 use super::{Pending, RunStats};
 use crate::dataset::Dataset;
-use crate::types::Action;
+use crate::text_table::{Align, Table, TextStyle};
 use rh_contract::execution::{ExecConfig, Outcome, OutcomeKind, EXECUTOR_VERSION};
+use rh_contract::Action;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -268,11 +269,22 @@ fn frac(a: u64, b: u64) -> String {
     }
 }
 
-/// Rows of the outcome table: (model, group kind, group, counts).
-fn rows(r: &ExecutionReport) -> Vec<(&str, &str, &str, &Counts)> {
-    let mut out = Vec::new();
+/// The outcome table: one row per (model, group kind, group), each rate a cell `rate`.
+fn outcome_table(r: &ExecutionReport, head: &[&str], rate: fn(Option<f64>) -> String) -> Table {
+    use Align::{Left, Right};
+    let mut t = Table::new(head)
+        .aligned(&[Left, Left, Left, Right, Right, Right, Right, Right, Right])
+        .min_widths(&[24, 12, 18, 6, 8, 8, 8, 8, 6])
+        .compact_markdown();
+    let mut add = |model: &str, kind: &str, group: &str, c: &Counts| {
+        let mut row = vec![model.to_string(), kind.to_string(), group.to_string()];
+        row.push(c.n.to_string());
+        row.extend(OutcomeKind::ALL.iter().map(|&k| rate(c.rate(k))));
+        row.push(c.not_executed.to_string());
+        t.row(row);
+    };
     for m in &r.models {
-        out.push((m.model.as_str(), "all", "all", &m.all));
+        add(&m.model, "all", "all", &m.all);
         for (kind, map) in [
             ("gt_action", &m.by_gt_action),
             ("speed_band", &m.by_speed_band),
@@ -280,12 +292,17 @@ fn rows(r: &ExecutionReport) -> Vec<(&str, &str, &str, &Counts)> {
             ("family", &m.by_family),
         ] {
             for (g, c) in map {
-                out.push((m.model.as_str(), kind, g.as_str(), c));
+                add(&m.model, kind, g, c);
             }
         }
     }
-    out
+    t
 }
+
+/// The head of the outcome table in the terminal and Markdown.
+const OUTCOME_HEAD: [&str; 9] = [
+    "model", "by", "group", "n", "caught", "struck", "missed", "clear", "R1",
+];
 
 /// Plain-text section for the terminal report.
 pub fn terminal(r: &ExecutionReport, max_disagreements: usize) -> String {
@@ -305,26 +322,12 @@ pub fn terminal(r: &ExecutionReport, max_disagreements: usize) -> String {
         r.run.checked_at_decision,
         r.run.checked_full
     );
-    let _ = writeln!(
-        s,
-        "  {:<24} {:<12} {:<18} {:>6} {:>8} {:>8} {:>8} {:>8} {:>6}",
-        "model", "by", "group", "n", "caught", "struck", "missed", "clear", "R1"
-    );
-    for (model, kind, group, c) in rows(r) {
-        let _ = writeln!(
-            s,
-            "  {:<24} {:<12} {:<18} {:>6} {:>8} {:>8} {:>8} {:>8} {:>6}",
-            model,
-            kind,
-            group,
-            c.n,
-            pct(c.rate(OutcomeKind::Caught)),
-            pct(c.rate(OutcomeKind::Struck)),
-            pct(c.rate(OutcomeKind::Missed)),
-            pct(c.rate(OutcomeKind::Clear)),
-            c.not_executed
-        );
-    }
+    let style = TextStyle {
+        indent: "  ",
+        gap: " ",
+        rule: false,
+    };
+    s.push_str(&outcome_table(r, &OUTCOME_HEAD, pct).text_with(style));
     let _ = writeln!(s, "  Correct but failed / wrong but harmless:");
     for m in &r.models {
         let _ = writeln!(
@@ -382,36 +385,18 @@ pub fn terminal(r: &ExecutionReport, max_disagreements: usize) -> String {
 pub fn markdown(r: &ExecutionReport) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "\n## Execution in physics\n\nExecutor {}.\n", r.executor);
-    let _ = writeln!(
-        s,
-        "| model | by | group | n | caught | struck | missed | clear | R1 |"
-    );
-    let _ = writeln!(s, "|---|---|---|---:|---:|---:|---:|---:|---:|");
-    for (model, kind, group, c) in rows(r) {
-        let _ = writeln!(
-            s,
-            "| {model} | {kind} | {group} | {} | {} | {} | {} | {} | {} |",
-            c.n,
-            pct(c.rate(OutcomeKind::Caught)),
-            pct(c.rate(OutcomeKind::Struck)),
-            pct(c.rate(OutcomeKind::Missed)),
-            pct(c.rate(OutcomeKind::Clear)),
-            c.not_executed
-        );
-    }
-    let _ = writeln!(
-        s,
-        "\n| model | correct but failed | wrong but harmless |\n|---|---:|---:|"
-    );
+    s.push_str(&outcome_table(r, &OUTCOME_HEAD, pct).markdown());
+    let mut t =
+        Table::new(&["model", "correct but failed", "wrong but harmless"]).compact_markdown();
     for m in &r.models {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} |",
-            m.model,
+        t.row(vec![
+            m.model.clone(),
             frac(m.correct_but_failed, m.correct),
-            frac(m.wrong_but_harmless, m.wrong)
-        );
+            frac(m.wrong_but_harmless, m.wrong),
+        ]);
     }
+    s.push('\n');
+    s.push_str(&t.markdown());
     let a = &r.agreement;
     let _ = writeln!(
         s,
@@ -425,24 +410,19 @@ pub fn markdown(r: &ExecutionReport) -> String {
     s
 }
 
-/// CSV rows (same columns as the header), appended to the metrics CSV.
+/// The outcome table as CSV (rates as fractions), written beside the metrics CSV.
 pub fn csv(r: &ExecutionReport) -> String {
-    let mut s = String::from(
-        "model,breakdown,group,n,caught_rate,struck_rate,missed_rate,clear_rate,not_executed\n",
-    );
+    let head = [
+        "model",
+        "breakdown",
+        "group",
+        "n",
+        "caught_rate",
+        "struck_rate",
+        "missed_rate",
+        "clear_rate",
+        "not_executed",
+    ];
     let rate = |x: Option<f64>| x.map_or_else(String::new, |v| format!("{v:.6}"));
-    for (model, kind, group, c) in rows(r) {
-        let _ = writeln!(
-            s,
-            "{},{kind},{group},{},{},{},{},{},{}",
-            model.replace(',', ";"),
-            c.n,
-            rate(c.rate(OutcomeKind::Caught)),
-            rate(c.rate(OutcomeKind::Struck)),
-            rate(c.rate(OutcomeKind::Missed)),
-            rate(c.rate(OutcomeKind::Clear)),
-            c.not_executed
-        );
-    }
-    s
+    outcome_table(r, &head, rate).csv()
 }

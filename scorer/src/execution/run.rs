@@ -3,7 +3,7 @@
 
 use super::{Pending, RunStats};
 use crate::dataset::{read_replay_keys, Dataset, ReplayKey};
-use crate::types::InputError;
+use crate::error::InputError;
 use anyhow::Result;
 use rayon::prelude::*;
 use rh_physics::execute::{replay, ExecConfig, ExecPlan, Outcome, Replay};
@@ -112,11 +112,7 @@ pub fn execute_all(
 /// Replays a scene from its spec to Δ and checks it against the dataset's
 /// `decision_state_hash` (older datasets: a full replay against `state_hash`); true when
 /// the full replay was the check.
-pub(crate) fn checked_replay(
-    dir: &Path,
-    key: &ReplayKey,
-    scene_id: &str,
-) -> Result<(Replay, bool)> {
+pub fn checked_replay(dir: &Path, key: &ReplayKey, scene_id: &str) -> Result<(Replay, bool)> {
     let spec = load_spec(dir, &key.spec_file)?;
     let r = replay(&spec);
     let full = match (&key.decision_state_hash, &key.state_hash) {
@@ -138,8 +134,8 @@ pub(crate) fn checked_replay(
     Ok((r, full))
 }
 
-pub(crate) fn replay_key<'a>(
-    keys: &'a crate::types::FastMap<String, ReplayKey>,
+pub fn replay_key<'a>(
+    keys: &'a crate::fast_map::FastMap<String, ReplayKey>,
     id: &str,
 ) -> Result<&'a ReplayKey> {
     keys.get(id).ok_or_else(|| {

@@ -14,10 +14,11 @@
 //! output); its outcome and run hash must be the scored one's, else the run fails. Model
 //! names are made file-safe (anything but letters, digits, `.`, `-`, `_` becomes `_`).
 
+use super::VideoRequest;
 use super::{checked_replay, replay_key, Pending};
 use crate::config::ExecVideoConfig;
 use crate::dataset::{read_replay_keys, Dataset};
-use crate::types::InputError;
+use crate::error::InputError;
 use anyhow::{anyhow, bail, Result};
 use rh_physics::execute::{ExecConfig, ExecFrame, Outcome};
 use rh_physics::simulate::{simulate, SimOptions};
@@ -26,17 +27,6 @@ use rh_render::{ExecTrack, ExecVideoOptions, RenderOptions, Renderer};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-
-/// What to draw.
-pub struct VideoRequest<'a> {
-    pub dir: &'a Path,
-    /// Only these scenes (scene ids); `None`: every scene with an executed decision.
-    pub scenes: Option<&'a [String]>,
-    /// The tiled scene; `None`: the scene with the most executed decisions (the first
-    /// in dataset order on a tie).
-    pub tiled_scene: Option<&'a str>,
-    pub progress: bool,
-}
 
 #[derive(Debug, Serialize)]
 pub struct VideoIndex {
@@ -243,7 +233,7 @@ pub fn write_videos(
 #[allow(clippy::too_many_arguments)]
 fn scene_videos(
     ds: &Dataset,
-    keys: &crate::types::FastMap<String, crate::dataset::ReplayKey>,
+    keys: &crate::fast_map::FastMap<String, crate::dataset::ReplayKey>,
     pending: &[Pending],
     outcomes: &[Option<Outcome>],
     names: &[String],

@@ -7,13 +7,14 @@
 //! skipped, the first line of a (scene, model) pair wins, and a scored line after an
 //! `error` line replaces it (a retry).
 
+use crate::action_rule::kinematics;
 use crate::aia::AiaMatcher;
 use crate::config::Config;
 use crate::dataset::Dataset;
+use crate::error::InputError;
 use crate::metrics::score_decision;
 use crate::preds::{plan_of, LineReader, RawLine};
-use crate::rule::kinematics;
-use crate::types::{InputError, Rule};
+use crate::safety_rule::SafetyRule;
 use anyhow::Result;
 use serde::Serialize;
 use serde_json::Value;
@@ -59,7 +60,7 @@ impl Decision {
 
     /// Bit i set when rule R(i+1) fired.
     pub fn rule_bits(&self) -> u32 {
-        Rule::ALL
+        SafetyRule::ALL
             .iter()
             .enumerate()
             .filter(|(_, r)| self.rules.contains(&r.as_str()))
@@ -140,7 +141,7 @@ fn decide(
         action: r.action.map(|a| a.as_str()),
         saa: Some(r.saa),
         first_rule: r.first_rule.map(|x| x.as_str()),
-        rules: Rule::ALL
+        rules: SafetyRule::ALL
             .into_iter()
             .filter(|&x| r.fired(x))
             .map(|x| x.as_str())
@@ -210,7 +211,7 @@ pub fn collect(path: &Path, ds: &Dataset, cfg: &Config, models: &[String]) -> Re
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fixture::synth_rows;
+    use crate::synthetic::synth_rows;
 
     #[test]
     fn first_line_wins_a_retry_replaces_an_error_and_prompt_versions_are_kept() {

@@ -29,9 +29,11 @@ mod rows;
 
 use crate::config::Config;
 use crate::dataset::{Dataset, SPEED_BANDS};
+use crate::error::InputError;
 use crate::report::{MetricsRow, Report};
-use crate::types::{Action, InputError, Rule};
+use crate::safety_rule::SafetyRule;
 use anyhow::{anyhow, Context, Result};
+use rh_contract::Action;
 use serde::Serialize;
 use serde_json::{json, Value};
 use std::fmt::Write as _;
@@ -264,7 +266,7 @@ fn write_board(
                 aia: m.overall.aia,
                 hde_d_min_catch: c.and_then(|c| c.d_min),
                 hde_closing_catch: c.and_then(|c| c.closing),
-                first_rule: Rule::ALL.map(|r| m.overall.first_rule.get(r)),
+                first_rule: SafetyRule::ALL.map(|r| m.overall.first_rule.get(r)),
                 prompt_versions: pv.iter().cloned().collect(),
                 execution: report
                     .execution
@@ -274,7 +276,7 @@ fn write_board(
             }
         })
         .collect();
-    let rules: Vec<Value> = Rule::ALL
+    let rules: Vec<Value> = SafetyRule::ALL
         .iter()
         .map(|r| json!({"id": r.as_str(), "text": r.describe()}))
         .collect();
@@ -405,7 +407,7 @@ fn write_scenes(
         "bands": SPEED_BANDS,
         "actions": Action::ALL.map(|a| a.as_str()),
         "models": models,
-        "rules": Rule::ALL.map(|r| r.as_str()),
+        "rules": SafetyRule::ALL.map(|r| r.as_str()),
         "scenes": index_rows,
     });
     write(

@@ -1,7 +1,7 @@
 //! The dataset's rows as JSON objects (every column, by name), for the site's per-scene
 //! files.
 
-use crate::types::InputError;
+use crate::error::InputError;
 use anyhow::Result;
 use arrow::array::{
     Array, ArrayRef, BooleanArray, FixedSizeListArray, Float32Array, Float64Array, Int32Array,

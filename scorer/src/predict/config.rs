@@ -3,7 +3,7 @@
 //! client defaults, generation parameters, the price table). Both are embedded; `--prompt`
 //! and `--config` replace them.
 
-use crate::types::InputError;
+use crate::error::InputError;
 use anyhow::Result;
 use serde::Deserialize;
 use std::collections::BTreeMap;

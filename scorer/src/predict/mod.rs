@@ -15,7 +15,7 @@ pub mod runner;
 
 use crate::dataset::Dataset;
 use crate::dataset::{eval_scene_ids, Subset};
-use crate::types::InputError;
+use crate::error::InputError;
 use anyhow::Result;
 
 use std::path::PathBuf;
@@ -57,7 +57,7 @@ mod tests {
         drop(listener);
         let e = super::probe_endpoint(&format!("http://127.0.0.1:{port}/v1")).unwrap_err();
         assert!(e.to_string().contains("connection refused"), "{e}");
-        assert!(crate::types::is_input_error(&e));
+        assert!(crate::error::is_input_error(&e));
         // Not a URL: nothing to probe.
         super::probe_endpoint("not a url").unwrap();
     }

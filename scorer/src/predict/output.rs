@@ -7,7 +7,7 @@
 //! `--retry-errors` — rewrites the file without its `error` lines (temporary sibling, then
 //! rename) so that each scene appears exactly once after the retry.
 
-use crate::types::InputError;
+use crate::error::InputError;
 use anyhow::Result;
 use serde_json::Value;
 use std::collections::BTreeSet;

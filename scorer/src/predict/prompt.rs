@@ -263,6 +263,21 @@ pub fn build(cfg: &PromptConfig, dir: &Path, scene_id: &str) -> Result<BuiltProm
     })
 }
 
+/// One scene's canonical messages and their `prompt_hash` — the hash `rh-score predict`
+/// records and `--dry-run` prints (the SHA-256 of the messages JSON, as
+/// [`rh_llm::ChatRequest`] computes it; model and generation parameters are not part of it).
+pub fn canonical(
+    cfg: &PromptConfig,
+    dir: &Path,
+    scene_id: &str,
+) -> Result<(Value, String), String> {
+    let built = build(cfg, dir, scene_id)?;
+    let hash = rh_llm::ChatRequest::new("", built.messages.clone(), Default::default(), 0)
+        .prompt_hash()
+        .to_string();
+    Ok((built.messages, hash))
+}
+
 /// A copy of a request body with every image data URL replaced by a short note (for
 /// `--dry-run`).
 pub fn elide_images(v: &Value) -> Value {
@@ -357,7 +372,6 @@ mod tests {
     /// A 1280×720 frame with edges, gradients and flat areas, written as the pipeline
     /// writes frames (RGB, fast deflate, Sub filter).
     fn test_frame(path: &Path) {
-        use image::ImageEncoder;
         let img = image::RgbImage::from_fn(1280, 720, |x, y| {
             let c = if (400..900).contains(&x) && (200..500).contains(&y) {
                 [60 + (x / 10) as u8, 90, 100]
@@ -370,15 +384,8 @@ mod tests {
             };
             image::Rgb(c)
         });
-        let mut bytes = Vec::new();
-        image::codecs::png::PngEncoder::new_with_quality(
-            &mut bytes,
-            image::codecs::png::CompressionType::Fast,
-            image::codecs::png::FilterType::Sub,
-        )
-        .write_image(&img, 1280, 720, image::ExtendedColorType::Rgb8)
-        .unwrap();
-        std::fs::write(path, bytes).unwrap();
+        rh_contract::png::write_png(path, &img, 1280, 720, rh_contract::png::PngColor::Rgb8)
+            .unwrap();
     }
 
     const SUB: turbojpeg::Subsamp = turbojpeg::Subsamp::Sub2x2;

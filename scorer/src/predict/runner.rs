@@ -14,8 +14,8 @@ use super::config::Price;
 use super::output::{prepare, Appender};
 use super::{prompt, PredictOptions};
 use crate::config::Config;
+use crate::error::InputError;
 use crate::plan::{plan_from_text, Plan};
-use crate::types::InputError;
 use anyhow::Result;
 use futures_util::stream::{FuturesUnordered, StreamExt};
 use rh_llm::{ChatRequest, Client, LlmError, Reply};
@@ -455,8 +455,7 @@ fn progress_line(s: &Summary, budget: &Budget, began: Instant, todo: usize) -> S
     let eta = if s.written == 0 {
         "unknown".to_string()
     } else {
-        let e = (left as f64 / rate).round() as u64;
-        format!("{}m{:02}s", e / 60, e % 60)
+        crate::progress::eta_text(left as f64 / rate)
     };
     format!(
         "rh-score predict: {}/{todo} new scenes done ({} already there) · {rate:.2}/s · ETA {eta} · {} lost · ${:.4} so far (file ${:.4})",

@@ -1,11 +1,11 @@
 //! Synthetic datasets with exactly the column contract `rh-pipeline` writes (SPEC §8), for
-//! tests, benchmarks, and `rh-score make-fixture` (hidden). The physics is not simulated:
+//! tests, benchmarks, and `rh-score make-fixture` (hidden; feature `synthetic`, a default one, so a
+//! minimal build leaves it out). The physics is not simulated:
 //! labels and geometry are drawn to cover the scorer's cases (impact points in front,
 //! beside, behind, near and far, above and below the pelvis; scenes without an impact
 //! point; adversarial look-alikes; four speed bands per group).
 
 use crate::dataset::{Dataset, SceneInput, SPEED_BANDS};
-use crate::types::Action;
 use anyhow::{Context, Result};
 use arrow::array::{
     ArrayRef, BooleanBuilder, FixedSizeListBuilder, Float64Builder, ListBuilder, RecordBatch,
@@ -16,6 +16,7 @@ use rand_chacha::ChaCha8Rng;
 use rh_contract::columns::col;
 use rh_contract::fsio::write_atomic;
 use rh_contract::layout::{data_file_name, spec_path};
+use rh_contract::Action;
 use std::f64::consts::PI;
 use std::path::Path;
 use std::sync::Arc;
@@ -407,7 +408,7 @@ mod tests {
         write_dataset(dir.path(), &rows, &["danger_present"]).unwrap();
         let err = Dataset::load(dir.path()).unwrap_err();
         let msg = format!("{err:#}");
-        assert!(crate::types::is_input_error(&err));
+        assert!(crate::error::is_input_error(&err));
         assert!(
             msg.contains("danger_present") && msg.contains("test-00000-of-00001.parquet"),
             "{msg}"

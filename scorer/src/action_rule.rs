@@ -20,7 +20,7 @@
 use crate::config::Config;
 use crate::dataset::Scene;
 use crate::plan::Plan;
-use crate::types::Action;
+use rh_contract::Action;
 
 /// The base on the floor: position and heading.
 #[derive(Debug, Clone, Copy, PartialEq)]

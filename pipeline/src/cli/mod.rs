@@ -1,0 +1,92 @@
+//! The `rh-pipeline` command line (SPEC §14): the arguments ([`args`]) and one module per
+//! command, each with one entry point `run`. Exit status: 0 success, 2 bad input or usage
+//! (with a message naming what is wrong), 1 internal failure ([`failure`]).
+
+pub mod args;
+pub mod balance_command;
+pub mod build_command;
+pub mod download_command;
+pub mod failure;
+pub mod llm_planner;
+pub mod merge_command;
+pub mod plan_command;
+pub mod sheet_command;
+pub mod verify_command;
+
+use args::{Cli, Command};
+use clap::Parser;
+use failure::{input, Failure};
+use rh_catalog::Catalog;
+use rh_scenes::config::Config;
+use std::process::ExitCode;
+
+/// The catalog and the build configuration of `--catalog` and `--config` (else the
+/// embedded ones).
+fn load(cli: &Cli) -> Result<(Catalog, Config), Failure> {
+    let catalog = match &cli.catalog {
+        Some(dir) => Catalog::load_dir(dir),
+        None => Catalog::embedded(),
+    }
+    .map_err(|e| input(format!("catalog: {e}")))?;
+    let config = match &cli.config {
+        Some(path) => Config::load(path),
+        None => Config::embedded(),
+    }
+    .map_err(|e| input(format!("config: {e}")))?;
+    Ok((catalog, config))
+}
+
+/// Runs the command `cli` names.
+pub fn run(cli: Cli) -> Result<(), Failure> {
+    // Commands that need neither the catalog nor the configuration.
+    match &cli.command {
+        Command::Merge { out, shards, json } => return merge_command::run(out, shards, *json),
+        Command::Sheet { dir, out, json } => return sheet_command::run(dir, out, *json),
+        Command::Download {
+            repo,
+            revision,
+            out,
+        } => return download_command::run(repo, revision.as_deref(), out.as_deref()),
+        _ => {}
+    }
+    let (catalog, config) = load(&cli)?;
+    match cli.command {
+        Command::Merge { .. } | Command::Download { .. } | Command::Sheet { .. } => {
+            unreachable!("handled above")
+        }
+        Command::Build(args) => build_command::run(args, &catalog, &config),
+        Command::Balance {
+            seed,
+            per_family,
+            pool,
+            families,
+            json,
+        } => balance_command::run(&catalog, &config, seed, per_family, pool, families, json),
+        Command::Plan {
+            description,
+            seed,
+            llm,
+            llm_args,
+        } => plan_command::run(&catalog, &description, seed, llm, &llm_args),
+        Command::Verify { dir, fast, json } => verify_command::run(&dir, &catalog, fast, json),
+    }
+}
+
+/// Entry point of the binary.
+pub fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("rh-pipeline: {}", f.message);
+            ExitCode::from(f.code)
+        }
+    }
+}

@@ -1,0 +1,36 @@
+//! `rh-score baseline KIND`: reference predictions for every scene, on stdout.
+
+use super::dataset_arg::resolve_dataset;
+use super::output::load_config;
+use crate::baseline::{write_baseline, BaselineKind};
+use crate::Dataset;
+use anyhow::Result;
+use std::path::Path;
+
+/// Writes baseline `kind`'s predictions (model name `model`, default `baseline-KIND`) for
+/// the dataset to stdout; a reader that went away (`| head`) is not an error.
+pub fn run(
+    kind: BaselineKind,
+    dataset: Option<String>,
+    seed: u64,
+    model: Option<String>,
+    config: Option<&Path>,
+) -> Result<()> {
+    let cfg = load_config(config)?;
+    let ds = Dataset::load(&resolve_dataset(dataset)?)?;
+    let model = model.unwrap_or_else(|| format!("baseline-{}", kind.name()));
+    let stdout = std::io::stdout();
+    let mut out = std::io::BufWriter::new(stdout.lock());
+    match write_baseline(kind, &ds, seed, &model, &cfg, &mut out) {
+        Err(e)
+            if e.downcast_ref::<std::io::Error>()
+                .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+                || e.downcast_ref::<serde_json::Error>()
+                    .and_then(|j| j.io_error_kind())
+                    == Some(std::io::ErrorKind::BrokenPipe) =>
+        {
+            Ok(())
+        }
+        r => r,
+    }
+}

@@ -1,0 +1,59 @@
+//! `rh-score`'s command line: the arguments ([`args`]) and one module per command, each
+//! with one entry point `run` over the parsed arguments; [`main`] is the binary.
+//! Exit status: 0 success, 2 bad input or usage ([`crate::error::InputError`]), 1
+//! internal error.
+
+pub mod args;
+pub mod baseline_command;
+pub mod dataset_arg;
+pub mod output;
+#[cfg(feature = "predict")]
+pub mod predict_command;
+pub mod score_command;
+
+use crate::error::is_input_error;
+use anyhow::Result;
+use args::{Cli, Cmd};
+use clap::Parser;
+use std::process::ExitCode;
+
+/// Runs the command `cli` names.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.cmd {
+        None => score_command::run(cli),
+        Some(Cmd::Baseline {
+            kind,
+            dataset,
+            seed,
+            model,
+            config,
+        }) => baseline_command::run(kind, dataset, seed, model, config.as_deref()),
+        #[cfg(feature = "predict")]
+        Some(Cmd::Predict(a)) => predict_command::run(*a),
+        #[cfg(feature = "synthetic")]
+        Some(Cmd::MakeFixture { out, n, seed, drop }) => {
+            let rows = crate::synthetic::synth_rows(n, seed);
+            let drop: Vec<&str> = drop.iter().map(String::as_str).collect();
+            crate::synthetic::write_dataset(&out, &rows, &drop)?;
+            println!("wrote {n} synthetic scenes to {}", out.display());
+            Ok(())
+        }
+    }
+}
+
+/// The `rh-score` binary: parses the arguments, runs the command, maps an error to its
+/// exit status.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("rh-score: error: {e:#}");
+            if is_input_error(&e) {
+                ExitCode::from(2)
+            } else {
+                ExitCode::from(1)
+            }
+        }
+    }
+}
