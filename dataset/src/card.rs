@@ -125,7 +125,8 @@ fn eval_rule_text(cfg: &EvalConfig) -> String {
         Some(share) => format!(
             "evaluation subset, stratified by label (label rule v5): up to {} valid scenes per \
              family, {:.0}% of them CATCH where the family has them, at most {} NO_ACTION, the \
-             rest DODGE; a family short of one kind gives more of the others",
+             rest DODGE; a family short of CATCH gives more DODGE and the other way round, but \
+             never more NO_ACTION (it stays short)",
             cfg.per_family,
             100.0 * share,
             cfg.no_action_per_family

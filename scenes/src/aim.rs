@@ -11,6 +11,7 @@
 //! stands beside the path instead, beyond the reach envelope. Everything else of the
 //! family's layout is unchanged; the pose depends only on the paths and the draws.
 
+use crate::intent::Intent;
 use crate::label::{approach, interception, ImpactKind};
 use rand::RngExt;
 use rh_physics::obstacles::Obstacles;
@@ -74,51 +75,6 @@ pub struct Aim {
     pub intent: Intent,
 }
 
-/// Where a group's event is aimed (recorded as `aim_intent`: 0 hands, 1 body, 2 miss).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Intent {
-    /// A benign hazard that fits in the arms: its path passes in front of the chest at a
-    /// height the hands can hold, after they can get there (a CATCH if it is not too fast).
-    Hands,
-    /// A dangerous hazard, or one too large to hold: its path runs into the body (a DODGE
-    /// when the touch would harm).
-    Body,
-    /// A deliberate near miss (`build.far_observer_share`): beside the path, out of reach.
-    Miss,
-}
-
-impl Intent {
-    pub fn code(self) -> f64 {
-        match self {
-            Intent::Hands => 0.0,
-            Intent::Body => 1.0,
-            Intent::Miss => 2.0,
-        }
-    }
-
-    /// The group's intent from its first band's spec: the near-miss draw, else the
-    /// hazard's own properties (what the label rule calls dangerous before any impact,
-    /// and `fits_in_arms`).
-    pub fn of(spec: &SceneSpec) -> Intent {
-        let near_miss = spec
-            .family_params
-            .get("far_observer")
-            .is_some_and(|&v| v == 1.0);
-        let has = |f: &str| spec.hazard_flags.iter().any(|x| x == f);
-        let dangerous = has("sharp")
-            || has("hot")
-            || (has("fragile") && has("large"))
-            || spec.hazard_body().mass >= spec.labels.heavy_mass_kg;
-        if near_miss {
-            Intent::Miss
-        } else if dangerous || !crate::label::fits_in_arms(spec) {
-            Intent::Body
-        } else {
-            Intent::Hands
-        }
-    }
-}
-
 /// The hazard speed below which a path point is not a meeting candidate (m/s).
 const MOVING: f64 = 0.1;
 
@@ -130,7 +86,11 @@ pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Optio
         return None;
     }
     let first = &runs[0].0;
-    let intent = Intent::of(first);
+    // Families that aim their own event (a throw) keep their pose.
+    if crate::families::get(&first.family).is_some_and(|f| f.self_aimed()) {
+        return None;
+    }
+    let intent = Intent::of(first)?;
     let near_miss = intent == Intent::Miss;
     let mut rng = rh_physics::seeds::stream(first.seed, first.attempt, "aim");
     // Always the same draws, whatever the paths.
@@ -213,7 +173,6 @@ pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Optio
         p.insert("aim_candidate".into(), aim.candidate as f64);
         p.insert("aim_meet_height".into(), aim.meet_height);
         p.insert("aim_bands_met".into(), aim.bands_met as f64);
-        p.insert("aim_intent".into(), aim.intent.code());
     }
     Some(aim)
 }

@@ -4,8 +4,9 @@
 //! Label rule v5 keeps the paper's label shape in the subset by stratifying it: per
 //! family, `[eval]` of `configs/default.toml` asks for `catch_share` of the family's
 //! scenes as CATCH and at most `no_action_per_family` NO_ACTION scenes, the rest DODGE;
-//! a family short of one kind gives more of the others (CATCH, then DODGE, then
-//! NO_ACTION). Within a kind, scenes are taken in scene-index order, so the subset is a
+//! a family short of CATCH gives more DODGE and the other way round, but never more
+//! NO_ACTION than that: a family without enough real decisions (CATCH or DODGE) stays
+//! short of `per_family`, and the card names it. Within a kind, scenes are taken in scene-index order, so the subset is a
 //! pure function of the build's rows. The labels themselves are untouched: the subset
 //! only chooses among them, and the card prints the whole build's shares beside the
 //! subset's. Builds before v5 (no `catch_share`) take whole speed-band groups first,
@@ -74,8 +75,8 @@ pub fn select(rows: &[EvalRow], cfg: &EvalConfig) -> (Vec<usize>, BTreeMap<Strin
 }
 
 /// Per kind, the first scenes in index order: CATCH up to its target, NO_ACTION up to
-/// its cap, DODGE for the rest; then whatever is left of CATCH, DODGE and NO_ACTION, in
-/// that order, until `per_family`.
+/// its cap, DODGE for the rest; then whatever is left of CATCH and DODGE, in that
+/// order, until `per_family`.
 fn stratified(rows: &[EvalRow], members: &[usize], cfg: &EvalConfig, share: f64) -> Vec<usize> {
     let n = cfg.per_family;
     let of = |action: &str| -> Vec<usize> {
@@ -95,7 +96,7 @@ fn stratified(rows: &[EvalRow], members: &[usize], cfg: &EvalConfig, share: f64)
         .chain(&none[..na])
         .copied()
         .collect();
-    for (kind, from) in [(&catch, c), (&dodge, d), (&none, na)] {
+    for (kind, from) in [(&catch, c), (&dodge, d)] {
         for &r in &kind[from..] {
             if taken.len() >= n {
                 break;
@@ -151,6 +152,7 @@ mod tests {
             no_action_per_family: 1,
         };
         // Family a: 3 CATCH, 12 DODGE, 4 NO_ACTION: CATCH short, DODGE fills.
+        // Family c: 1 CATCH, 1 DODGE, 5 NO_ACTION: short, one NO_ACTION only.
         let mut rows = Vec::new();
         for i in 0..19u64 {
             let a = match i {
@@ -165,9 +167,13 @@ mod tests {
             rows.push(row("b", i, if i % 2 == 0 { "CATCH" } else { "DODGE" }));
         }
         rows[19].valid = false;
+        for i in 200..207u64 {
+            rows.push(row("c", i, ["CATCH", "DODGE", "NO_ACTION"][(i as usize).saturating_sub(200).min(2)]));
+        }
         let (chosen, counts) = select(&rows, &cfg);
         assert_eq!(counts["a"], 10);
         assert_eq!(counts["b"], 10);
+        assert_eq!(counts["c"], 3, "CATCH, DODGE and one NO_ACTION");
         let kinds = |f: &str, k: &str| {
             chosen
                 .iter()

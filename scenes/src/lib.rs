@@ -17,6 +17,7 @@ pub mod config;
 pub mod driver;
 pub mod eval_subset;
 pub mod families;
+pub mod intent;
 pub mod label;
 pub mod randomize;
 pub mod selection;

@@ -6,6 +6,7 @@
 //! (see `cameras`), from their own stream.
 
 use crate::config::Config;
+use crate::intent::Intent;
 use crate::families::{self, FamilyInput};
 use rand::RngExt;
 use rh_catalog::Catalog;
@@ -99,6 +100,7 @@ pub fn randomize(
         band_speeds: *bands,
         far_observer,
         observer_height: config.observer.height,
+        intent: Intent::for_object(object, far_observer, &config.labels),
     };
     let layout = family.sample(&input, &mut seeds::stream(seed, key.attempt, "placement"));
 
@@ -120,6 +122,7 @@ pub fn randomize(
     let steps = |seconds: f64| (seconds / dt).round() as u32;
     let mut family_params = layout.params;
     family_params.insert("far_observer".into(), if far_observer { 1.0 } else { 0.0 });
+    family_params.insert(crate::intent::PARAM.into(), input.intent.code());
 
     Ok(SceneSpec {
         schema_version: SCHEMA_VERSION,

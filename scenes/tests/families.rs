@@ -356,68 +356,41 @@ fn pendulum_small_angle_period_matches_the_physical_pendulum() {
 }
 
 #[test]
-fn thrown_object_fastest_band_arrives_after_its_designed_flight_time() {
-    use families::thrown_object::{indoor_elevation, throw_distance, FASTEST_FLIGHT_S};
-    // Closed form: aimed at the point `throw_distance` away, a throw whose lob would hit
-    // the ceiling flies exactly FASTEST_FLIGHT_S (the flatter solution); one whose lob
-    // fits under it takes the lob and flies longer.
-    // (Speed, release and aim heights, room to rise above the release: a 2.5 m ceiling
-    // less clearance and the object's size, or a 4.3 m one.)
-    for (v, h0, ha, rise, lob_fits) in [
-        (6.7, 1.0, 0.6, 1.28, false),
-        (6.7, 1.3, 0.95, 0.98, false),
-        (7.0, 1.2, 0.9, 1.08, false),
-        (6.7, 1.0, 0.6, 3.0, true),
-    ] {
-        let d = throw_distance(v, FASTEST_FLIGHT_S, h0, ha);
-        let e = indoor_elevation(v, d, ha - h0, rise);
-        let t = d / (v * e.cos());
-        if lob_fits {
-            assert!(t > FASTEST_FLIGHT_S + 0.1, "v {v}: flight {t}");
-        } else {
-            assert!((t - FASTEST_FLIGHT_S).abs() < 1e-9, "v {v}: flight {t}");
-        }
-        assert!((v * e.sin()).powi(2) / (2.0 * GRAVITY) <= rise);
-        // It passes through the aim point: the height after the flight is `ha`.
-        let z = h0 + v * e.sin() * t - 0.5 * GRAVITY * t * t;
-        assert!((z - ha).abs() < 1e-9, "v {v}: arrives at {z} m");
-        // A slower throw cannot carry that far: it goes at its longest range (45°, or
-        // flatter when the ceiling is lower) and falls short.
-        let slow = indoor_elevation(3.5, d, ha - h0, rise);
-        assert!((slow - std::f64::consts::FRAC_PI_4).abs() < 1e-12);
-        let low_ceiling = indoor_elevation(6.5, 2.0 * d, ha - h0, 0.5);
-        assert!((6.5 * low_ceiling.sin()).powi(2) / (2.0 * GRAVITY) <= 0.5 + 1e-9);
+fn an_aimed_throw_meets_the_observer_at_the_sampled_height() {
+    use families::thrown_object::{launch_velocity, longest_flight, FLIGHT_S};
+    // Closed form: a throw at speed v from h0 whose launch velocity `launch_velocity`
+    // gives for a flight t is at height h after t, at the speed v.
+    for (v, t, h0, h) in [(5.2, 1.05, 1.0, 0.9), (7.4, 1.1, 1.3, 1.2), (6.0, 1.0, 1.2, 0.75)] {
+        let (vh, vz) = launch_velocity(v, t, h0, h);
+        assert!((vh.hypot(vz) - v).abs() < 1e-9);
+        assert!((h0 + vz * t - 0.5 * GRAVITY * t * t - h).abs() < 1e-9);
+        // The longest flight keeps the vertical speed within what it may be.
+        let tmax = longest_flight(v, 4.0, h0, h);
+        assert!(launch_velocity(v, tmax, h0, h).1 <= 4.0 + 1e-9);
     }
-    // In the simulation (a big room, so the room does not cut the distance short): the
-    // fastest band's tennis ball (scene index 3: the very_fast band) crosses the aim
-    // distance when its ballistic flight says, no earlier than FASTEST_FLIGHT_S.
-    let spec = custom_scene(
-        "thrown_object",
-        "tennis_ball",
-        "gym",
-        [3.5, 4.8, 5.8, 6.7],
-        3,
-    );
-    let sim = plain(&spec);
-    let v = sim.hazard_velocity(0);
-    let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    assert!((speed - 6.7).abs() < 1e-5);
-    let dx = spec.family_params["throw_distance_m"];
-    let e = spec.family_params["elevation_rad"];
-    let a = sim.hazard_position(0);
-    let crossed = (0..=sim.steps())
-        .find(|&k| {
-            let p = sim.hazard_position(k);
-            ((p[0] - a[0]).powi(2) + (p[1] - a[1]).powi(2)).sqrt() >= dx
-        })
-        .expect("the throw reaches the aim distance");
-    let t = crossed as f64 * spec.physics.dt;
-    let expected = dx / (6.7 * e.cos());
-    assert!(
-        (t - expected).abs() <= 2.0 * spec.physics.dt,
-        "flight {t} s vs {expected} s"
-    );
-    assert!(t >= FASTEST_FLIGHT_S - spec.physics.dt, "flight {t} s");
+    // In the simulation, every band of a group (a tennis ball in the gym): the release
+    // speed is the band's, the flight lasts past Δ + the reaction time, and the centre
+    // of mass is at the target point (beside the observer, at the sampled height) when
+    // the flight ends.
+    for band in 0..4 {
+        let spec = custom_scene("thrown_object", "tennis_ball", "gym", [5.2, 5.8, 6.4, 7.4], band);
+        let sim = plain(&spec);
+        let v = sim.hazard_velocity(0);
+        let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        assert!((speed - [5.2, 5.8, 6.4, 7.4][band as usize]).abs() < 1e-5);
+        let p = &spec.family_params;
+        let t = p["flight_s"];
+        assert!(t >= spec.observation_window_s + spec.labels.reaction_time_min, "flight {t} s");
+        assert!(t <= FLIGHT_S[1] + 1e-9);
+        let k = (t / spec.physics.dt).round() as u32;
+        let at = sim.hazard_com(k);
+        let target = [p["aim_target_x_m"], p["aim_target_y_m"], p["aim_height_m"]];
+        let miss = ((at[0] - target[0]).powi(2) + (at[1] - target[1]).powi(2) + (at[2] - target[2]).powi(2)).sqrt();
+        // Within one step's travel.
+        assert!(miss <= speed * spec.physics.dt, "band {band}: {miss} m from the target");
+        let o = &spec.observer;
+        assert!(o.torso_axis_distance(target) <= 0.5, "the target is beside the observer");
+    }
 }
 
 #[test]

@@ -51,6 +51,9 @@ pub struct FamilyInput<'a> {
     /// Whether this group's observer stands far from the event (drawn by the randomizer).
     pub far_observer: bool,
     pub observer_height: f64,
+    /// Where the group's event is aimed (label rule v5): families that aim their own
+    /// event (`Family::self_aimed`) read it.
+    pub intent: crate::intent::Intent,
 }
 
 /// Where the observer stands: on the floor at (x, y), facing `yaw`.
@@ -98,6 +101,11 @@ pub trait Family: Sync {
     }
     /// Lays out the scene. Must draw from `rng` identically for every `input.speed`.
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout;
+    /// Whether the family aims its own event at the observer (`input.intent`); for the
+    /// others `aim::aim_group` places the observer on the simulated path.
+    fn self_aimed(&self) -> bool {
+        false
+    }
     /// Whether the family's intended event happened in the simulation.
     fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool;
 }
@@ -545,18 +553,24 @@ mod tests {
                         band_speeds: [0.3, 0.6, 1.0, 2.0],
                         far_observer: false,
                         observer_height: 1.32,
+                        intent: crate::intent::Intent::Hands,
                     };
                     family.sample(&input, &mut seeds::stream(11, 0, "placement"))
                 })
                 .collect();
-            // Thrown objects aim with an elevation that follows from the speed.
+            // A thrown object is aimed: its elevation, and (a fixed flight time) its
+            // release point and range, follow from the speed.
             let strip = |l: &Layout| {
                 let mut l = l.clone();
                 for b in &mut l.bodies {
                     b.linvel = [0.0; 3];
                     b.angvel = [0.0; 3];
+                    if family.self_aimed() {
+                        b.position = [0.0; 3];
+                    }
                 }
                 l.params.retain(|k, _| !k.contains("elevation"));
+                l.params.retain(|k, _| k != "throw_distance_m" && k != "flight_s");
                 // door_swing records the push impulse that gives its door the band's edge
                 // speed (`J = I_hinge·v/w²`): a momentum, like the velocities above.
                 l.params.retain(|k, _| k != "push_impulse_ns");

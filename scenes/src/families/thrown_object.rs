@@ -1,52 +1,43 @@
 //! thrown_object: an object is thrown at the observer (SPEC §4).
 //!
-//! Timing (label rule v2): indoors a throw that reaches the observer only after
-//! Δ + 0.2 s must be a long lob under the ceiling, so the thrower stands along the room's
-//! diagonal as far away as the fastest band needs to arrive `FASTEST_FLIGHT_S` after the
-//! release (its apex under the ceiling); each band aims at the observer with the longest
-//! flight whose apex clears the ceiling, and a throw too weak to carry that far is thrown
-//! at its longest range and falls short, arriving (if at all) bouncing, rolling or sliding.
+//! Aimed (label rule v5): the throw is aimed at a target point beside the observer
+//! chosen by the group's intent (`crate::intent`) — in front of the chest at a height the
+//! hands hold (a benign object), into the chest or head (a dangerous one), or 1.8–2.2 m
+//! to the side (a near miss) — and arrives there a drawn flight time after the release,
+//! long enough for Δ plus the reaction time. Every band flies for that time (less only
+//! where its speed or the ceiling cannot keep it up so long), so a faster band is
+//! released from farther away: the release point follows from the speed, like the
+//! elevation. No air drag: the centre of mass flies a parabola through the target
+//! until it touches something (closed-form test).
 
 use super::launch::*;
 use super::*;
+use crate::intent::Intent;
 
 pub struct ThrownObject;
 
-/// Flight time of the fastest band's throw to the aim point (s).
-pub const FASTEST_FLIGHT_S: f64 = 0.9;
 /// Clearance kept between the throw's apex (plus the object's size) and the ceiling (m).
 const CEILING_CLEARANCE: f64 = 0.1;
 /// Distance kept between the thrower's hand or the observer and the walls (m).
 const WALL_MARGIN: f64 = 0.3;
 
-/// Elevation of a throw at `speed` toward a point `dx` away and `dy` higher whose apex
-/// may rise at most `rise` above the release: of the two aiming solutions, the one with
-/// the longer flight whose apex fits (the flatter one when neither does); when the speed
-/// cannot carry that far, the longest throw that fits (45°, or flatter under the ceiling).
-pub fn indoor_elevation(speed: f64, dx: f64, dy: f64, rise: f64) -> f64 {
-    let v2 = speed * speed;
-    let fits = |e: f64| (speed * e.sin()).max(0.0).powi(2) / (2.0 * GRAVITY) <= rise;
-    let disc = v2 * v2 - GRAVITY * (GRAVITY * dx * dx + 2.0 * dy * v2);
-    if disc < 0.0 || dx <= 0.0 {
-        let ceiling = ((2.0 * GRAVITY * rise.max(0.0)).sqrt() / speed)
-            .min(1.0)
-            .asin();
-        return ceiling.min(std::f64::consts::FRAC_PI_4);
-    }
-    let high = ((v2 + disc.sqrt()) / (GRAVITY * dx)).atan();
-    let low = ((v2 - disc.sqrt()) / (GRAVITY * dx)).atan();
-    if fits(high) {
-        high
-    } else {
-        low
-    }
+/// The flight time (s) to draw from: release at t0, arrival after Δ (0.6 s) plus the
+/// reaction time (0.2 s) and a margin.
+pub const FLIGHT_S: [f64; 2] = [1.0, 1.15];
+
+/// The flight time a throw at `speed` from height `h0` to height `h` can last at most:
+/// its vertical launch speed at most `vz_max` (m/s) — 97% of the speed (a throw has some
+/// horizontal speed) or what keeps the apex under the ceiling.
+pub fn longest_flight(speed: f64, vz_max: f64, h0: f64, h: f64) -> f64 {
+    let vz = vz_max.min(0.97 * speed).max(0.0);
+    (vz + (vz * vz - 2.0 * GRAVITY * (h - h0)).max(0.0).sqrt()) / GRAVITY
 }
 
-/// Horizontal distance at which a throw at `speed`, released at height `h0`, passes
-/// height `ha` after `flight` seconds (0 when the speed cannot stay up that long).
-pub fn throw_distance(speed: f64, flight: f64, h0: f64, ha: f64) -> f64 {
-    let vz = (ha - h0 + 0.5 * GRAVITY * flight * flight) / flight;
-    (speed * speed - vz * vz).max(0.0).sqrt() * flight
+/// The launch velocity (horizontal along the throw, vertical) of a throw at `speed` from
+/// height `h0` that is at height `h` after `flight` seconds.
+pub fn launch_velocity(speed: f64, flight: f64, h0: f64, h: f64) -> (f64, f64) {
+    let vz = (h - h0 + 0.5 * GRAVITY * flight * flight) / flight;
+    ((speed * speed - vz * vz).max(0.0).sqrt(), vz)
 }
 
 impl Family for ThrownObject {
@@ -58,56 +49,81 @@ impl Family for ThrownObject {
         }
     }
 
+    fn self_aimed(&self) -> bool {
+        true
+    }
+
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
         let room = input.room;
         let heading_angle = diagonal_heading(rng, room, 0.05);
         let dir = heading(heading_angle);
-        let perp = [-dir[1], dir[0]];
+        let side = left_of(dir);
         let launch_height = uniform(rng, 1.0, 1.3);
-        let aim_height = uniform(rng, 0.6, 0.95);
-        let aim_lateral = uniform(rng, -0.25, 0.25);
-        // A far-observer group is a throw that goes wide of the observer.
-        let miss_side = if uniform(rng, 0.0, 1.0) < 0.5 {
-            -1.0
-        } else {
-            1.0
+        let flight = uniform(rng, FLIGHT_S[0], FLIGHT_S[1]);
+        // Where the target lies from the torso axis: `ahead` toward the thrower, `across`
+        // to the side, at `height`.
+        let (ahead_d, across, height) = match input.intent {
+            Intent::Hands => (
+                uniform(rng, 0.2, 0.4),
+                uniform(rng, -0.15, 0.15),
+                uniform(rng, 0.75, 1.15),
+            ),
+            Intent::Body => (
+                uniform(rng, -0.05, 0.05),
+                uniform(rng, -0.05, 0.05),
+                uniform(rng, 1.0, 1.3),
+            ),
+            Intent::Miss => {
+                let off = uniform(rng, 1.8, 2.2);
+                let sign = if uniform(rng, 0.0, 1.0) < 0.5 { -1.0 } else { 1.0 };
+                (0.0, off * sign, uniform(rng, 0.6, 1.2))
+            }
         };
-        let miss_offset = uniform(rng, 1.8, 2.2) * miss_side;
         let spin = [
             uniform(rng, -6.0, 6.0),
             uniform(rng, -6.0, 6.0),
             uniform(rng, -6.0, 6.0),
         ];
         let yaw = uniform(rng, 0.0, std::f64::consts::TAU);
-        // The fastest band reaches the aim point `FASTEST_FLIGHT_S` after release; the
-        // room may cut that distance short.
-        let fastest = input.band_speeds.iter().copied().fold(0.0, f64::max);
-        let wanted = throw_distance(fastest, FASTEST_FLIGHT_S, launch_height, aim_height);
-        let distance = wanted.min(room_span(room, dir, WALL_MARGIN));
-        let origin = span_start(rng, room, dir, distance, WALL_MARGIN);
         let radius = input.object.half_extents().into_iter().fold(0.0, f64::max);
         let rise = room.ceiling_height - CEILING_CLEARANCE - radius - launch_height;
-
-        let start = [origin[0], origin[1], launch_height];
-        let observer_xy = [origin[0] + dir[0] * distance, origin[1] + dir[1] * distance];
-        let lateral = if input.far_observer {
-            miss_offset
-        } else {
-            aim_lateral
+        let vz_ceiling = (2.0 * GRAVITY * rise.max(0.0)).sqrt();
+        // Each band's flight and range; the room must hold the longest range plus the
+        // observer's offset.
+        let span = room_span(room, dir, WALL_MARGIN) - ahead_d.max(0.0);
+        let range_of = |v: f64| {
+            let t = flight.min(longest_flight(v, vz_ceiling, launch_height, height));
+            let (vh, _) = launch_velocity(v, t, launch_height, height);
+            // Shorten the flight of a throw the room cannot hold (bisection on t).
+            if vh * t <= span {
+                return t;
+            }
+            let (mut lo, mut hi) = (0.05, t);
+            for _ in 0..40 {
+                let mid = 0.5 * (lo + hi);
+                if launch_velocity(v, mid, launch_height, height).0 * mid > span {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            lo
         };
-        let target = [
-            observer_xy[0] + perp[0] * lateral,
-            observer_xy[1] + perp[1] * lateral,
-            aim_height,
-        ];
-        let dx = ((target[0] - start[0]).powi(2) + (target[1] - start[1]).powi(2)).sqrt();
-        let elevation = indoor_elevation(input.speed, dx, target[2] - start[2], rise);
-        let aim = [(target[0] - start[0]) / dx, (target[1] - start[1]) / dx];
-        let linvel = [
-            aim[0] * input.speed * elevation.cos(),
-            aim[1] * input.speed * elevation.cos(),
-            input.speed * elevation.sin(),
-        ];
+        let range = |v: f64| {
+            let t = range_of(v);
+            launch_velocity(v, t, launch_height, height).0 * t
+        };
+        let longest = input.band_speeds.iter().map(|&v| range(v)).fold(0.0, f64::max);
+        let origin = span_start(rng, room, dir, longest + ahead_d.max(0.0), WALL_MARGIN);
+        // The target's ground point, the torso axis `ahead_d` beyond it, and this band's
+        // release point `range` before it.
+        let target_xy = ahead(ahead(origin, dir, longest), side, across);
+        let observer_xy = ahead(ahead(target_xy, dir, ahead_d), side, -across);
+        let t = range_of(input.speed);
+        let (vh, vz) = launch_velocity(input.speed, t, launch_height, height);
+        let release = ahead(target_xy, dir, -vh * t);
+        let start = [release[0], release[1], launch_height];
+        let linvel = [dir[0] * vh, dir[1] * vh, vz];
         let hazard = hazard_body(input.object, start, yaw_quat(yaw), linvel, spin);
         let observer = ObserverPose {
             x: observer_xy[0],
@@ -122,9 +138,12 @@ impl Family for ThrownObject {
             observer,
             params: BTreeMap::from([
                 ("launch_height_m".into(), launch_height),
-                ("throw_distance_m".into(), dx),
-                ("aim_height_m".into(), aim_height),
-                ("elevation_rad".into(), elevation),
+                ("throw_distance_m".into(), vh * t),
+                ("aim_height_m".into(), height),
+                ("aim_target_x_m".into(), target_xy[0]),
+                ("aim_target_y_m".into(), target_xy[1]),
+                ("flight_s".into(), t),
+                ("elevation_rad".into(), vz.atan2(vh)),
             ]),
         }
     }
