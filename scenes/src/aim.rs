@@ -166,7 +166,13 @@ pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Optio
             best.map(|(m, a)| (m, a.candidate, a.meet_height))
         );
     }
-    let (_, aim) = best?;
+    // Only an aim that every band meets as intended: otherwise the family's own pose
+    // stands (it keeps the event valid; the attempt is not wasted on a pose that the
+    // reaction-time rule would reject).
+    let (met, aim) = best?;
+    if (met as usize) < runs.len() {
+        return None;
+    }
     for (spec, _) in runs.iter_mut() {
         *spec = posed(spec, aim.x, aim.y, aim.yaw);
         let p = &mut spec.family_params;

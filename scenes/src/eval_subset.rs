@@ -135,7 +135,7 @@ fn whole_groups_first(rows: &[EvalRow], members: &[usize], n: usize) -> Vec<usiz
 mod tests {
     use super::*;
 
-    fn row(family: &str, i: u64, action: &'static str) -> EvalRow<'_> {
+    fn row<'a>(family: &'a str, i: u64, action: &'static str) -> EvalRow<'a> {
         EvalRow {
             family,
             scene_index: i,
