@@ -52,5 +52,15 @@ if ! python3 -c "import kubernetes_validate" 2>/dev/null; then
     || python3 -m pip install --quiet --disable-pip-version-check --break-system-packages kubernetes-validate
 fi
 
+# inspect_ai for the harness integration (integrations/inspect_ai; tested offline by
+# python/tests/test_inspect.py with its mock model), pinned: the task is written against
+# this version's Task / scorer / mockllm API.
+inspect_version=0.3.285
+if [ "$(python3 -c 'import inspect_ai; print(inspect_ai.__version__)' 2>/dev/null)" != "$inspect_version" ]; then
+  echo "setup: installing Python package: inspect_ai==$inspect_version"
+  python3 -m pip install --quiet --disable-pip-version-check "inspect_ai==$inspect_version" \
+    || python3 -m pip install --quiet --disable-pip-version-check --break-system-packages "inspect_ai==$inspect_version"
+fi
+
 command -v cargo >/dev/null || { echo "setup: cargo not found; install Rust (rustup) first" >&2; exit 1; }
 echo "setup: ok"
