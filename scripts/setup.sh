@@ -17,6 +17,9 @@ apt_packages=(
 # maturin, numpy, gymnasium and pytest; its wheel's own dependencies are numpy, pyarrow
 # and gymnasium.
 python_packages=(pyarrow datasets maturin numpy gymnasium pytest)
+# Modules whose pip package has another name (module:package): Pillow decodes the
+# `datasets` Image columns of rendered builds (`<cam>_frames`).
+python_renamed=(PIL:pillow)
 
 missing=()
 for pkg in "${apt_packages[@]}"; do
@@ -37,6 +40,9 @@ fi
 py_missing=()
 for mod in "${python_packages[@]}"; do
   python3 -c "import $mod" 2>/dev/null || py_missing+=("$mod")
+done
+for pair in "${python_renamed[@]}"; do
+  python3 -c "import ${pair%%:*}" 2>/dev/null || py_missing+=("${pair#*:}")
 done
 if [ ${#py_missing[@]} -gt 0 ]; then
   echo "setup: installing Python packages: ${py_missing[*]}"

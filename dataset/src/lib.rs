@@ -8,6 +8,7 @@
 //! running build), [`finalize`] (data, eval subset, card and sums from the rows),
 //! [`card`] (the dataset card), [`merge`] (shards into one dataset) and [`verify`].
 
+pub mod frames;
 pub mod read;
 pub mod stream;
 pub mod table;

@@ -179,6 +179,54 @@ fn rendered_build_has_probed_videos_frames_columns_and_merges_byte_equal() {
         );
     }
 
+    // The model-input frames are data: `datasets` (run from another folder) gives each
+    // rendered row's `<cam>_frames` as five PIL images in time order, pixel for pixel the
+    // PNG files; unrendered (invalid) rows have none; the eval config carries them too.
+    let hf_home = tempfile::tempdir().unwrap();
+    let report = python(&format!(
+        r#"
+import os, json
+os.environ["HF_HOME"] = {home:?}
+os.environ["HF_DATASETS_OFFLINE"] = "1"
+os.environ["HF_HUB_OFFLINE"] = "1"
+import numpy as np
+from PIL import Image
+import datasets
+d = {dir:?}
+os.chdir("/")
+ds = datasets.load_dataset(d, "default", split="test")
+ev = datasets.load_dataset(d, "eval", split="test")
+times = ["0.000", "0.150", "0.300", "0.450", "0.600"]
+checked, unrendered, bad = 0, 0, []
+for r in ds:
+    for cam in ["ego", "closeup", "overhead"]:
+        frames = r[cam + "_frames"]
+        if r[cam + "_file_name"] is None:
+            unrendered += frames is None
+            continue
+        if len(frames) != 5:
+            bad.append((r["scene_id"], cam, len(frames)))
+            continue
+        for t, img in zip(times, frames):
+            want = np.asarray(Image.open(os.path.join(d, "frames", r["scene_id"], cam + "_t" + t + ".png")).convert("RGB"))
+            if not isinstance(img, Image.Image) or not np.array_equal(np.asarray(img.convert("RGB")), want):
+                bad.append((r["scene_id"], cam, t))
+            checked += 1
+print(json.dumps({{"checked": checked, "unrendered": unrendered, "bad": bad,
+  "feature": str(ds.features["ego_frames"]),
+  "eval_frames": sum(1 for r in ev if r["ego_frames"] is not None and len(r["ego_frames"]) == 5),
+  "eval_rows": ev.num_rows}}))
+"#,
+        home = hf_home.path().to_str().unwrap(),
+        dir = single.to_str().unwrap()
+    ));
+    let v: serde_json::Value = serde_json::from_str(report.trim()).unwrap();
+    assert_eq!(v["bad"], serde_json::json!([]), "{v}");
+    assert_eq!(v["checked"], (rendered * 15) as u64, "{v}");
+    assert_eq!(v["unrendered"], ((8 - rendered) * 3) as u64, "{v}");
+    assert!(v["feature"].as_str().unwrap().contains("Image"), "{v}");
+    assert_eq!(v["eval_frames"], v["eval_rows"], "every eval scene is rendered: {v}");
+
     // The contact sheet: one tile per family.
     let sheet = tmp.path().join("sheet.png");
     let json = run_ok(
