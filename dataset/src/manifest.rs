@@ -3,12 +3,29 @@
 //! build seed, scene count, families, shard, render flag, and the exact configuration and
 //! catalog — so that a restarted build can tell its own half-finished work from another
 //! build's, and `rh-pipeline merge` can check that shards belong together.
+//!
+//! Reading it ([`Manifest::read`], the identity fields, [`Manifest::differences`]) needs
+//! no scene crates, so the table reader alone (without feature `write`) has it too:
+//! `rh-score` names the build it scored from it. Making one, the typed configuration and
+//! the planned selections need `write`.
 
+#[cfg(feature = "write")]
 use rh_catalog::Catalog;
+#[cfg(feature = "write")]
 use rh_scenes::config::Config;
 use serde::{Deserialize, Serialize};
+#[cfg(feature = "write")]
 use sha2::{Digest, Sha256};
 use std::path::Path;
+
+/// A planned selection of a build from descriptions: typed with `write`; without it (the
+/// table reader alone) kept as the JSON it was written as.
+#[cfg(feature = "write")]
+pub type PlannedSelection = rh_physics::spec::Selection;
+/// A planned selection of a build from descriptions: typed with `write`; without it (the
+/// table reader alone) kept as the JSON it was written as.
+#[cfg(not(feature = "write"))]
+pub type PlannedSelection = serde_json::Value;
 
 pub const MANIFEST_FILE: &str = "build.json";
 pub const FORMAT: &str = "rh-build/1";
@@ -43,13 +60,14 @@ pub struct Manifest {
     /// SHA-256 of every file the build wrote (this one aside), by path: written when the
     /// build is finished (`finalize::finalize`); absent while it runs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub files: Option<crate::integrity::FileSums>,
+    pub files: Option<std::collections::BTreeMap<String, String>>,
     /// The planned selections of a build from descriptions (`--descriptions`), one per
     /// description with its planner record; group g takes selection g mod len.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub selections: Option<Vec<rh_physics::spec::Selection>>,
+    pub selections: Option<Vec<PlannedSelection>>,
 }
 
+#[cfg(feature = "write")]
 fn sha256_hex(bytes: &[u8]) -> String {
     Sha256::digest(bytes)
         .iter()
@@ -58,6 +76,7 @@ fn sha256_hex(bytes: &[u8]) -> String {
 }
 
 /// A fingerprint of a configuration (also used to tell the embedded default apart).
+#[cfg(feature = "write")]
 pub fn config_sha256(config: &Config) -> String {
     sha256_hex(
         serde_json::to_string(config)
@@ -67,11 +86,13 @@ pub fn config_sha256(config: &Config) -> String {
 }
 
 /// A fingerprint of a catalog's validated content.
+#[cfg(feature = "write")]
 pub fn catalog_sha256(catalog: &Catalog) -> String {
     sha256_hex(format!("{:?}\n{:?}", catalog.objects, catalog.rooms).as_bytes())
 }
 
 impl Manifest {
+    #[cfg(feature = "write")]
     pub fn new(
         seed: u64,
         n: u64,
@@ -128,12 +149,19 @@ impl Manifest {
         }
     }
 
+    /// The label rule's version (`labels.rule_version` of the configuration), if any.
+    pub fn label_rule(&self) -> Option<&str> {
+        self.config.pointer("/labels/rule_version")?.as_str()
+    }
+
     /// The label thresholds of the build.
+    #[cfg(feature = "write")]
     pub fn labels(&self) -> Option<rh_physics::spec::LabelConfig> {
         serde_json::from_value(self.config.get("labels")?.clone()).ok()
     }
 
     /// The configuration the build ran with.
+    #[cfg(feature = "write")]
     pub fn build_config(&self) -> Result<Config, String> {
         serde_json::from_value(self.config.clone())
             .map_err(|e| format!("{MANIFEST_FILE}: its configuration cannot be read: {e}"))
@@ -203,7 +231,7 @@ impl Manifest {
     }
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "write"))]
 mod tests {
     use super::*;
 
@@ -218,6 +246,7 @@ mod tests {
         assert_eq!(a.groups(), vec![1]);
         assert_eq!(a.group_size(2), 2);
         assert_eq!(a.labels().unwrap(), config.labels);
+        assert_eq!(a.label_rule(), Some(config.labels.rule_version.as_str()));
         let b = Manifest::new(8, 10, &fams, (1, 3), false, &catalog, &config);
         assert_eq!(a.differences(&b), vec!["seed 7 vs 8".to_string()]);
         assert!(a.whole().is_whole());
