@@ -352,7 +352,7 @@ fn insert_provenance(input: &CardInput, v: &mut BTreeMap<&str, String>) {
         format!(
             "| | |\n|---|---|\n| build seed | {} |\n| scenes (whole build) | {} |\n| scene groups | {} |\n\
 | families | {} |\n| shard | {}/{} |\n| render | {} |\n| configuration | {} (sha256 `{}`) |\n\
-| catalog | sha256 `{}` |\n| rh-pipeline | {} |\n| data files | {} |",
+| render adapter | {} |\n| catalog | sha256 `{}` |\n| rh-pipeline | {} |\n| data files | {} |",
             m.seed,
             m.n,
             m.n_groups(),
@@ -366,6 +366,10 @@ fn insert_provenance(input: &CardInput, v: &mut BTreeMap<&str, String>) {
             },
             if default_config { "the default `configs/default.toml`" } else { "custom" },
             m.config_sha256,
+            match &m.render_adapter {
+                Some(a) => a.describe().replace('|', "/"),
+                None => "none (not rendered, or not recorded)".into(),
+            },
             m.catalog_sha256,
             m.rh_pipeline_version,
             input

@@ -65,6 +65,11 @@ pub struct Manifest {
     /// description with its planner record; group g takes selection g mod len.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub selections: Option<Vec<PlannedSelection>>,
+    /// The adapter that drew the videos and frames (`null` for a label-only build, and
+    /// read as `null` from manifests written before it was recorded). Shards rendered on
+    /// different adapters do not merge: their pixels, the models' inputs, may differ.
+    #[serde(default)]
+    pub render_adapter: Option<rh_contract::adapter::RenderAdapter>,
 }
 
 #[cfg(feature = "write")]
@@ -116,6 +121,7 @@ impl Manifest {
             config: serde_json::to_value(config).expect("config serializes"),
             files: None,
             selections: None,
+            render_adapter: None,
         }
     }
 
@@ -207,7 +213,23 @@ impl Manifest {
         if self.catalog_sha256 != other.catalog_sha256 {
             d.push("catalog".into());
         }
+        if let Some(a) = self.adapter_difference(other) {
+            d.push(a);
+        }
         d
+    }
+
+    /// "render adapter A vs B" when the two builds were rendered on different adapters
+    /// (None when equal, or when either records none: a label-only build).
+    pub fn adapter_difference(&self, other: &Manifest) -> Option<String> {
+        match (&self.render_adapter, &other.render_adapter) {
+            (Some(a), Some(b)) if a != b => Some(format!(
+                "render adapter {} vs {}",
+                a.describe(),
+                b.describe()
+            )),
+            _ => None,
+        }
     }
 
     pub fn to_json(&self) -> String {
@@ -250,5 +272,29 @@ mod tests {
         let b = Manifest::new(8, 10, &fams, (1, 3), false, &catalog, &config);
         assert_eq!(a.differences(&b), vec!["seed 7 vs 8".to_string()]);
         assert!(a.whole().is_whole());
+        // Older manifests (no render_adapter) read as null; two adapters differ.
+        let mut old: serde_json::Value = serde_json::from_str(&a.to_json()).unwrap();
+        old.as_object_mut().unwrap().remove("render_adapter");
+        let old: Manifest = serde_json::from_value(old).unwrap();
+        assert_eq!(old.render_adapter, None);
+        let adapter = |name: &str| rh_contract::adapter::RenderAdapter {
+            name: name.into(),
+            backend: "vulkan".into(),
+            device_type: "cpu".into(),
+            driver: "llvmpipe".into(),
+            driver_info: "Mesa".into(),
+            cpu_features: vec![],
+            lp_native_vector_width: None,
+        };
+        let (mut x, mut y) = (a.clone(), a.clone());
+        x.render_adapter = Some(adapter("one"));
+        y.render_adapter = Some(adapter("two"));
+        let diff = x.differences(&y);
+        assert_eq!(diff.len(), 1, "{diff:?}");
+        assert!(
+            diff[0].contains("one") && diff[0].contains("two"),
+            "{diff:?}"
+        );
+        assert_eq!(x.adapter_difference(&a), None, "label-only merges freely");
     }
 }

@@ -178,6 +178,7 @@ fn rendered_build_has_probed_videos_frames_columns_and_merges_byte_equal() {
             "{name} differs between the build and the merge"
         );
     }
+    shards_from_two_adapters_do_not_merge(tmp.path(), &shards);
 
     // The model-input frames are data: `datasets` (run from another folder) gives each
     // rendered row's `<cam>_frames` as five PIL images in time order, pixel for pixel the
@@ -352,4 +353,75 @@ fn rendered_build_killed_mid_video_resumes_to_the_same_bytes() {
     for (name, bytes) in &a {
         assert!(bytes == &b[name], "{name} differs after the resumed build");
     }
+}
+
+/// `build.json` names the adapter that rendered a shard; shards whose adapters differ do
+/// not merge (exit 2, naming both adapters and both directories), and `verify` prints the
+/// recorded adapter beside this machine's. The second adapter is faked by editing a copy
+/// of shard 1's `build.json`: the manifest is not among the checksummed files, so the
+/// copy passes merge's integrity checks and is refused for its adapter alone.
+fn shards_from_two_adapters_do_not_merge(tmp: &Path, shards: &[PathBuf]) {
+    let read = |dir: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("build.json")).unwrap()).unwrap()
+    };
+    let ours = read(&shards[0])["render_adapter"].clone();
+    assert!(
+        ours["name"].as_str().is_some_and(|n| !n.is_empty()) && ours["backend"].is_string(),
+        "build.json records the adapter: {ours}"
+    );
+    let other = tmp.join("s1-other-adapter");
+    let cp = Command::new("cp")
+        .arg("-r")
+        .arg(&shards[1])
+        .arg(&other)
+        .status()
+        .unwrap();
+    assert!(cp.success());
+    let mut m = read(&other);
+    m["render_adapter"]["name"] = "Other GPU 9000".into();
+    m["render_adapter"]["driver_info"] = "other driver 1.0".into();
+    std::fs::write(
+        other.join("build.json"),
+        serde_json::to_string_pretty(&m).unwrap(),
+    )
+    .unwrap();
+    let out = run(
+        "rh-pipeline",
+        &[
+            "merge",
+            tmp.join("m-adapters").to_str().unwrap(),
+            shards[0].to_str().unwrap(),
+            other.to_str().unwrap(),
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    for needle in [
+        "different adapters",
+        ours["name"].as_str().unwrap(),
+        "Other GPU 9000",
+        shards[0].to_str().unwrap(),
+        other.to_str().unwrap(),
+    ] {
+        assert!(err.contains(needle), "'{needle}' not in: {err}");
+    }
+    assert!(!tmp.join("m-adapters").exists());
+    // verify reports the recorded adapter and this machine's, and when they differ.
+    let same = run_ok(
+        "rh-pipeline",
+        &["verify", shards[0].to_str().unwrap(), "--fast"],
+    );
+    assert!(
+        same.contains("render adapter (recorded)") && same.contains("(the same)"),
+        "{same}"
+    );
+    let differs = run(
+        "rh-pipeline",
+        &["verify", other.to_str().unwrap(), "--fast"],
+    );
+    let text = String::from_utf8_lossy(&differs.stdout);
+    assert!(
+        text.contains("Other GPU 9000") && text.contains("DIFFERS"),
+        "{text}"
+    );
 }
