@@ -83,8 +83,8 @@ pub fn finalize(
     let eval = if manifest.is_whole() {
         let (indices, counts) = card::eval_selection(&summary);
         let path = out.join(card::EVAL_FILE);
-        let mut eval = stream::ParquetStream::create_with(&path, group_rows)
-            .map_err(BuildError::Internal)?;
+        let mut eval =
+            stream::ParquetStream::create_with(&path, group_rows).map_err(BuildError::Internal)?;
         write_streamed(&rows, &indices, &mut eval)?;
         eval.finish().map_err(BuildError::Internal)?;
         let sum = integrity::sha256_file(&path).map_err(|e| internal(&path, e))?;

@@ -35,7 +35,10 @@ fn builder() -> ListBuilder<StructBuilder> {
     let item = Field::new("item", rh_contract::arrow_schema::image_type(), true);
     ListBuilder::new(StructBuilder::new(
         fields,
-        vec![Box::new(BinaryBuilder::new()), Box::new(StringBuilder::new())],
+        vec![
+            Box::new(BinaryBuilder::new()),
+            Box::new(StringBuilder::new()),
+        ],
     ))
     .with_field(Arc::new(item))
 }

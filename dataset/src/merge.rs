@@ -310,7 +310,10 @@ impl ShardCursor {
         let file = std::fs::File::open(path).map_err(|e| fail(&e))?;
         let reader = ParquetRecordBatchReaderBuilder::try_new(file)
             // Small batches: a rendered shard's rows carry ~1 MB of frame images each.
-            .and_then(|b| b.with_batch_size(crate::frames::IMAGE_ROW_GROUP_SIZE * 4).build())
+            .and_then(|b| {
+                b.with_batch_size(crate::frames::IMAGE_ROW_GROUP_SIZE * 4)
+                    .build()
+            })
             .map_err(|e| fail(&e))?;
         Ok(ShardCursor {
             path: path.to_path_buf(),

@@ -176,8 +176,8 @@ pub fn parquet_bytes(batch: &RecordBatch) -> Vec<u8> {
     let mut bytes = Vec::new();
     {
         let props = writer_props(batch, group_rows(batch));
-        let mut writer = ArrowWriter::try_new(&mut bytes, batch.schema(), Some(props))
-                .expect("valid schema");
+        let mut writer =
+            ArrowWriter::try_new(&mut bytes, batch.schema(), Some(props)).expect("valid schema");
         writer.write(batch).expect("in-memory write");
         writer.close().expect("in-memory close");
     }
@@ -207,12 +207,9 @@ pub(crate) fn writer_props(batch: &RecordBatch, group_rows: usize) -> WriterProp
 /// Rows per row group for `batch`'s table: `frames::IMAGE_ROW_GROUP_SIZE` when any row
 /// carries images, else `ROW_GROUP_SIZE`.
 pub fn group_rows(batch: &RecordBatch) -> usize {
-    let images = batch
-        .schema()
-        .fields()
-        .iter()
-        .enumerate()
-        .any(|(i, f)| crate::frames::is_image_column(f.name()) && batch.column(i).null_count() < batch.num_rows());
+    let images = batch.schema().fields().iter().enumerate().any(|(i, f)| {
+        crate::frames::is_image_column(f.name()) && batch.column(i).null_count() < batch.num_rows()
+    });
     if images {
         crate::frames::IMAGE_ROW_GROUP_SIZE
     } else {

@@ -226,7 +226,10 @@ print(json.dumps({{"checked": checked, "unrendered": unrendered, "bad": bad,
     assert_eq!(v["checked"], (rendered * 15) as u64, "{v}");
     assert_eq!(v["unrendered"], ((8 - rendered) * 3) as u64, "{v}");
     assert!(v["feature"].as_str().unwrap().contains("Image"), "{v}");
-    assert_eq!(v["eval_frames"], v["eval_rows"], "every eval scene is rendered: {v}");
+    assert_eq!(
+        v["eval_frames"], v["eval_rows"],
+        "every eval scene is rendered: {v}"
+    );
 
     // The contact sheet: one tile per family.
     let sheet = tmp.path().join("sheet.png");
