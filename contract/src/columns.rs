@@ -121,6 +121,13 @@ pub fn frames_column(camera: &str) -> String {
     format!("{camera}_frames")
 }
 
+/// Whether a column is one of the `<cam>_frames` image columns.
+pub fn is_frames_column(name: &str) -> bool {
+    crate::layout::CAMERAS
+        .iter()
+        .any(|cam| frames_column(cam) == name)
+}
+
 /// The `<cam>_mask_paths` column of a camera (instance-id PNGs, `build --masks`).
 pub fn mask_paths_column(camera: &str) -> String {
     format!("{camera}_mask_paths")

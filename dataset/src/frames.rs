@@ -61,7 +61,8 @@ pub fn null_columns(rows: usize) -> Vec<ArrayRef> {
 /// read from the frame files under `dir`; rows whose frames are already there, and rows
 /// not rendered, are unchanged.
 pub fn embed(batch: &RecordBatch, dir: &Path) -> Result<RecordBatch, String> {
-    let ids = crate::table::string_column(batch, "scene_id");
+    let table = Path::new("scene table");
+    let ids = crate::read::required_strings(batch, table, "scene_id")?;
     let mut columns = batch.columns().to_vec();
     for cam in CAMERAS {
         let name = frames_column(cam);
@@ -74,7 +75,10 @@ pub fn embed(batch: &RecordBatch, dir: &Path) -> Result<RecordBatch, String> {
             .as_any()
             .downcast_ref::<ListArray>()
             .ok_or_else(|| format!("column `{name}` is not a list"))?;
-        let rendered = crate::table::optional_string_column(batch, &video_column(cam));
+        let rendered = match batch.column_by_name(&video_column(cam)) {
+            Some(_) => crate::read::strings(batch, table, &video_column(cam))?,
+            None => vec![None; batch.num_rows()],
+        };
         if (0..batch.num_rows()).all(|r| current.is_valid(r) || rendered[r].is_none()) {
             continue;
         }
@@ -142,7 +146,4 @@ fn append_existing(b: &mut ListBuilder<StructBuilder>, from: &ListArray, r: usiz
     b.append(true);
 }
 
-/// Whether a column is one of the `<cam>_frames` image columns.
-pub fn is_image_column(name: &str) -> bool {
-    CAMERAS.iter().any(|cam| frames_column(cam) == name)
-}
+pub use rh_contract::columns::is_frames_column as is_image_column;

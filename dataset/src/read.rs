@@ -37,7 +37,7 @@ pub fn open_parquet(file: &Path, batch_size: usize) -> Result<ParquetRecordBatch
                 .fields()
                 .iter()
                 .enumerate()
-                .filter(|(_, f)| !crate::frames::is_image_column(f.name()))
+                .filter(|(_, f)| !rh_contract::columns::is_frames_column(f.name()))
                 .map(|(i, _)| i)
                 .collect();
             let mask = parquet::arrow::ProjectionMask::roots(b.parquet_schema(), roots);
