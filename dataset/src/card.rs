@@ -200,12 +200,10 @@ pub fn text(input: &CardInput) -> String {
     let mut v: BTreeMap<&str, String> = BTreeMap::new();
     v.insert("size_category", size_category(n_rows).into());
     v.insert("repo_id", rh_hub::RELEASED_DATASET.into());
-    let group_rows = if m.render {
-        crate::frames::IMAGE_ROW_GROUP_SIZE
-    } else {
-        table::ROW_GROUP_SIZE
-    };
-    v.insert("row_group_size", group_rows.to_string());
+    v.insert(
+        "row_group_size",
+        table::row_group_size(m.render).to_string(),
+    );
     v.insert("rule_version", labels.rule_version.clone());
     let window = m
         .config

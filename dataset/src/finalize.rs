@@ -44,11 +44,7 @@ pub fn finalize(
     let data_file = table::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
     let data_path = out.join(&data_file);
     // Rendered rows carry their frames' images (`frames::embed`), read from `out`.
-    let group_rows = if manifest.render {
-        frames::IMAGE_ROW_GROUP_SIZE
-    } else {
-        table::ROW_GROUP_SIZE
-    };
+    let group_rows = table::row_group_size(manifest.render);
     let source = rows;
     let rows = move |sink: &mut RowSink| -> Result<(), BuildError> {
         source(&mut |batch| {

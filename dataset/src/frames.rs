@@ -145,5 +145,3 @@ fn append_existing(b: &mut ListBuilder<StructBuilder>, from: &ListArray, r: usiz
     }
     b.append(true);
 }
-
-pub use rh_contract::columns::is_frames_column as is_image_column;

@@ -113,7 +113,7 @@ fn with_null_images(batch: &RecordBatch) -> RecordBatch {
     for f in plain.fields() {
         match batch.column_by_name(f.name()) {
             Some(c) => columns.push(c.clone()),
-            None if crate::frames::is_image_column(f.name()) => {
+            None if rh_contract::columns::is_frames_column(f.name()) => {
                 columns.push(next_null.next().expect("one per camera"))
             }
             None => return batch.clone(),
@@ -170,12 +170,13 @@ pub fn bool_column(batch: &RecordBatch, name: &str) -> Vec<bool> {
     read::bools(batch, Path::new(TABLE), name).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Serialises rows to Parquet bytes (Snappy, fixed row groups, no timestamps: the same
-/// rows always give the same bytes).
+/// Serialises rows to Parquet bytes (Snappy, `ROW_GROUP_SIZE`-row groups, no timestamps:
+/// the same rows always give the same bytes). Rows carrying images (a finished rendered
+/// build's) are written by `stream::ParquetStream` with `row_group_size`.
 pub fn parquet_bytes(batch: &RecordBatch) -> Vec<u8> {
     let mut bytes = Vec::new();
     {
-        let props = writer_props(batch, group_rows(batch));
+        let props = writer_props(batch, ROW_GROUP_SIZE);
         let mut writer =
             ArrowWriter::try_new(&mut bytes, batch.schema(), Some(props)).expect("valid schema");
         writer.write(batch).expect("in-memory write");
@@ -204,13 +205,10 @@ pub(crate) fn writer_props(batch: &RecordBatch, group_rows: usize) -> WriterProp
         .build()
 }
 
-/// Rows per row group for `batch`'s table: `frames::IMAGE_ROW_GROUP_SIZE` when any row
-/// carries images, else `ROW_GROUP_SIZE`.
-pub fn group_rows(batch: &RecordBatch) -> usize {
-    let images = batch.schema().fields().iter().enumerate().any(|(i, f)| {
-        crate::frames::is_image_column(f.name()) && batch.column(i).null_count() < batch.num_rows()
-    });
-    if images {
+/// Rows per row group of a dataset's tables: `frames::IMAGE_ROW_GROUP_SIZE` for a rendered
+/// build (its rows carry images), else `ROW_GROUP_SIZE`.
+pub fn row_group_size(render: bool) -> usize {
+    if render {
         crate::frames::IMAGE_ROW_GROUP_SIZE
     } else {
         ROW_GROUP_SIZE
