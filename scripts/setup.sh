@@ -17,6 +17,9 @@ apt_packages=(
 # maturin, numpy, gymnasium and pytest; its wheel's own dependencies are numpy, pyarrow
 # and gymnasium.
 python_packages=(pyarrow datasets maturin numpy gymnasium pytest)
+# Modules whose pip package has another name (module:package): Pillow decodes the
+# `datasets` Image columns of rendered builds (`<cam>_frames`).
+python_renamed=(PIL:pillow)
 
 missing=()
 for pkg in "${apt_packages[@]}"; do
@@ -38,6 +41,9 @@ py_missing=()
 for mod in "${python_packages[@]}"; do
   python3 -c "import $mod" 2>/dev/null || py_missing+=("$mod")
 done
+for pair in "${python_renamed[@]}"; do
+  python3 -c "import ${pair%%:*}" 2>/dev/null || py_missing+=("${pair#*:}")
+done
 if [ ${#py_missing[@]} -gt 0 ]; then
   echo "setup: installing Python packages: ${py_missing[*]}"
   python3 -m pip install --quiet --disable-pip-version-check "${py_missing[@]}" \
@@ -50,6 +56,16 @@ if ! python3 -c "import kubernetes_validate" 2>/dev/null; then
   echo "setup: installing Python package: kubernetes-validate"
   python3 -m pip install --quiet --disable-pip-version-check kubernetes-validate \
     || python3 -m pip install --quiet --disable-pip-version-check --break-system-packages kubernetes-validate
+fi
+
+# inspect_ai for the harness integration (integrations/inspect_ai; tested offline by
+# python/tests/test_inspect.py with its mock model), pinned: the task is written against
+# this version's Task / scorer / mockllm API.
+inspect_version=0.3.285
+if [ "$(python3 -c 'import inspect_ai; print(inspect_ai.__version__)' 2>/dev/null)" != "$inspect_version" ]; then
+  echo "setup: installing Python package: inspect_ai==$inspect_version"
+  python3 -m pip install --quiet --disable-pip-version-check "inspect_ai==$inspect_version" \
+    || python3 -m pip install --quiet --disable-pip-version-check --break-system-packages "inspect_ai==$inspect_version"
 fi
 
 command -v cargo >/dev/null || { echo "setup: cargo not found; install Rust (rustup) first" >&2; exit 1; }

@@ -11,12 +11,12 @@ export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 python3 -m maturin build --release --quiet --out "$work/wheels"
-# Fresh venv; numpy, pyarrow, gymnasium and pytest come from the system site
-# (scripts/setup.sh installs them), so the test needs no network.
+# Fresh venv; numpy, pyarrow, gymnasium, pytest and inspect_ai (pinned) come from the
+# system site (scripts/setup.sh installs them), so the test needs no network.
 python3 -m venv --system-site-packages "$work/venv"
 "$work/venv/bin/python" -m pip install --quiet --no-deps --no-index --disable-pip-version-check \
   "$work"/wheels/reacthuman-*.whl
-"$work/venv/bin/python" -c "import reacthuman, gymnasium; print('reacthuman', reacthuman.versions())"
+"$work/venv/bin/python" -c "import reacthuman, gymnasium, inspect_ai; print('reacthuman', reacthuman.versions(), 'inspect_ai', inspect_ai.__version__)"
 rc=0
 ( cd "$work" && RH_BIN_DIR="$OLDPWD/target/release" "$work/venv/bin/python" -m pytest -q \
     -p no:cacheprovider "$OLDPWD/python/tests" ) || rc=$?

@@ -23,7 +23,20 @@ pub fn data_type(ty: ColumnType) -> DataType {
             Arc::new(Field::new("item", DataType::Float32, false)),
             4,
         )),
+        ColumnType::ImageList => list(image_type()),
     }
+}
+
+/// One image of an `ImageList` column: `{bytes: binary, path: string}`, the Arrow type
+/// of `datasets`' `Image` feature.
+pub fn image_type() -> DataType {
+    DataType::Struct(
+        vec![
+            Field::new("bytes", DataType::Binary, true),
+            Field::new("path", DataType::Utf8, true),
+        ]
+        .into(),
+    )
 }
 
 /// The Arrow field of a column.

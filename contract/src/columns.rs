@@ -21,6 +21,9 @@ pub enum ColumnType {
     Float64List,
     /// List of fixed-size lists of 4 non-null float32 (`[t, x, y, z]` samples).
     Vec4F32List,
+    /// List of images, each a struct of the encoded file's `bytes` and its relative
+    /// `path` (Hugging Face `datasets`' `Image` feature).
+    ImageList,
 }
 
 /// One column of the scene table.
@@ -115,6 +118,18 @@ pub fn visible_px_column(camera: &str) -> String {
 /// The `<cam>_hazard_unoccluded_fraction` column of a camera.
 pub fn unoccluded_column(camera: &str) -> String {
     format!("{camera}_hazard_unoccluded_fraction")
+}
+
+/// The `<cam>_frames` column of a camera (the model-input frames as images).
+pub fn frames_column(camera: &str) -> String {
+    format!("{camera}_frames")
+}
+
+/// Whether a column is one of the `<cam>_frames` image columns.
+pub fn is_frames_column(name: &str) -> bool {
+    crate::layout::CAMERAS
+        .iter()
+        .any(|cam| frames_column(cam) == name)
 }
 
 /// The `<cam>_mask_paths` column of a camera (instance-id PNGs, `build --masks`).
@@ -569,6 +584,24 @@ pub const COLUMNS: &[Column] = &[
         Utf8List,
         true,
         "Relative paths `depth/<scene_id>/overhead_t0.000.png` … `_t0.600.png`: 16-bit depth images of the `overhead` observation frames, Euclidean distance from the camera centre in millimetres (0 = no surface); null unless built with `--masks`",
+    ),
+    c(
+        "ego_frames",
+        ImageList,
+        true,
+        "The `ego` model-input frames at t = 0.000 … 0.600 s as images (`datasets` `Image`: the PNG bytes of `frames/<scene_id>/ego_t….png` and that path), in time order; what `rh-score predict` sends; null when not rendered",
+    ),
+    c(
+        "closeup_frames",
+        ImageList,
+        true,
+        "The `closeup` model-input frames at t = 0.000 … 0.600 s as images (`datasets` `Image`: the PNG bytes of `frames/<scene_id>/closeup_t….png` and that path), in time order; null when not rendered",
+    ),
+    c(
+        "overhead_frames",
+        ImageList,
+        true,
+        "The `overhead` model-input frames at t = 0.000 … 0.600 s as images (`datasets` `Image`: the PNG bytes of `frames/<scene_id>/overhead_t….png` and that path), in time order; null when not rendered",
     ),
 ];
 

@@ -13,6 +13,7 @@
 //! programs can depend on it without pulling in anything else.
 
 pub mod action;
+pub mod adapter;
 pub mod columns;
 pub mod execution;
 pub mod families;

@@ -197,7 +197,10 @@ pub fn text(input: &CardInput) -> String {
     let mut v: BTreeMap<&str, String> = BTreeMap::new();
     v.insert("size_category", size_category(n_rows).into());
     v.insert("repo_id", rh_hub::RELEASED_DATASET.into());
-    v.insert("row_group_size", table::ROW_GROUP_SIZE.to_string());
+    v.insert(
+        "row_group_size",
+        table::row_group_size(m.render).to_string(),
+    );
     v.insert("rule_version", labels.rule_version.clone());
     let window = m
         .config
@@ -347,7 +350,7 @@ fn insert_provenance(input: &CardInput, v: &mut BTreeMap<&str, String>) {
         format!(
             "| | |\n|---|---|\n| build seed | {} |\n| scenes (whole build) | {} |\n| scene groups | {} |\n\
 | families | {} |\n| shard | {}/{} |\n| render | {} |\n| configuration | {} (sha256 `{}`) |\n\
-| catalog | sha256 `{}` |\n| rh-pipeline | {} |\n| data files | {} |",
+| render adapter | {} |\n| catalog | sha256 `{}` |\n| rh-pipeline | {} |\n| data files | {} |",
             m.seed,
             m.n,
             m.n_groups(),
@@ -361,6 +364,10 @@ fn insert_provenance(input: &CardInput, v: &mut BTreeMap<&str, String>) {
             },
             if default_config { "the default `configs/default.toml`" } else { "custom" },
             m.config_sha256,
+            match &m.render_adapter {
+                Some(a) => a.describe().replace('|', "/"),
+                None => "none (not rendered, or not recorded)".into(),
+            },
             m.catalog_sha256,
             m.rh_pipeline_version,
             input

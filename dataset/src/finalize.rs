@@ -4,7 +4,7 @@
 
 use crate::integrity::{self, FileSums};
 use crate::manifest::{Manifest, MANIFEST_FILE};
-use crate::{card, stream, table};
+use crate::{card, frames, stream, table};
 use arrow::array::RecordBatch;
 use std::path::Path;
 
@@ -43,7 +43,17 @@ pub fn finalize(
 ) -> Result<(RecordBatch, Option<usize>), BuildError> {
     let data_file = table::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
     let data_path = out.join(&data_file);
-    let mut data = stream::ParquetStream::create(&data_path).map_err(BuildError::Internal)?;
+    // Rendered rows carry their frames' images (`frames::embed`), read from `out`.
+    let group_rows = table::row_group_size(manifest.render);
+    let source = rows;
+    let rows = move |sink: &mut RowSink| -> Result<(), BuildError> {
+        source(&mut |batch| {
+            let batch = frames::embed(&batch, out).map_err(BuildError::Internal)?;
+            sink(batch)
+        })
+    };
+    let mut data =
+        stream::ParquetStream::create_with(&data_path, group_rows).map_err(BuildError::Internal)?;
     let summary_schema = stream::project(
         &RecordBatch::new_empty(std::sync::Arc::new(table::schema())),
         &stream::SUMMARY_COLUMNS,
@@ -68,11 +78,13 @@ pub fn finalize(
     let summary = compact(&summary)?;
     let eval = if manifest.is_whole() {
         let (indices, counts) = card::manifest_eval_selection(&summary, manifest);
-        let subset = take_streamed(rows, &indices)?;
         let path = out.join(card::EVAL_FILE);
-        let bytes = table::parquet_bytes(&subset);
-        table::write_atomic(&path, &bytes).map_err(|e| internal(&path, e))?;
-        sums.insert(card::EVAL_FILE.to_string(), integrity::sha256_bytes(&bytes));
+        let mut eval =
+            stream::ParquetStream::create_with(&path, group_rows).map_err(BuildError::Internal)?;
+        write_streamed(&rows, &indices, &mut eval)?;
+        eval.finish().map_err(BuildError::Internal)?;
+        let sum = integrity::sha256_file(&path).map_err(|e| internal(&path, e))?;
+        sums.insert(card::EVAL_FILE.to_string(), sum);
         Some(counts)
     } else {
         None
@@ -98,9 +110,13 @@ pub fn finalize(
     Ok((summary, eval.map(|c| c.values().sum())))
 }
 
-/// The rows at `indices` (ascending positions in the whole table) of a streamed table.
-fn take_streamed(rows: &RowSource, indices: &[u32]) -> Result<RecordBatch, BuildError> {
-    let mut parts = Vec::new();
+/// Writes the rows at `indices` (ascending positions in the whole table) of a streamed
+/// table to `to`.
+fn write_streamed(
+    rows: &RowSource,
+    indices: &[u32],
+    to: &mut stream::ParquetStream,
+) -> Result<(), BuildError> {
     let (mut offset, mut next) = (0usize, 0usize);
     rows(&mut |batch| {
         let end = offset + batch.num_rows();
@@ -111,10 +127,10 @@ fn take_streamed(rows: &RowSource, indices: &[u32]) -> Result<RecordBatch, Build
             .collect();
         next += local.len();
         if !local.is_empty() {
-            parts.push(table::take_rows(&batch, &local));
+            to.write(&table::take_rows(&batch, &local))
+                .map_err(BuildError::Internal)?;
         }
         offset = end;
         Ok(())
-    })?;
-    table::concat(&parts).map_err(BuildError::Internal)
+    })
 }

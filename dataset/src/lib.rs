@@ -1,13 +1,15 @@
 //! ReactHuman dataset files (SPEC §8).
 //!
 //! Always: [`table`] — the scene table's Arrow schema, its Parquet writer settings and
-//! reading it back; [`stream`] — a Parquet file written row group by row group.
+//! reading it back; [`stream`] — a Parquet file written row group by row group;
+//! [`manifest`] — reading `build.json` (writing one needs `write`).
 //! With feature `write` (default): [`rows`] (scene rows from scene results),
-//! [`media_columns`] (the measured-visibility and mask columns), [`manifest`]
-//! (`build.json`), [`integrity`] (SHA-256 sums), [`records`] (finished scene groups of a
+//! [`media_columns`] (the measured-visibility and mask columns), [`integrity`] (SHA-256 sums), [`records`] (finished scene groups of a
 //! running build), [`finalize`] (data, eval subset, card and sums from the rows),
 //! [`card`] (the dataset card), [`merge`] (shards into one dataset) and [`verify`].
 
+pub mod frames;
+pub mod manifest;
 pub mod read;
 pub mod stream;
 pub mod table;
@@ -18,8 +20,6 @@ pub mod card;
 pub mod finalize;
 #[cfg(feature = "write")]
 pub mod integrity;
-#[cfg(feature = "write")]
-pub mod manifest;
 #[cfg(feature = "write")]
 pub mod media_columns;
 #[cfg(feature = "write")]

@@ -3,12 +3,29 @@
 //! build seed, scene count, families, shard, render flag, and the exact configuration and
 //! catalog — so that a restarted build can tell its own half-finished work from another
 //! build's, and `rh-pipeline merge` can check that shards belong together.
+//!
+//! Reading it ([`Manifest::read`], the identity fields, [`Manifest::differences`]) needs
+//! no scene crates, so the table reader alone (without feature `write`) has it too:
+//! `rh-score` names the build it scored from it. Making one, the typed configuration and
+//! the planned selections need `write`.
 
+#[cfg(feature = "write")]
 use rh_catalog::Catalog;
+#[cfg(feature = "write")]
 use rh_scenes::config::Config;
 use serde::{Deserialize, Serialize};
+#[cfg(feature = "write")]
 use sha2::{Digest, Sha256};
 use std::path::Path;
+
+/// A planned selection of a build from descriptions: typed with `write`; without it (the
+/// table reader alone) kept as the JSON it was written as.
+#[cfg(feature = "write")]
+pub type PlannedSelection = rh_physics::spec::Selection;
+/// A planned selection of a build from descriptions: typed with `write`; without it (the
+/// table reader alone) kept as the JSON it was written as.
+#[cfg(not(feature = "write"))]
+pub type PlannedSelection = serde_json::Value;
 
 pub const MANIFEST_FILE: &str = "build.json";
 pub const FORMAT: &str = "rh-build/1";
@@ -43,13 +60,19 @@ pub struct Manifest {
     /// SHA-256 of every file the build wrote (this one aside), by path: written when the
     /// build is finished (`finalize::finalize`); absent while it runs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub files: Option<crate::integrity::FileSums>,
+    pub files: Option<std::collections::BTreeMap<String, String>>,
     /// The planned selections of a build from descriptions (`--descriptions`), one per
     /// description with its planner record; group g takes selection g mod len.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub selections: Option<Vec<rh_physics::spec::Selection>>,
+    pub selections: Option<Vec<PlannedSelection>>,
+    /// The adapter that drew the videos and frames (`null` for a label-only build, and
+    /// read as `null` from manifests written before it was recorded). Shards rendered on
+    /// different adapters do not merge: their pixels, the models' inputs, may differ.
+    #[serde(default)]
+    pub render_adapter: Option<rh_contract::adapter::RenderAdapter>,
 }
 
+#[cfg(feature = "write")]
 fn sha256_hex(bytes: &[u8]) -> String {
     Sha256::digest(bytes)
         .iter()
@@ -58,6 +81,7 @@ fn sha256_hex(bytes: &[u8]) -> String {
 }
 
 /// A fingerprint of a configuration (also used to tell the embedded default apart).
+#[cfg(feature = "write")]
 pub fn config_sha256(config: &Config) -> String {
     sha256_hex(
         serde_json::to_string(config)
@@ -67,11 +91,13 @@ pub fn config_sha256(config: &Config) -> String {
 }
 
 /// A fingerprint of a catalog's validated content.
+#[cfg(feature = "write")]
 pub fn catalog_sha256(catalog: &Catalog) -> String {
     sha256_hex(format!("{:?}\n{:?}", catalog.objects, catalog.rooms).as_bytes())
 }
 
 impl Manifest {
+    #[cfg(feature = "write")]
     pub fn new(
         seed: u64,
         n: u64,
@@ -95,6 +121,7 @@ impl Manifest {
             config: serde_json::to_value(config).expect("config serializes"),
             files: None,
             selections: None,
+            render_adapter: None,
         }
     }
 
@@ -128,12 +155,19 @@ impl Manifest {
         }
     }
 
+    /// The label rule's version (`labels.rule_version` of the configuration), if any.
+    pub fn label_rule(&self) -> Option<&str> {
+        self.config.pointer("/labels/rule_version")?.as_str()
+    }
+
     /// The label thresholds of the build.
+    #[cfg(feature = "write")]
     pub fn labels(&self) -> Option<rh_physics::spec::LabelConfig> {
         serde_json::from_value(self.config.get("labels")?.clone()).ok()
     }
 
     /// The configuration the build ran with.
+    #[cfg(feature = "write")]
     pub fn build_config(&self) -> Result<Config, String> {
         serde_json::from_value(self.config.clone())
             .map_err(|e| format!("{MANIFEST_FILE}: its configuration cannot be read: {e}"))
@@ -179,7 +213,23 @@ impl Manifest {
         if self.catalog_sha256 != other.catalog_sha256 {
             d.push("catalog".into());
         }
+        if let Some(a) = self.adapter_difference(other) {
+            d.push(a);
+        }
         d
+    }
+
+    /// "render adapter A vs B" when the two builds were rendered on different adapters
+    /// (None when equal, or when either records none: a label-only build).
+    pub fn adapter_difference(&self, other: &Manifest) -> Option<String> {
+        match (&self.render_adapter, &other.render_adapter) {
+            (Some(a), Some(b)) if a != b => Some(format!(
+                "render adapter {} vs {}",
+                a.describe(),
+                b.describe()
+            )),
+            _ => None,
+        }
     }
 
     pub fn to_json(&self) -> String {
@@ -203,7 +253,7 @@ impl Manifest {
     }
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "write"))]
 mod tests {
     use super::*;
 
@@ -218,8 +268,33 @@ mod tests {
         assert_eq!(a.groups(), vec![1]);
         assert_eq!(a.group_size(2), 2);
         assert_eq!(a.labels().unwrap(), config.labels);
+        assert_eq!(a.label_rule(), Some(config.labels.rule_version.as_str()));
         let b = Manifest::new(8, 10, &fams, (1, 3), false, &catalog, &config);
         assert_eq!(a.differences(&b), vec!["seed 7 vs 8".to_string()]);
         assert!(a.whole().is_whole());
+        // Older manifests (no render_adapter) read as null; two adapters differ.
+        let mut old: serde_json::Value = serde_json::from_str(&a.to_json()).unwrap();
+        old.as_object_mut().unwrap().remove("render_adapter");
+        let old: Manifest = serde_json::from_value(old).unwrap();
+        assert_eq!(old.render_adapter, None);
+        let adapter = |name: &str| rh_contract::adapter::RenderAdapter {
+            name: name.into(),
+            backend: "vulkan".into(),
+            device_type: "cpu".into(),
+            driver: "llvmpipe".into(),
+            driver_info: "Mesa".into(),
+            cpu_features: vec![],
+            lp_native_vector_width: None,
+        };
+        let (mut x, mut y) = (a.clone(), a.clone());
+        x.render_adapter = Some(adapter("one"));
+        y.render_adapter = Some(adapter("two"));
+        let diff = x.differences(&y);
+        assert_eq!(diff.len(), 1, "{diff:?}");
+        assert!(
+            diff[0].contains("one") && diff[0].contains("two"),
+            "{diff:?}"
+        );
+        assert_eq!(x.adapter_difference(&a), None, "label-only merges freely");
     }
 }

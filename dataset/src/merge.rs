@@ -135,6 +135,19 @@ pub fn merge(out: &Path, shards: &[PathBuf]) -> Result<MergeSummary, BuildError>
     let whole = first.whole();
     let n_shards = first.shard[1];
     let mut by_index: BTreeMap<u64, &Path> = BTreeMap::new();
+    // One set of model inputs: every shard drawn on the same adapter (label-only shards
+    // record none and merge freely).
+    for (dir, (m, _)) in &read {
+        if let Some(a) = first.adapter_difference(m) {
+            return Err(input(format!(
+                "{} and {} were rendered on different adapters ({a}): their frames may differ, \
+                 so the merged dataset would not be one set of model inputs; render every shard \
+                 on the same adapter",
+                first_dir.display(),
+                dir.display(),
+            )));
+        }
+    }
     for (dir, (m, _)) in &read {
         let diff = whole.differences(&m.whole());
         if !diff.is_empty() {
@@ -296,7 +309,11 @@ impl ShardCursor {
         let fail = |e: &dyn std::fmt::Display| input(format!("{}: {e}", path.display()));
         let file = std::fs::File::open(path).map_err(|e| fail(&e))?;
         let reader = ParquetRecordBatchReaderBuilder::try_new(file)
-            .and_then(|b| b.with_batch_size(1024).build())
+            // Small batches: a rendered shard's rows carry ~1 MB of frame images each.
+            .and_then(|b| {
+                b.with_batch_size(crate::frames::IMAGE_ROW_GROUP_SIZE * 4)
+                    .build()
+            })
             .map_err(|e| fail(&e))?;
         Ok(ShardCursor {
             path: path.to_path_buf(),

@@ -24,12 +24,25 @@ pub fn parquet_files(folder: &Path) -> Result<Vec<PathBuf>, String> {
     Ok(files)
 }
 
-/// A record-batch reader over one Parquet file.
+/// A record-batch reader over one Parquet file, every column but the model-input
+/// frames' images (`<cam>_frames`, about 1 MB a row: only `datasets` users and `merge`
+/// read them).
 pub fn open_parquet(file: &Path, batch_size: usize) -> Result<ParquetRecordBatchReader, String> {
     let f =
         std::fs::File::open(file).map_err(|e| format!("cannot open {}: {e}", file.display()))?;
     ParquetRecordBatchReaderBuilder::try_new(f)
-        .and_then(|b| b.with_batch_size(batch_size).build())
+        .and_then(|b| {
+            let roots: Vec<usize> = b
+                .schema()
+                .fields()
+                .iter()
+                .enumerate()
+                .filter(|(_, f)| !rh_contract::columns::is_frames_column(f.name()))
+                .map(|(i, _)| i)
+                .collect();
+            let mask = parquet::arrow::ProjectionMask::roots(b.parquet_schema(), roots);
+            b.with_projection(mask).with_batch_size(batch_size).build()
+        })
         .map_err(|e| format!("{} is not a readable Parquet file: {e}", file.display()))
 }
 

@@ -144,6 +144,8 @@ pub fn record_batch(results: &[SceneResult], catalog: &Catalog) -> RecordBatch {
         .map(|m| m.full_event.clone())));
     columns.extend(frame_and_trajectory_columns(results));
     columns.extend(crate::media_columns::measured_columns(results));
+    // The frames' images are embedded when the build is finished (`frames::embed`).
+    columns.extend(crate::frames::null_columns(results.len()));
     RecordBatch::try_new(Arc::new(schema()), columns).expect("columns match the schema")
 }
 

@@ -17,6 +17,7 @@ use std::sync::Arc;
 /// renamed by `finish`, like `write_atomic`; dropped unfinished, the temporary is removed.
 pub struct ParquetStream {
     path: PathBuf,
+    group_rows: usize,
     tmp: PathBuf,
     writer: Option<ArrowWriter<std::io::BufWriter<fs::File>>>,
     pending: Vec<RecordBatch>,
@@ -24,17 +25,25 @@ pub struct ParquetStream {
 }
 
 impl ParquetStream {
+    /// A table of `ROW_GROUP_SIZE` rows per row group.
     pub fn create(path: &Path) -> Result<ParquetStream, String> {
+        ParquetStream::create_with(path, ROW_GROUP_SIZE)
+    }
+
+    /// A table of `group_rows` rows per row group (`frames::IMAGE_ROW_GROUP_SIZE` when
+    /// the rows carry images).
+    pub fn create_with(path: &Path, group_rows: usize) -> Result<ParquetStream, String> {
         let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
         fs::create_dir_all(path.parent().unwrap_or(Path::new("."))).map_err(|e| fail(&e))?;
         let tmp = rh_contract::fsio::temp_sibling(path);
         let file = fs::File::create(&tmp).map_err(|e| fail(&e))?;
         let schema = Arc::new(schema());
-        let props = writer_props(&RecordBatch::new_empty(schema.clone()));
+        let props = writer_props(&RecordBatch::new_empty(schema.clone()), group_rows);
         let writer = ArrowWriter::try_new(std::io::BufWriter::new(file), schema, Some(props))
             .map_err(|e| fail(&e))?;
         Ok(ParquetStream {
             path: path.to_path_buf(),
+            group_rows,
             tmp,
             writer: Some(writer),
             pending: Vec::new(),
@@ -46,11 +55,11 @@ impl ParquetStream {
     pub fn write(&mut self, batch: &RecordBatch) -> Result<(), String> {
         let mut offset = 0;
         while offset < batch.num_rows() {
-            let take = (ROW_GROUP_SIZE - self.pending_rows).min(batch.num_rows() - offset);
+            let take = (self.group_rows - self.pending_rows).min(batch.num_rows() - offset);
             self.pending.push(batch.slice(offset, take));
             self.pending_rows += take;
             offset += take;
-            if self.pending_rows == ROW_GROUP_SIZE {
+            if self.pending_rows == self.group_rows {
                 self.write_pending()?;
             }
         }

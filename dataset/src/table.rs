@@ -51,6 +51,11 @@ fn feature_of(data_type: &DataType) -> serde_json::Value {
         DataType::FixedSizeList(item, n) => {
             json!({"feature": feature_of(item.data_type()), "length": n, "_type": "Sequence"})
         }
+        DataType::Struct(fields)
+            if fields.len() == 2 && fields[0].name() == "bytes" && fields[1].name() == "path" =>
+        {
+            json!({"_type": "Image"})
+        }
         DataType::List(item) | DataType::LargeList(item) => {
             json!({"feature": feature_of(item.data_type()), "_type": "Sequence"})
         }
@@ -89,12 +94,32 @@ pub fn optional_string_column(batch: &RecordBatch, name: &str) -> Vec<Option<Str
 }
 
 /// Reads a Parquet file of scene rows written by `parquet_bytes` back into one batch with
-/// the canonical schema (`schema()`).
+/// the canonical schema (`schema()`), the images of `<cam>_frames` left out (null).
 pub fn read_batch(path: &Path) -> Result<RecordBatch, String> {
     let batches: Vec<RecordBatch> = read::open_parquet(path, 8192)?
+        .map(|b| b.map(|b| with_null_images(&b)))
         .collect::<Result<_, _>>()
         .map_err(|e| format!("{}: {e}", path.display()))?;
     concat(&batches).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// `batch` (read without its image columns) with null `<cam>_frames` columns in their
+/// places; a batch that has them, or lacks other columns, is returned as it is.
+fn with_null_images(batch: &RecordBatch) -> RecordBatch {
+    let plain = plain_schema();
+    let nulls = crate::frames::null_columns(batch.num_rows());
+    let mut next_null = nulls.into_iter();
+    let mut columns = Vec::with_capacity(plain.fields().len());
+    for f in plain.fields() {
+        match batch.column_by_name(f.name()) {
+            Some(c) => columns.push(c.clone()),
+            None if rh_contract::columns::is_frames_column(f.name()) => {
+                columns.push(next_null.next().expect("one per camera"))
+            }
+            None => return batch.clone(),
+        }
+    }
+    RecordBatch::try_new(Arc::new(plain), columns).unwrap_or_else(|_| batch.clone())
 }
 
 /// Concatenates scene batches into one with the canonical schema; fails if a batch's
@@ -145,23 +170,25 @@ pub fn bool_column(batch: &RecordBatch, name: &str) -> Vec<bool> {
     read::bools(batch, Path::new(TABLE), name).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Serialises rows to Parquet bytes (Snappy, fixed row groups, no timestamps: the same
-/// rows always give the same bytes).
+/// Serialises rows to Parquet bytes (Snappy, `ROW_GROUP_SIZE`-row groups, no timestamps:
+/// the same rows always give the same bytes). Rows carrying images (a finished rendered
+/// build's) are written by `stream::ParquetStream` with `row_group_size`.
 pub fn parquet_bytes(batch: &RecordBatch) -> Vec<u8> {
     let mut bytes = Vec::new();
     {
+        let props = writer_props(batch, ROW_GROUP_SIZE);
         let mut writer =
-            ArrowWriter::try_new(&mut bytes, batch.schema(), Some(writer_props(batch)))
-                .expect("valid schema");
+            ArrowWriter::try_new(&mut bytes, batch.schema(), Some(props)).expect("valid schema");
         writer.write(batch).expect("in-memory write");
         writer.close().expect("in-memory close");
     }
     bytes
 }
 
-/// The writer settings of every scene table: Snappy, `ROW_GROUP_SIZE` rows per row group,
-/// no timestamps.
-pub(crate) fn writer_props(batch: &RecordBatch) -> WriterProperties {
+/// The writer settings of every scene table: Snappy, `group_rows` rows per row group
+/// (`ROW_GROUP_SIZE`, or `frames::IMAGE_ROW_GROUP_SIZE` for rows with images), no
+/// timestamps.
+pub(crate) fn writer_props(batch: &RecordBatch, group_rows: usize) -> WriterProperties {
     // The `huggingface` features also as a plain key-value entry of the file, for readers
     // that do not decode the embedded Arrow schema.
     let kv = batch.schema().metadata().get("huggingface").map(|v| {
@@ -173,9 +200,19 @@ pub(crate) fn writer_props(batch: &RecordBatch) -> WriterProperties {
     WriterProperties::builder()
         .set_key_value_metadata(kv)
         .set_compression(Compression::SNAPPY)
-        .set_max_row_group_row_count(Some(ROW_GROUP_SIZE))
+        .set_max_row_group_row_count(Some(group_rows))
         .set_created_by("rh-pipeline".to_string())
         .build()
+}
+
+/// Rows per row group of a dataset's tables: `frames::IMAGE_ROW_GROUP_SIZE` for a rendered
+/// build (its rows carry images), else `ROW_GROUP_SIZE`.
+pub fn row_group_size(render: bool) -> usize {
+    if render {
+        crate::frames::IMAGE_ROW_GROUP_SIZE
+    } else {
+        ROW_GROUP_SIZE
+    }
 }
 
 /// Paths of the dataset's Parquet files, in name order.

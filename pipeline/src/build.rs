@@ -352,7 +352,10 @@ pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError
 
 /// Fails before any work when rendering is requested but impossible: no GPU, no
 /// encoder, or a program built without the `render` feature.
-fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<Option<String>, BuildError> {
+/// Returns the banner to print and the adapter's record for `build.json`.
+type RenderCheck = Option<(String, rh_contract::adapter::RenderAdapter)>;
+
+fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<RenderCheck, BuildError> {
     if !opts.render {
         return Ok(None);
     }
@@ -373,10 +376,13 @@ fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<Option<Str
                 .map_err(|e| {
                     BuildError::Input(format!("render stage: {e} (or build with --no-render)"))
                 })?;
-        Ok(Some(format!(
-            "rendering on {} ({} MSAA samples)",
-            renderer.adapter_name(),
-            renderer.samples()
+        Ok(Some((
+            format!(
+                "rendering on {} ({} MSAA samples)",
+                renderer.adapter().describe(),
+                renderer.samples()
+            ),
+            renderer.adapter().clone(),
         )))
     }
 }
@@ -432,7 +438,7 @@ pub fn build(
     check_options(opts, catalog, config)?;
     // Fail before any work when there is nothing to render with; say what renders only
     // once there is something to render (not before "nothing to do").
-    let render_banner = check_render_stage(opts, config)?;
+    let (render_banner, render_adapter) = check_render_stage(opts, config)?.unzip();
     let mut manifest = Manifest::new(
         opts.seed,
         opts.n,
@@ -444,6 +450,7 @@ pub fn build(
     );
     manifest.selections = opts.selections.clone();
     manifest.masks = opts.masks;
+    manifest.render_adapter = render_adapter;
     let out = &opts.out;
     std::fs::create_dir_all(out)
         .map_err(|e| BuildError::Input(format!("cannot write to --out {}: {e}", out.display())))?;

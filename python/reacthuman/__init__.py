@@ -6,6 +6,7 @@ A thin layer over the benchmark's Rust crates (the scorer ``rh-score`` and the p
 * :class:`Dataset` — a dataset directory (or Hub id): scenes as a ``pyarrow.Table`` or
   dicts, specs, frame paths, the eval subset;
 * :func:`score` — the report of ``rh-score PREDS --dataset DIR --json -``;
+* :func:`decisions` — its per-decision grades (``rh-score ... --decisions FILE``);
 * :func:`classify` — the action rule (CATCH / DODGE / NO_ACTION) with its kinematics;
 * :func:`prompt` — the canonical OpenAI-style messages and their ``prompt_hash``
   (``rh-score predict`` records the same);
@@ -29,10 +30,12 @@ from . import _native
 __all__ = [
     "Dataset",
     "score",
+    "decisions",
     "classify",
     "prompt",
     "execute",
     "versions",
+    "generation",
     "ACTION_RULE_VERSION",
     "EXECUTOR_VERSION",
     "PROMPT_VERSION",
@@ -51,6 +54,12 @@ def versions() -> dict:
         "executor": EXECUTOR_VERSION,
         "prompt": PROMPT_VERSION,
     }
+
+
+def generation() -> dict:
+    """``rh-score predict``'s generation parameters (``[generation]`` of
+    ``configs/predict.toml``): ``{"temperature": ..., "max_tokens": ...}``."""
+    return json.loads(_native.generation_config())
 
 
 def _plan_json(plan: Plan) -> str:
@@ -141,6 +150,12 @@ class Dataset:
         """Scene ids of the balanced eval subset (sorted), or None without ``eval/``."""
         return self._native.eval_ids()
 
+    def predict_scenes(self, subset: str = "eval", limit: int | None = None) -> list[str]:
+        """The scene ids ``rh-score predict --subset SUBSET [--limit N]`` runs, in its
+        order: the valid scenes of the subset (``"eval"`` or ``"all"``) in dataset order.
+        ``ValueError`` when there are none or the dataset has no eval subset."""
+        return self._native.predict_scenes(subset, limit)
+
     def spec_path(self, scene_id: str) -> str:
         """Absolute path of ``specs/<scene_id>.json``."""
         return self._native.spec_path(scene_id)
@@ -184,20 +199,51 @@ def score(
         text = ds._native.score(
             path=os.fspath(preds), subset=subset, answered_only=answered_only
         )
-    elif isinstance(preds, Iterable) and not isinstance(preds, (bytes, Mapping)):
-        lines = []
-        for i, p in enumerate(preds):
-            if not isinstance(p, Mapping):
-                raise ValueError(f"preds[{i}] must be a dict, got {type(p).__name__}")
-            lines.append(json.dumps(p))
-        text = ds._native.score(
-            text="\n".join(lines) + "\n", subset=subset, answered_only=answered_only
-        )
     else:
+        text = ds._native.score(
+            text=_jsonl(preds), subset=subset, answered_only=answered_only
+        )
+    return json.loads(text)
+
+
+def _jsonl(preds: Sequence[Mapping[str, Any]]) -> str:
+    """Prediction dicts as JSON Lines text (``ValueError`` naming a bad item)."""
+    if not isinstance(preds, Iterable) or isinstance(preds, (str, bytes, Mapping)):
         raise ValueError(
             f"preds must be a path or a list of dicts, got {type(preds).__name__}"
         )
-    return json.loads(text)
+    lines = []
+    for i, p in enumerate(preds):
+        if not isinstance(p, Mapping):
+            raise ValueError(f"preds[{i}] must be a dict, got {type(p).__name__}")
+        lines.append(json.dumps(p))
+    return "\n".join(lines) + "\n"
+
+
+def decisions(
+    preds: Union[PathLike, Sequence[Mapping[str, Any]]],
+    dataset: Union[Dataset, PathLike],
+    *,
+    subset: str | None = None,
+) -> list[dict]:
+    """The per-decision grades of ``rh-score PREDS --dataset DIR [--subset S] --decisions
+    FILE``: one dict per input decision, in input order, with its ``line``, ``scene_id``,
+    ``model``, ``status`` (``scored`` / ``lost`` / ``duplicate``), ``gt_action``, the
+    ``action`` the rule derived (``None`` for no parseable plan), ``saa``, the safety
+    ``rules`` fired and ``first_rule``, and the distance metrics. Lines the scorer drops
+    (outside the subset, no scene id, ...) have no entry (see :func:`score`'s warnings).
+    """
+    ds = _dataset(dataset)
+    if isinstance(preds, (str, os.PathLike)):
+        path = os.fspath(preds)
+        if not os.path.isfile(path):
+            raise FileNotFoundError(f"predictions file {path} does not exist")
+        with open(path, encoding="utf-8", errors="replace") as f:
+            text = f.read()
+    else:
+        text = _jsonl(preds)
+    out = ds._native.decisions(text, subset=subset)
+    return [json.loads(line) for line in out.splitlines() if line.strip()]
 
 
 def classify(

@@ -181,6 +181,21 @@ impl NativeDataset {
         })
     }
 
+    /// The scenes `rh-score predict --subset S [--limit N]` runs, in its order: the valid
+    /// scenes of the subset in dataset order (`rh_score::predict::select_scenes`).
+    #[pyo3(signature = (subset, limit=None))]
+    fn predict_scenes(
+        &self,
+        py: Python<'_>,
+        subset: String,
+        limit: Option<usize>,
+    ) -> PyResult<Vec<String>> {
+        run(py, || {
+            let s = self::subset(Some(&subset))?.expect("a named subset");
+            Ok(rh_score::predict::select_scenes(&self.ds, s, limit)?)
+        })
+    }
+
     /// `specs/<scene_id>.json` (absolute) of a known scene.
     fn spec_path(&self, scene_id: &str) -> PyResult<String> {
         crate::errors::guard(|| {
@@ -241,6 +256,24 @@ impl NativeDataset {
             let report =
                 rh_score::api::score_report(&self.ds, &self.cfg, subset, answered_only, preds)?;
             serde_json::to_string(&report).map_err(|e| Error::Internal(e.to_string()))
+        })
+    }
+
+    /// The decision lines (JSON Lines text) of `rh-score PREDS --dataset DIR [--subset S]
+    /// --decisions FILE` for predictions given as JSON Lines text: one line per input
+    /// decision (status scored / lost / duplicate, action, rules fired, metrics). Lines the
+    /// scorer drops (outside the subset, no scene id, ...) have none.
+    #[pyo3(signature = (text, subset=None))]
+    fn decisions(&self, py: Python<'_>, text: String, subset: Option<String>) -> PyResult<String> {
+        run(py, || {
+            let subset = self::subset(subset.as_deref())?;
+            let expected = rh_score::coverage::Expected::resolve(&self.ds, subset)?;
+            let mut out = Vec::new();
+            rh_score::Scoring::new(&self.ds, &self.cfg)
+                .with_expected(expected)
+                .with_decisions_output(Box::new(&mut out))
+                .score_reader(std::io::Cursor::new(text.as_bytes()))?;
+            String::from_utf8(out).map_err(|e| Error::Internal(e.to_string()))
         })
     }
 

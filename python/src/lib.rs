@@ -37,6 +37,16 @@ fn versions() -> PyResult<(String, String, String)> {
     })
 }
 
+/// `rh-score predict`'s generation parameters (`[generation]` of configs/predict.toml,
+/// JSON text): the temperature and max_tokens of the canonical request.
+#[pyfunction]
+fn generation_config() -> PyResult<String> {
+    errors::guard(|| {
+        let cfg = rh_score::predict::config::PredictConfig::load(None)?;
+        serde_json::to_string(&cfg.generation).map_err(|e| errors::Error::Internal(e.to_string()))
+    })
+}
+
 /// The executor's `[execution]` table (JSON text): the limits the environment runs under.
 #[pyfunction]
 fn execution_config() -> PyResult<String> {
@@ -61,6 +71,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(classify_plan, m)?)?;
     m.add_function(wrap_pyfunction!(versions, m)?)?;
     m.add_function(wrap_pyfunction!(execution_config, m)?)?;
+    m.add_function(wrap_pyfunction!(generation_config, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     m.add_function(wrap_pyfunction!(session::plan_action, m)?)?;
     m.add_function(wrap_pyfunction!(session::rest_action, m)?)?;

@@ -69,7 +69,8 @@ def executed(work, ds68, oracle_preds) -> dict:
 
 @pytest.fixture(scope="session")
 def rendered(work) -> str:
-    """A tiny rendered build (frames/ for the canonical prompt)."""
+    """A small rendered build (frames/ for the canonical prompt): 24 scenes, all in its
+    eval subset, for the inspect task's `--limit 20` (about 250 CPU-seconds to render)."""
     out = work / "rendered"
-    run("rh-pipeline", "build", "--n", "2", "--seed", "5", "--quiet", "--out", str(out))
+    run("rh-pipeline", "build", "--n", "24", "--seed", "5", "--quiet", "--out", str(out))
     return str(out)

@@ -51,6 +51,34 @@ def test_score_list_of_dicts_equals_file(ds68, preds):
     assert got == want
 
 
+def test_decisions_equal_rh_score_decisions(ds68, preds, tmp_path):
+    out = tmp_path / "decisions.jsonl"
+    run("rh-score", preds, "--dataset", ds68, "--decisions", str(out), "--quiet")
+    want = [json.loads(x) for x in out.read_text().splitlines()]
+    assert len(want) == 5 * 68 and any(d["saa"] for d in want) and not all(d["saa"] for d in want)
+    assert rh.decisions(preds, ds68) == want
+    assert rh.decisions([json.loads(x) for x in open(preds)], rh.Dataset(ds68)) == want
+    with pytest.raises(FileNotFoundError, match="predictions"):
+        rh.decisions(tmp_path / "missing.jsonl", ds68)
+
+
+def test_predict_scenes_are_predicts_selection(ds68):
+    ds = rh.Dataset(ds68)
+    valid = [r["scene_id"] for r in ds.scenes() if r["valid"]]
+    assert ds.predict_scenes("all") == valid
+    ev = set(ds.eval_ids)
+    assert ds.predict_scenes("eval") == [s for s in valid if s in ev]
+    assert ds.predict_scenes("eval", 3) == ds.predict_scenes("eval")[:3]
+    with pytest.raises(ValueError, match="subset"):
+        ds.predict_scenes("most")
+    import tomllib
+
+    from conftest import REPO
+
+    with open(REPO / "configs" / "predict.toml", "rb") as f:
+        assert rh.generation() == tomllib.load(f)["generation"]
+
+
 def test_classify_equals_the_scorers_action(ds68, executed, oracle_preds):
     ds = rh.Dataset(ds68)
     for p in oracle_preds:

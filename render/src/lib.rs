@@ -58,6 +58,7 @@ use std::collections::BTreeMap;
 
 pub use camera::{full_event_camera, view_proj};
 pub use execution::{ExecTrack, ExecVideoOptions, ExecVideos, TiledVideo};
+pub use gpu::probe_adapter;
 pub use measure::Observed;
 pub use renderer::{render_stage, with_thread_renderer, Renderer};
 pub use rh_contract::layout::{frame_file_name, frame_path};

@@ -62,6 +62,11 @@ impl Renderer {
         &self.gpu.adapter_name
     }
 
+    /// The adapter's record (name, backend, driver, CPU features) for `build.json`.
+    pub fn adapter(&self) -> &rh_contract::adapter::RenderAdapter {
+        &self.gpu.adapter
+    }
+
     /// MSAA samples per pixel in use.
     pub fn samples(&self) -> u32 {
         self.gpu.samples()

@@ -71,7 +71,7 @@ impl Expected {
 }
 
 /// One model's coverage.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct ModelCoverage {
     /// Expected scenes with a scored decision (an R1 decision is answered).
     pub answered: u64,

@@ -154,6 +154,10 @@ fn dataset_build_layout_card_and_manifest() {
     let manifest: serde_json::Value = serde_json::from_slice(&files["build.json"]).unwrap();
     assert_eq!(manifest["seed"], 11);
     assert_eq!(manifest["n"], 40);
+    assert!(
+        manifest["render_adapter"].is_null(),
+        "a label-only build records no adapter"
+    );
     assert_eq!(manifest["shard"], serde_json::json!([0, 1]));
     assert_eq!(manifest["config"]["labels"]["rule_version"], "v5");
 }

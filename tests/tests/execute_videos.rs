@@ -58,6 +58,50 @@ fn rgb(path: &Path, frame: Option<u64>) -> Vec<u8> {
     out.stdout
 }
 
+/// `frame` (RGB) is a drawn scene — its luma spans a range and no one colour fills it —
+/// and it differs from at least one of `others` in a patch far above encoder noise.
+fn assert_drawn_and_moving(frame: &[u8], others: &[Vec<u8>], what: &str) {
+    let luma: Vec<i32> = frame
+        .chunks_exact(3)
+        .map(|p| (299 * p[0] as i32 + 587 * p[1] as i32 + 114 * p[2] as i32) / 1000)
+        .collect();
+    let (lo, hi) = (luma.iter().min().unwrap(), luma.iter().max().unwrap());
+    assert!(hi - lo >= 40, "{what}: a flat frame (luma {lo}..{hi})");
+    let mut colours: Vec<[u8; 3]> = frame
+        .chunks_exact(3)
+        .map(|p| [p[0] / 16, p[1] / 16, p[2] / 16])
+        .collect();
+    colours.sort();
+    let largest = colours
+        .chunk_by(|a, b| a == b)
+        .map(|run| run.len())
+        .max()
+        .unwrap();
+    assert!(
+        largest * 10 < colours.len() * 9,
+        "{what}: one colour fills {largest} of {} pixels",
+        colours.len()
+    );
+    let changed = |other: &Vec<u8>| {
+        frame
+            .chunks_exact(3)
+            .zip(other.chunks_exact(3))
+            .filter(|(a, b)| {
+                a.iter()
+                    .zip(*b)
+                    .map(|(&x, &y)| (x as i32 - y as i32).abs())
+                    .sum::<i32>()
+                    > 48
+            })
+            .count()
+    };
+    let moved: Vec<usize> = others.iter().map(changed).collect();
+    assert!(
+        moved.iter().any(|&n| n >= 8),
+        "{what}: the middle frame shows no motion against the first and last ({moved:?} pixels changed)"
+    );
+}
+
 fn near(p: &[u8], c: [u8; 3], tol: i32) -> bool {
     p.iter()
         .zip(c)
@@ -208,15 +252,20 @@ fn execution_videos_outside_ego_tiled_and_the_outcome_figure() {
                 (duration - want as f64 / fps as f64).abs() < 0.05,
                 "{rel}: {duration} s"
             );
-            // A drawn scene, not a blank frame: many distinct colours.
-            let px = rgb(&vids.join(rel), Some(want / 2));
-            let mut colours: Vec<[u8; 3]> = px
-                .chunks_exact(3)
-                .map(|p| [p[0] / 16, p[1] / 16, p[2] / 16])
-                .collect();
-            colours.sort();
-            colours.dedup();
-            assert!(colours.len() > 20, "{rel}: {} colours", colours.len());
+            // A drawn scene, not a blank frame, and a moving one: the middle frame has
+            // light and dark parts (a lit room), and differs from the first or the last
+            // frame where something (the thrown object, the humanoid) moved. No count of
+            // distinct colours: a plain room corner honestly has few (19 under Debian's
+            // Mesa 22.3 on an AVX-512 CPU), and that count depends on the adapter.
+            let mid = rgb(&vids.join(rel), Some(want / 2));
+            assert_drawn_and_moving(
+                &mid,
+                &[
+                    rgb(&vids.join(rel), Some(0)),
+                    rgb(&vids.join(rel), Some(want - 1)),
+                ],
+                rel,
+            );
         }
     }
     // The tiled video: the two outside views side by side, as long as the longest.

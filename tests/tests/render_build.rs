@@ -178,6 +178,58 @@ fn rendered_build_has_probed_videos_frames_columns_and_merges_byte_equal() {
             "{name} differs between the build and the merge"
         );
     }
+    shards_from_two_adapters_do_not_merge(tmp.path(), &shards);
+
+    // The model-input frames are data: `datasets` (run from another folder) gives each
+    // rendered row's `<cam>_frames` as five PIL images in time order, pixel for pixel the
+    // PNG files; unrendered (invalid) rows have none; the eval config carries them too.
+    let hf_home = tempfile::tempdir().unwrap();
+    let report = python(&format!(
+        r#"
+import os, json
+os.environ["HF_HOME"] = {home:?}
+os.environ["HF_DATASETS_OFFLINE"] = "1"
+os.environ["HF_HUB_OFFLINE"] = "1"
+import numpy as np
+from PIL import Image
+import datasets
+d = {dir:?}
+os.chdir("/")
+ds = datasets.load_dataset(d, "default", split="test")
+ev = datasets.load_dataset(d, "eval", split="test")
+times = ["0.000", "0.150", "0.300", "0.450", "0.600"]
+checked, unrendered, bad = 0, 0, []
+for r in ds:
+    for cam in ["ego", "closeup", "overhead"]:
+        frames = r[cam + "_frames"]
+        if r[cam + "_file_name"] is None:
+            unrendered += frames is None
+            continue
+        if len(frames) != 5:
+            bad.append((r["scene_id"], cam, len(frames)))
+            continue
+        for t, img in zip(times, frames):
+            want = np.asarray(Image.open(os.path.join(d, "frames", r["scene_id"], cam + "_t" + t + ".png")).convert("RGB"))
+            if not isinstance(img, Image.Image) or not np.array_equal(np.asarray(img.convert("RGB")), want):
+                bad.append((r["scene_id"], cam, t))
+            checked += 1
+print(json.dumps({{"checked": checked, "unrendered": unrendered, "bad": bad,
+  "feature": str(ds.features["ego_frames"]),
+  "eval_frames": sum(1 for r in ev if r["ego_frames"] is not None and len(r["ego_frames"]) == 5),
+  "eval_rows": ev.num_rows}}))
+"#,
+        home = hf_home.path().to_str().unwrap(),
+        dir = single.to_str().unwrap()
+    ));
+    let v: serde_json::Value = serde_json::from_str(report.trim()).unwrap();
+    assert_eq!(v["bad"], serde_json::json!([]), "{v}");
+    assert_eq!(v["checked"], (rendered * 15) as u64, "{v}");
+    assert_eq!(v["unrendered"], ((8 - rendered) * 3) as u64, "{v}");
+    assert!(v["feature"].as_str().unwrap().contains("Image"), "{v}");
+    assert_eq!(
+        v["eval_frames"], v["eval_rows"],
+        "every eval scene is rendered: {v}"
+    );
 
     // The contact sheet: one tile per family.
     let sheet = tmp.path().join("sheet.png");
@@ -304,4 +356,75 @@ fn rendered_build_killed_mid_video_resumes_to_the_same_bytes() {
     for (name, bytes) in &a {
         assert!(bytes == &b[name], "{name} differs after the resumed build");
     }
+}
+
+/// `build.json` names the adapter that rendered a shard; shards whose adapters differ do
+/// not merge (exit 2, naming both adapters and both directories), and `verify` prints the
+/// recorded adapter beside this machine's. The second adapter is faked by editing a copy
+/// of shard 1's `build.json`: the manifest is not among the checksummed files, so the
+/// copy passes merge's integrity checks and is refused for its adapter alone.
+fn shards_from_two_adapters_do_not_merge(tmp: &Path, shards: &[PathBuf]) {
+    let read = |dir: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("build.json")).unwrap()).unwrap()
+    };
+    let ours = read(&shards[0])["render_adapter"].clone();
+    assert!(
+        ours["name"].as_str().is_some_and(|n| !n.is_empty()) && ours["backend"].is_string(),
+        "build.json records the adapter: {ours}"
+    );
+    let other = tmp.join("s1-other-adapter");
+    let cp = Command::new("cp")
+        .arg("-r")
+        .arg(&shards[1])
+        .arg(&other)
+        .status()
+        .unwrap();
+    assert!(cp.success());
+    let mut m = read(&other);
+    m["render_adapter"]["name"] = "Other GPU 9000".into();
+    m["render_adapter"]["driver_info"] = "other driver 1.0".into();
+    std::fs::write(
+        other.join("build.json"),
+        serde_json::to_string_pretty(&m).unwrap(),
+    )
+    .unwrap();
+    let out = run(
+        "rh-pipeline",
+        &[
+            "merge",
+            tmp.join("m-adapters").to_str().unwrap(),
+            shards[0].to_str().unwrap(),
+            other.to_str().unwrap(),
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    for needle in [
+        "different adapters",
+        ours["name"].as_str().unwrap(),
+        "Other GPU 9000",
+        shards[0].to_str().unwrap(),
+        other.to_str().unwrap(),
+    ] {
+        assert!(err.contains(needle), "'{needle}' not in: {err}");
+    }
+    assert!(!tmp.join("m-adapters").exists());
+    // verify reports the recorded adapter and this machine's, and when they differ.
+    let same = run_ok(
+        "rh-pipeline",
+        &["verify", shards[0].to_str().unwrap(), "--fast"],
+    );
+    assert!(
+        same.contains("render adapter (recorded)") && same.contains("(the same)"),
+        "{same}"
+    );
+    let differs = run(
+        "rh-pipeline",
+        &["verify", other.to_str().unwrap(), "--fast"],
+    );
+    let text = String::from_utf8_lossy(&differs.stdout);
+    assert!(
+        text.contains("Other GPU 9000") && text.contains("DIFFERS"),
+        "{text}"
+    );
 }

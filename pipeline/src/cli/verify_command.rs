@@ -13,9 +13,17 @@ pub fn run(dir: &Path, catalog: &Catalog, fast: bool, json: bool) -> Result<(), 
         verify(dir, catalog)
     }
     .map_err(input)?;
+    let adapter = adapter_lines(dir);
     if json {
+        // The report on stdout stays one JSON object; the adapter lines go to stderr.
+        for line in &adapter {
+            eprintln!("{line}");
+        }
         print_json(&report);
     } else {
+        for line in &adapter {
+            println!("{line}");
+        }
         for p in &report.file_problems {
             println!("FILE {}: {}", p.file, p.problem);
         }
@@ -55,4 +63,32 @@ pub fn run(dir: &Path, catalog: &Catalog, fast: bool, json: bool) -> Result<(), 
             report.mismatches.len()
         )))
     }
+}
+
+/// The adapter the build recorded and this machine's, and whether they differ (frames
+/// rendered here would then not be the same model inputs).
+fn adapter_lines(dir: &Path) -> Vec<String> {
+    let recorded = match rh_dataset::manifest::Manifest::read(dir) {
+        Ok(Some(m)) => m.render_adapter,
+        _ => return Vec::new(),
+    };
+    let Some(recorded) = recorded else {
+        return vec!["render adapter: none recorded (a label-only build, or an older one)".into()];
+    };
+    let mut lines = vec![format!(
+        "render adapter (recorded): {}",
+        recorded.describe()
+    )];
+    #[cfg(feature = "render")]
+    match rh_render::probe_adapter() {
+        Ok(here) if here == recorded => {
+            lines.push(format!("render adapter (this machine): {} (the same)", here.describe()))
+        }
+        Ok(here) => lines.push(format!(
+            "render adapter (this machine): {} (DIFFERS: frames rendered here may not be the same model inputs)",
+            here.describe()
+        )),
+        Err(e) => lines.push(format!("render adapter (this machine): none ({e})")),
+    }
+    lines
 }

@@ -9,6 +9,7 @@ mod ids;
 use super::mesh::Vertex;
 use super::RenderError;
 pub use ids::{IdImage, IdPass, IdView};
+pub use setup::probe_adapter;
 use std::ops::Range;
 
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -85,6 +86,8 @@ pub struct Gpu {
     device: wgpu::Device,
     queue: wgpu::Queue,
     pub adapter_name: String,
+    /// What `build.json` records of the adapter.
+    pub adapter: rh_contract::adapter::RenderAdapter,
     samples: u32,
     main: wgpu::RenderPipeline,
     /// Depth only (no colour written): the moving bodies' pre-pass.

@@ -1,6 +1,7 @@
 //! Opening the GPU and building the render pipelines (`Gpu::new`).
 
 use super::*;
+use rh_contract::adapter::RenderAdapter;
 
 /// What differs between the render pipelines.
 struct PipelineDesc<'a> {
@@ -19,12 +20,9 @@ struct PipelineDesc<'a> {
 const VERTEX_ATTRS: [wgpu::VertexAttribute; 3] =
     wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4];
 
-/// The device and queue of the adapter, its name, and the MSAA sample count to use
-/// (`samples` on a hardware GPU, `cpu_samples` on a CPU rasterizer; 4 or 1).
-fn open_device(
-    samples: u32,
-    cpu_samples: u32,
-) -> Result<(wgpu::Device, wgpu::Queue, String, u32), RenderError> {
+/// The adapter the renderer uses: Vulkan unless `WGPU_BACKEND` says otherwise, the
+/// high-performance one (a GPU before lavapipe).
+fn request_adapter() -> Result<wgpu::Adapter, RenderError> {
     if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
         // Silences a harmless probe error of the Vulkan loader on headless machines.
         // SAFETY: called before any other thread of ours reads the environment here.
@@ -35,7 +33,7 @@ fn open_device(
         desc.backends = wgpu::Backends::VULKAN;
     }
     let instance = wgpu::Instance::new(desc);
-    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+    pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
         power_preference: wgpu::PowerPreference::HighPerformance,
         force_fallback_adapter: false,
         compatible_surface: None,
@@ -45,8 +43,52 @@ fn open_device(
         RenderError::NoAdapter(format!(
             "{e} (install a Vulkan driver: Mesa's lavapipe, package mesa-vulkan-drivers)"
         ))
-    })?;
+    })
+}
+
+/// What `build.json` records of an adapter: wgpu's `AdapterInfo`, and for a CPU
+/// rasterizer the CPU's vector features and `LP_NATIVE_VECTOR_WIDTH`.
+fn adapter_record(info: &wgpu::AdapterInfo) -> RenderAdapter {
+    let cpu = info.device_type == wgpu::DeviceType::Cpu;
+    RenderAdapter {
+        name: info.name.clone(),
+        backend: info.backend.to_str().to_string(),
+        device_type: match info.device_type {
+            wgpu::DeviceType::Cpu => "cpu",
+            wgpu::DeviceType::DiscreteGpu => "discrete_gpu",
+            wgpu::DeviceType::IntegratedGpu => "integrated_gpu",
+            wgpu::DeviceType::VirtualGpu => "virtual_gpu",
+            wgpu::DeviceType::Other => "other",
+        }
+        .to_string(),
+        driver: info.driver.clone(),
+        driver_info: info.driver_info.clone(),
+        cpu_features: if cpu {
+            rh_contract::adapter::cpu_vector_features()
+        } else {
+            Vec::new()
+        },
+        lp_native_vector_width: cpu
+            .then(|| std::env::var(rh_contract::adapter::LP_NATIVE_VECTOR_WIDTH).ok())
+            .flatten(),
+    }
+}
+
+/// The adapter this machine would render on, without opening a device (`rh-pipeline
+/// verify` compares it with the one a build recorded).
+pub fn probe_adapter() -> Result<RenderAdapter, RenderError> {
+    Ok(adapter_record(&request_adapter()?.get_info()))
+}
+
+/// The device and queue of the adapter, its record, and the MSAA sample count to use
+/// (`samples` on a hardware GPU, `cpu_samples` on a CPU rasterizer; 4 or 1).
+fn open_device(
+    samples: u32,
+    cpu_samples: u32,
+) -> Result<(wgpu::Device, wgpu::Queue, RenderAdapter, u32), RenderError> {
+    let adapter = request_adapter()?;
     let info = adapter.get_info();
+    let record = adapter_record(&info);
     let adapter_name = info.name;
     let samples = if info.device_type == wgpu::DeviceType::Cpu {
         cpu_samples
@@ -61,7 +103,7 @@ fn open_device(
     }))
     .map_err(|e| RenderError::NoAdapter(format!("request device on {adapter_name}: {e}")))?;
     let samples = if samples >= 4 { 4 } else { 1 };
-    Ok((device, queue, adapter_name, samples))
+    Ok((device, queue, record, samples))
 }
 
 /// The bind group layouts: the shadow pass's (uniforms) and the lit passes' (uniforms,
@@ -245,7 +287,8 @@ impl Gpu {
     /// hardware GPU, `cpu_samples` on a CPU rasterizer (4 or 1 each); `fxaa`: a
     /// post-process anti-aliasing pass on lit frames wherever MSAA is off.
     pub fn new(samples: u32, cpu_samples: u32, fxaa: bool) -> Result<Gpu, RenderError> {
-        let (device, queue, adapter_name, samples) = open_device(samples, cpu_samples)?;
+        let (device, queue, adapter, samples) = open_device(samples, cpu_samples)?;
+        let adapter_name = adapter.name.clone();
         let post = (fxaa && samples == 1).then(|| post::Post::new(&device));
         let (shadow_bgl, main_bgl) = bind_group_layouts(&device);
         let layout = |bgl: &wgpu::BindGroupLayout| {
@@ -299,6 +342,7 @@ impl Gpu {
             device,
             queue,
             adapter_name,
+            adapter,
             samples,
             main,
             depth_only,

@@ -54,6 +54,12 @@ pub struct Cli {
     #[arg(long, value_name = "DIR")]
     pub html: Option<PathBuf>,
 
+    /// Write one results file per model into this directory (DIR/<model>.json: what was
+    /// measured — dataset, prompt, rules — coverage and every headline metric with its
+    /// interval; schemas/results.schema.json), for `rh-score leaderboard`.
+    #[arg(long, value_name = "DIR")]
+    pub results: Option<PathBuf>,
+
     /// Write one JSON line per decision (its action, rules and metrics).
     #[arg(long, value_name = "FILE")]
     pub decisions: Option<PathBuf>,
@@ -143,6 +149,24 @@ pub enum Cmd {
         /// Scoring configuration (body constants, thresholds).
         #[arg(long, value_name = "FILE")]
         config: Option<PathBuf>,
+    },
+    /// Merge results files (`rh-score PREDS --results DIR`) into one leaderboard: one row
+    /// per model run with coverage and headline metrics with their 95% intervals. Runs
+    /// measured on different datasets, label rules, prompts or scoring configurations are
+    /// refused (exit 2, naming the field, the two values and the two files).
+    Leaderboard {
+        /// Results files (DIR/<model>.json).
+        #[arg(required = true, value_name = "FILE")]
+        files: Vec<PathBuf>,
+        /// Write the board as a one-page site into this directory (DIR/index.html).
+        #[arg(long, value_name = "DIR")]
+        html: Option<PathBuf>,
+        /// Write the board as Markdown.
+        #[arg(long, value_name = "FILE")]
+        markdown: Option<PathBuf>,
+        /// Print the merged board as JSON on stdout (instead of the table).
+        #[arg(long)]
+        json: bool,
     },
     /// Run a model over a dataset through the OpenAI-compatible chat API with the
     /// canonical prompt (configs/prompt.toml) and write preds.jsonl. Resumes: run it again

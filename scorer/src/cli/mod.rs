@@ -6,6 +6,7 @@
 pub mod args;
 pub mod baseline_command;
 pub mod dataset_arg;
+pub mod leaderboard_command;
 pub mod output;
 #[cfg(feature = "predict")]
 pub mod predict_command;
@@ -28,6 +29,12 @@ pub fn run(cli: Cli) -> Result<()> {
             model,
             config,
         }) => baseline_command::run(kind, dataset, seed, model, config.as_deref()),
+        Some(Cmd::Leaderboard {
+            files,
+            html,
+            markdown,
+            json,
+        }) => leaderboard_command::run(&files, html.as_deref(), markdown.as_deref(), json),
         #[cfg(feature = "predict")]
         Some(Cmd::Predict(a)) => predict_command::run(*a),
         #[cfg(feature = "synthetic")]

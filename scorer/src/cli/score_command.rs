@@ -88,7 +88,18 @@ pub fn run(cli: Cli) -> Result<()> {
             videos,
         )?);
     }
+    let identity = match cli.results {
+        Some(_) => Some(crate::results::DatasetIdentity::of(&ds, &scoring.expected)?),
+        None => None,
+    };
     drop(scoring);
+    if let (Some(dir), Some(identity)) = (&cli.results, &identity) {
+        let scoring_id = crate::results::ScoringIdentity::of(&cfg, cli.answered_only);
+        let files = crate::results::results_files(&report, identity, &scoring_id);
+        for p in crate::results::write_results(dir, &files)? {
+            eprintln!("rh-score: results file {}", p.display());
+        }
+    }
     write_reports(&cli, &report, &ds, &cfg, &preds)
 }
 

@@ -39,8 +39,8 @@ use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-const CSS: &str = include_str!("assets/site.css");
-const JS: &str = include_str!("assets/site.js");
+pub(crate) const CSS: &str = include_str!("assets/site.css");
+pub(crate) const JS: &str = include_str!("assets/site.js");
 /// Marks a directory as a site written by rh-score (only such a directory is replaced).
 const MARKER: &str = ".rh-score-site";
 /// The video columns and the camera each shows (`full_event` is the outside view).
@@ -155,21 +155,37 @@ fn script_json(v: &impl Serialize) -> Result<String> {
     Ok(serde_json::to_string(v)?.replace("</", "<\\/"))
 }
 
-fn esc(s: &str) -> String {
+pub(crate) fn esc(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")
 }
 
+/// The site's navigation bar.
+const SITE_NAV: &str =
+    "<a href=\"index.html\">Leaderboard</a><a href=\"index.html#figures\">Figures</a>\
+    <a href=\"scenes.html\">Scenes</a>";
+
 fn page(title: &str, body_id: &str, body: &str, scripts: &[&str]) -> String {
+    page_with(title, body_id, body, scripts, SITE_NAV)
+}
+
+/// A page of the site's style (`assets/site.css`) with the navigation bar `nav` (links;
+/// `rh-score leaderboard --html` has only its board).
+pub(crate) fn page_with(
+    title: &str,
+    body_id: &str,
+    body: &str,
+    scripts: &[&str],
+    nav: &str,
+) -> String {
     let mut s = format!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
          <title>{}</title>\n<link rel=\"stylesheet\" href=\"assets/site.css\">\n</head>\n\
          <body id=\"{body_id}\">\n<header><a class=\"brand\" href=\"index.html\">ReactHuman</a>\
-         <nav><a href=\"index.html\">Leaderboard</a><a href=\"index.html#figures\">Figures</a>\
-         <a href=\"scenes.html\">Scenes</a></nav></header>\n<main>\n{body}\n</main>\n",
+         <nav>{nav}</nav></header>\n<main>\n{body}\n</main>\n",
         esc(title)
     );
     // The page code first: data scripts call into it (`RH.index(...)`).

@@ -1,0 +1,34 @@
+//! `rh-score leaderboard FILE...`: results files merged into one board
+//! ([`crate::leaderboard::merge`]), printed and written in the forms asked for.
+
+use super::output::print_out;
+use crate::error::InputError;
+use crate::leaderboard::{merge, render};
+use anyhow::Result;
+use std::path::{Path, PathBuf};
+
+/// Merges `files`; writes `--html`, `--markdown`; prints the table (or JSON with `--json`).
+pub fn run(
+    files: &[PathBuf],
+    html: Option<&Path>,
+    markdown: Option<&Path>,
+    json: bool,
+) -> Result<()> {
+    let board = merge(files)?;
+    if let Some(dir) = html {
+        render::write_html(&board, dir)?;
+        eprintln!(
+            "rh-score: leaderboard site in {}",
+            dir.join("index.html").display()
+        );
+    }
+    if let Some(p) = markdown {
+        rh_contract::fsio::write_atomic(p, render::markdown(&board).as_bytes())
+            .map_err(|e| InputError(format!("--markdown: cannot write {}: {e}", p.display())))?;
+    }
+    if json {
+        print_out(&(serde_json::to_string_pretty(&board)? + "\n"))
+    } else {
+        print_out(&render::terminal(&board))
+    }
+}
