@@ -115,6 +115,18 @@ pub fn run_group(
     Ok((results, rejections))
 }
 
+/// Frames one set of cameras for a group's bands and labels and validates each band.
+fn label_group(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> Vec<SceneResult> {
+    let bands: Vec<(&SceneSpec, &Simulation)> = runs.iter().map(|(s, m)| (s, m)).collect();
+    let framed = cameras::frame_group(&bands, &config.validators.framing()).unwrap_or_default();
+    runs.into_iter()
+        .map(|(mut spec, sim)| {
+            spec.cameras = framed.clone();
+            label_scene(spec, sim, config)
+        })
+        .collect()
+}
+
 /// Simulates one spec (plain and counterfactual), frames its cameras (as a group of
 /// one; a build frames a group's bands together, see `produce_group`), labels and
 /// validates.
@@ -272,17 +284,18 @@ pub fn produce_group_counted(
             let sim = simulate(&spec, SimOptions::default());
             runs.push((spec, sim));
         }
-        // Label rule v5: the observer stands on the bands' hazard paths (one pose).
-        crate::aim::aim_group(&mut runs, &config.aim);
-        let bands: Vec<(&SceneSpec, &Simulation)> = runs.iter().map(|(s, m)| (s, m)).collect();
-        let framed = cameras::frame_group(&bands, &config.validators.framing()).unwrap_or_default();
-        results = runs
-            .into_iter()
-            .map(|(mut spec, sim)| {
-                spec.cameras = framed.clone();
-                label_scene(spec, sim, config)
-            })
-            .collect();
+        // Label rule v5: the observer stands on the bands' hazard paths (one pose). An
+        // aimed pose the validators reject (the hazard out of the ego view, too early to
+        // react) falls back to the family's own pose before a new attempt is drawn.
+        let unaimed = runs.clone();
+        let aimed = crate::aim::aim_group(&mut runs, &config.aim).is_some();
+        results = label_group(runs, config);
+        if aimed && !results.iter().all(|r| r.verdicts.all()) {
+            let fallback = label_group(unaimed, config);
+            if fallback.iter().all(|r| r.verdicts.all()) {
+                results = fallback;
+            }
+        }
         if results.iter().all(|r| r.verdicts.all()) {
             break;
         }
