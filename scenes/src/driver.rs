@@ -291,6 +291,11 @@ pub fn produce_group_counted(
         let aimed = crate::aim::aim_group(&mut runs, &config.aim).is_some();
         results = label_group(runs, config);
         if aimed && !results.iter().all(|r| r.verdicts.all()) {
+            if std::env::var_os("RH_AIM_DEBUG").is_some() {
+                let failed: Vec<[bool; VALIDATOR_COLUMNS.len()]> =
+                    results.iter().map(|r| r.verdicts.as_array()).collect();
+                eprintln!("aim fallback {} {}: {failed:?}", results[0].spec.family, results[0].spec.selection.object_id);
+            }
             let fallback = label_group(unaimed, config);
             if fallback.iter().all(|r| r.verdicts.all()) {
                 results = fallback;

@@ -20,6 +20,28 @@ pub struct ChainReaction;
 /// The trigger block slides on felt pads.
 const TRIGGER_FRICTION: f64 = 0.02;
 
+/// When every band's trigger strikes the target (s after t0): the target then leaves the
+/// edge after Δ (0.6 s) plus the reaction time (0.2 s).
+pub const STRIKE_S: [f64; 2] = [0.75, 0.9];
+
+/// The trigger's run-up (m) when not aimed at the hands (label rule v4's range).
+pub const FLOOR_GAP_M: [f64; 2] = [1.1, 1.5];
+
+fn lerp(range: [f64; 2], u: f64) -> f64 {
+    range[0] + (range[1] - range[0]) * u
+}
+
+/// The least table height (m): from there the target falls through the hands' heights.
+pub const TABLE_MIN_M: f64 = 0.8;
+
+/// The run-up (m) a trigger sliding at `speed` on its felt pads covers in `t` seconds.
+pub fn gap_for(speed: f64, t: f64) -> f64 {
+    let decel = TRIGGER_FRICTION * GRAVITY;
+    let stop = speed / decel;
+    let t = t.min(stop);
+    speed * t - 0.5 * decel * t * t
+}
+
 impl Family for ChainReaction {
     fn info(&self) -> FamilyInfo {
         FamilyInfo {
@@ -34,11 +56,24 @@ impl Family for ChainReaction {
         let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
         let dir = heading(heading_angle);
         let side = left_of(dir);
+        // At least hip height: the target leaves it where the hands can hold it.
         let height = uniform(rng, input.room.table_height[0], input.room.table_height[1]);
         let half_width = uniform(rng, 0.35, 0.6);
         let friction = uniform(rng, 0.08, 0.15);
         let behind = uniform(rng, 0.15, 0.45);
-        let gap = uniform(rng, 1.1, 1.5);
+        // Every band's trigger strikes after the same drawn time (label rule v5: the target
+        // leaves the edge after Δ plus the reaction time): a faster trigger starts farther
+        // back, `gap_for` its speed; the table is as long as the fastest band needs.
+        let u = uniform(rng, 0.0, 1.0);
+        // Aimed at the hands, every band's trigger strikes after the same drawn time (the
+        // target leaves the edge after Δ plus the reaction time; a faster trigger starts
+        // farther back, `gap_for` its speed). Else (aimed at the body, or a near miss) the
+        // drawn run-up of label rule v4: the target reaches the observer along the floor.
+        let hands = input.intent == crate::intent::Intent::Hands;
+        let t_strike = lerp(STRIKE_S, u);
+        let gap_of = |v: f64| if hands { gap_for(v, t_strike) } else { lerp(FLOOR_GAP_M, u) };
+        let gap = gap_of(input.speed);
+        let longest_gap = input.band_speeds.iter().map(|&v| gap_of(v)).fold(0.0, f64::max);
         let lateral = uniform(rng, -0.12, 0.12);
         let origin = event_origin(rng, input.room, dir, 0.4 + far_shift(input));
 
@@ -56,7 +91,9 @@ impl Family for ChainReaction {
             (target_h / 2.0).clamp(0.01, 0.15),
         ];
         // The table reaches from behind the trigger to the edge.
-        let needed = 2.0 * trigger_half[0] + gap + half_len * (1.0 + behind) + 0.15;
+        // Aimed at the hands, a table at least at hip height.
+        let height = if hands { height.max(TABLE_MIN_M) } else { height };
+        let needed = 2.0 * trigger_half[0] + longest_gap + half_len * (1.0 + behind) + 0.15;
         let half_depth = (needed / 2.0).max(0.3);
         let table = table_block(
             "table",
@@ -100,18 +137,22 @@ impl Family for ChainReaction {
             input.far_observer,
             target_xy,
         );
+        let mut params = BTreeMap::from([
+            ("table_height_m".into(), height),
+            ("com_behind_edge_m".into(), behind * half_len),
+            ("trigger_gap_m".into(), gap),
+            ("drop_height_m".into(), height),
+        ]);
+        if hands {
+            params.insert("strike_time_s".into(), t_strike);
+        }
         Layout {
             bodies: vec![table, trigger, target],
             joints: vec![],
             hazard: 2,
             source_support: Some(0),
             observer,
-            params: BTreeMap::from([
-                ("table_height_m".into(), height),
-                ("com_behind_edge_m".into(), behind * half_len),
-                ("trigger_gap_m".into(), gap),
-                ("drop_height_m".into(), height),
-            ]),
+            params,
         }
     }
 

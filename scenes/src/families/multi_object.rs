@@ -11,9 +11,20 @@
 //! table and of the fall: the hazard reaches them only on the floor, after the run-up,
 //! the collisions down the row and the fall.
 
+use super::launch::rests_on_a_ball;
 use super::*;
 
 pub struct MultiObject;
+
+/// When every band's shoved object reaches the row (s after t0).
+pub const HIT_S: [f64; 2] = [0.7, 0.85];
+
+/// The run-up (m) when not aimed at the hands (label rule v4's range).
+pub const FLOOR_RUN_UP_M: [f64; 2] = [0.3, 0.5];
+
+/// Aimed at the hands, the least table height (m): from there the last object falls
+/// through the hands' heights.
+pub const TABLE_MIN_M: f64 = 0.8;
 
 impl Family for MultiObject {
     fn info(&self) -> FamilyInfo {
@@ -34,8 +45,30 @@ impl Family for MultiObject {
         let friction = uniform(rng, 0.03, 0.1);
         let count = if uniform(rng, 0.0, 1.0) < 0.5 { 3 } else { 4 };
         let mut gaps = [0, 1, 2].map(|_| uniform(rng, 0.005, 0.03));
-        // The run-up: the shoved object starts well back from the rest of the row.
-        gaps[0] += uniform(rng, 0.3, 0.5);
+        // The run-up: the shoved object starts back from the rest of the row, by what it
+        // slides in a drawn time (label rule v5: every band's row is struck then, so the
+        // last object leaves the edge after Δ plus the reaction time; a faster shove starts
+        // farther back). The table is as long as the fastest band needs.
+        // Aimed at the hands only; else (at the body, a near miss) label rule v4's drawn
+        // run-up: the hazard reaches the observer along the floor.
+        let u = uniform(rng, 0.0, 1.0);
+        let hands = input.intent == crate::intent::Intent::Hands;
+        let t_hit = HIT_S[0] + (HIT_S[1] - HIT_S[0]) * u;
+        let decel = if rests_on_a_ball(object) {
+            0.0
+        } else {
+            0.5 * (object.friction + friction) * GRAVITY
+        };
+        let run_up = |v: f64| {
+            if !hands {
+                return FLOOR_RUN_UP_M[0] + (FLOOR_RUN_UP_M[1] - FLOOR_RUN_UP_M[0]) * u;
+            }
+            let t = t_hit.min(if decel > 0.0 { v / decel } else { f64::INFINITY });
+            v * t - 0.5 * decel * t * t
+        };
+        let longest_run_up = input.band_speeds.iter().map(|&v| run_up(v)).fold(0.0, f64::max);
+        gaps[0] += run_up(input.speed);
+        let height = if hands { height.max(TABLE_MIN_M) } else { height };
         let behind = uniform(rng, 0.15, 0.4);
         let lateral = uniform(rng, -0.12, 0.12);
         let origin = event_origin(rng, input.room, dir, 0.5 + far_shift(input));
@@ -44,7 +77,8 @@ impl Family for MultiObject {
         let rotation = quat::mul(yaw_quat(heading_angle), pose);
         let half_len = object.half_extents()[0];
         let row: f64 = 2.0 * half_len * count as f64 + gaps[..count - 1].iter().sum::<f64>();
-        let half_depth = ((row + 0.2) / 2.0).max(0.3);
+        let longest_row = row - run_up(input.speed) + longest_run_up;
+        let half_depth = ((longest_row + 0.2) / 2.0).max(0.3);
         let table = table_block(
             "table",
             origin,
@@ -97,6 +131,7 @@ impl Family for MultiObject {
             params: BTreeMap::from([
                 ("table_height_m".into(), height),
                 ("row_count".into(), count as f64),
+                ("run_up_m".into(), run_up(input.speed)),
                 ("com_behind_edge_m".into(), behind * half_len),
                 ("drop_height_m".into(), height),
             ]),

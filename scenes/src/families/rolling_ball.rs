@@ -13,6 +13,13 @@ pub struct RollingBall;
 /// Least floor distance between the fastest band's landing point and the observer (m).
 pub const OBSERVER_GAP_M: f64 = 1.3;
 
+/// When every band's ball leaves the table edge (s after t0): after Δ (0.6 s) plus the
+/// reaction time (0.2 s), a little before the label's earliest meeting.
+pub const EDGE_S: [f64; 2] = [0.8, 0.95];
+
+/// The least counter height (m): from there the ball falls through the hands' heights.
+pub const COUNTER_MIN_M: f64 = 0.8;
+
 impl Family for RollingBall {
     fn info(&self) -> FamilyInfo {
         FamilyInfo {
@@ -26,12 +33,16 @@ impl Family for RollingBall {
         let room = input.room;
         let heading_angle = diagonal_heading(rng, room, 0.2);
         let dir = heading(heading_angle);
-        let height = uniform(rng, room.table_height[0], room.table_height[1]);
+        // A counter at least at hip height: the ball leaves it where the hands can hold it.
+        let height = uniform(rng, room.table_height[0], room.table_height[1]).max(COUNTER_MIN_M);
         let surface_half = [uniform(rng, 0.35, 0.5), uniform(rng, 0.35, 0.7)];
         let surface_friction = uniform(rng, 0.4, 0.7);
         let lateral = uniform(rng, -0.2, 0.2);
-        // A rolling ball keeps its speed, so it may start well behind the edge.
-        let com_to_edge = uniform(rng, 0.08, 0.3);
+        // A rolling ball keeps its speed: it starts `speed · t_edge` behind the edge, so
+        // every band leaves the edge after the same drawn time (label rule v5: after Δ
+        // plus the reaction time, then it falls through the hands' heights).
+        let t_edge = uniform(rng, EDGE_S[0], EDGE_S[1]);
+        let com_to_edge = input.speed * t_edge;
         let gap_near = uniform(rng, OBSERVER_GAP_M, OBSERVER_GAP_M + 0.6);
         let gap_far = uniform(rng, OBSERVER_GAP_M + 1.5, OBSERVER_GAP_M + 2.0);
         let side = uniform(rng, -0.3, 0.3);
@@ -45,6 +56,8 @@ impl Family for RollingBall {
             } else {
                 gap_near
             };
+        let longest_run = fastest * t_edge + 0.1;
+        let surface_half = [surface_half[0].max(longest_run / 2.0), surface_half[1]];
         let length = (surface_half[0] * 2.0 + beyond).min(room_span(room, dir, 0.55));
         let back = span_start(rng, room, dir, length, 0.55);
         let origin = ahead(back, dir, surface_half[0]);
@@ -78,6 +91,7 @@ impl Family for RollingBall {
             params: BTreeMap::from([
                 ("table_height_m".into(), height),
                 ("com_behind_edge_m".into(), com_to_edge),
+                ("edge_time_s".into(), t_edge),
                 ("drop_height_m".into(), height),
             ]),
         }
