@@ -12,6 +12,16 @@ pub struct SlidingObject;
 const CONE_MARGIN_RAD: f64 = 0.07;
 const MAX_ANGLE_RAD: f64 = 0.80;
 
+/// Aimed at the hands: when every band leaves the ramp (s after t0), the height of its
+/// lower end (m), and the longest ramp (m).
+pub const HANDS_OFF_S: [f64; 2] = [0.8, 0.95];
+pub const HANDS_END_M: [f64; 2] = [0.75, 0.9];
+pub const HANDS_MAX_LENGTH_M: f64 = 2.6;
+
+fn lerp(range: [f64; 2], u: f64) -> f64 {
+    range[0] + (range[1] - range[0]) * u
+}
+
 impl Family for SlidingObject {
     fn info(&self) -> FamilyInfo {
         FamilyInfo {
@@ -31,12 +41,31 @@ impl Family for SlidingObject {
         let cone = mu.atan();
         let angle = (cone + CONE_MARGIN_RAD + uniform(rng, 0.0, 0.15))
             .min(MAX_ANGLE_RAD.max(cone + CONE_MARGIN_RAD));
-        let length = uniform(rng, 1.2, 2.0);
+        let u_length = uniform(rng, 0.0, 1.0);
         let half_width = uniform(rng, 0.25, 0.35);
         let start_gap = uniform(rng, 0.05, 0.2);
         // The lower end stands on a low support, so the object slides off the end and
         // drops rather than jamming its front edge into the floor at the kink.
-        let end_height = uniform(rng, 0.15, 0.35);
+        let u_end = uniform(rng, 0.0, 1.0);
+        // Aimed at the hands (label rule v5), a chute whose lower end is at hip height and
+        // every band slides off it after the same drawn time: a faster band starts lower
+        // on the ramp, which is as long as the fastest band needs (at most
+        // `HANDS_MAX_LENGTH_M`). Else label rule v4's drawn ramp, ending near the floor.
+        let hands = input.intent == crate::intent::Intent::Hands;
+        let accel = GRAVITY * (angle.sin() - mu * angle.cos());
+        let t_off = lerp(HANDS_OFF_S, u_length);
+        let slide = |v: f64| v * t_off + 0.5 * accel * t_off * t_off;
+        let fastest = input.band_speeds.iter().copied().fold(0.0, f64::max);
+        let (length, end_height) = if hands {
+            (
+                (slide(fastest) + 0.2 + 2.0 * footprint_half_length(object, 0.0))
+                    .min(HANDS_MAX_LENGTH_M)
+                    .min((input.room.ceiling_height - 0.3 - HANDS_END_M[1]) / angle.sin()),
+                lerp(HANDS_END_M, u_end),
+            )
+        } else {
+            (lerp([1.2, 2.0], u_length), lerp([0.15, 0.35], u_end))
+        };
         let origin = event_origin(rng, input.room, dir, 0.8);
         let thickness = 0.04;
 
@@ -61,7 +90,11 @@ impl Family for SlidingObject {
         );
         let half_len = footprint_half_length(object, 0.0);
         // Distance (along the slope) from the object's centre to the ramp's lower end.
-        let slide_distance = length - start_gap - half_len;
+        let slide_distance = if hands {
+            slide(input.speed).min(length - start_gap - half_len)
+        } else {
+            length - start_gap - half_len
+        };
         let position = along(slide_distance, bottom_offset(object));
         let linvel = downhill.map(|c| c * input.speed);
         let hazard = hazard_body(object, position, rotation, linvel, [0.0; 3]);
