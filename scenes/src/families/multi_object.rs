@@ -19,6 +19,9 @@ pub struct MultiObject;
 /// When every band's shoved object reaches the row (s after t0).
 pub const HIT_S: [f64; 2] = [0.7, 0.85];
 
+/// The least share of its shove the first object keeps over a timed run-up.
+pub const KEPT_SPEED: f64 = 0.3;
+
 /// The run-up (m) when not aimed at the hands (label rule v4's range).
 pub const FLOOR_RUN_UP_M: [f64; 2] = [0.3, 0.5];
 
@@ -52,13 +55,18 @@ impl Family for MultiObject {
         // Aimed at the hands only; else (at the body, a near miss) label rule v4's drawn
         // run-up: the hazard reaches the observer along the floor.
         let u = uniform(rng, 0.0, 1.0);
-        let hands = input.intent == crate::intent::Intent::Hands;
         let t_hit = HIT_S[0] + (HIT_S[1] - HIT_S[0]) * u;
         let decel = if rests_on_a_ball(object) {
             0.0
         } else {
             0.5 * (object.friction + friction) * GRAVITY
         };
+        // Timed only while the long run-up keeps most of the shove (a rolling or slippery
+        // object): a slider that loses more than `KEPT_SPEED` of the slowest shove no
+        // longer pushes the row off the edge.
+        let slowest = input.band_speeds.iter().copied().fold(f64::INFINITY, f64::min);
+        let hands = input.intent == crate::intent::Intent::Hands
+            && decel * t_hit <= (1.0 - KEPT_SPEED) * slowest;
         let run_up = |v: f64| {
             if !hands {
                 return FLOOR_RUN_UP_M[0] + (FLOOR_RUN_UP_M[1] - FLOOR_RUN_UP_M[0]) * u;
