@@ -8,9 +8,9 @@
 
 use crate::manifest::Manifest;
 use crate::table;
-use rh_scenes::eval_subset::{self, EvalConfig, EvalRow};
 use arrow::array::{Array, RecordBatch};
 use arrow::datatypes::DataType;
+use rh_scenes::eval_subset::{self, EvalConfig, EvalRow};
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
@@ -700,7 +700,6 @@ mod tests {
         );
         assert!(t.contains("| lower_leg | 130 | 60 | 75 | 0.56 |"), "{t}");
     }
-
 
     #[test]
     fn size_categories() {

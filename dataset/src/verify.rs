@@ -149,8 +149,14 @@ pub fn verify(dir: &Path, catalog: &Catalog) -> Result<VerifyReport, String> {
             // selections (group g takes g mod len); else the lexicon plans the group.
             let selection = match manifest.selections.as_deref() {
                 Some(s) if !s.is_empty() => s[(g % s.len() as u64) as usize].clone(),
-                _ => plan_group_with(catalog, &manifest.families, manifest.seed, g, &config.plan_policy())
-                    .map_err(|e| e.to_string())?,
+                _ => plan_group_with(
+                    catalog,
+                    &manifest.families,
+                    manifest.seed,
+                    g,
+                    &config.plan_policy(),
+                )
+                .map_err(|e| e.to_string())?,
             };
             let mut results = produce_group(
                 &selection,

@@ -333,7 +333,9 @@ pub fn meets(spec: &SceneSpec, sim: &Simulation, cfg: &AimConfig, intent: Intent
     if reached.is_some_and(|k| k < from) {
         return false;
     }
-    let closest = (from..=sim.steps()).map(distance).fold(f64::INFINITY, f64::min);
+    let closest = (from..=sim.steps())
+        .map(distance)
+        .fold(f64::INFINITY, f64::min);
     match intent {
         Intent::Miss => closest > spec.labels.reach_radius,
         Intent::Body => closest <= o.torso_radius + 0.5 * radius + cfg.touch_slack,

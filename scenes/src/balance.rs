@@ -14,11 +14,11 @@
 
 use crate::config::Config;
 use crate::driver::produce_group_counted;
-use crate::families;
 use crate::eval_subset::{EvalConfig, EvalRow};
+use crate::families;
 use crate::label::Action;
-use rayon::prelude::*;
 use crate::selection::plan_group_with;
+use rayon::prelude::*;
 use rh_catalog::Catalog;
 use serde::Serialize;
 use std::fmt::Write;
@@ -159,8 +159,16 @@ pub fn label_balance(
         let built: Vec<anyhow::Result<_>> = groups
             .par_iter()
             .map(|&group| {
-                let selection = plan_group_with(catalog, &all, build_seed, group, &config.plan_policy())?;
-                Ok(produce_group_counted(&selection, build_seed, group * 4, 4, catalog, config)?)
+                let selection =
+                    plan_group_with(catalog, &all, build_seed, group, &config.plan_policy())?;
+                Ok(produce_group_counted(
+                    &selection,
+                    build_seed,
+                    group * 4,
+                    4,
+                    catalog,
+                    config,
+                )?)
             })
             .collect();
         let mut balance = FamilyBalance {
@@ -221,7 +229,15 @@ pub fn label_balance(
 pub fn format_table(rows: &[FamilyBalance]) -> String {
     let header = format!(
         "{:<16} {:>6} {:>6} {:>9}   {:>15} {:>7} {:>8} {:>9} {:>7}\n",
-        "family", "CATCH", "DODGE", "NO_ACTION", "pool C/D/N", "invalid", "attempts", "reaction", "other"
+        "family",
+        "CATCH",
+        "DODGE",
+        "NO_ACTION",
+        "pool C/D/N",
+        "invalid",
+        "attempts",
+        "reaction",
+        "other"
     );
     let mut s = header;
     let reaction = crate::validate::VALIDATOR_COLUMNS
@@ -278,7 +294,10 @@ pub fn format_table(rows: &[FamilyBalance]) -> String {
     }
     s.push_str(&line(&total));
     let share = |n: usize, of: usize| 100.0 * n as f64 / of.max(1) as f64;
-    let (e, p) = (total.total(), total.pool_catch + total.pool_dodge + total.pool_no_action);
+    let (e, p) = (
+        total.total(),
+        total.pool_catch + total.pool_dodge + total.pool_no_action,
+    );
     let _ = writeln!(
         s,
         "shares: evaluation subset CATCH {:.1}%, DODGE {:.1}%, NO_ACTION {:.1}% of {e}; pool CATCH {:.1}%, DODGE {:.1}%, NO_ACTION {:.1}% of {p}",

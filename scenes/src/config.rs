@@ -319,7 +319,10 @@ impl Config {
             if r[0].is_finite() && r[1].is_finite() && r[0] <= r[1] {
                 Ok(())
             } else {
-                Err(fail(field, format!("must be [low, high] with low <= high (got {r:?})")))
+                Err(fail(
+                    field,
+                    format!("must be [low, high] with low <= high (got {r:?})"),
+                ))
             }
         };
         range("aim.meet_height", a.meet_height)?;
@@ -338,7 +341,10 @@ impl Config {
             ("aim.touch_slack", a.touch_slack),
         ] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(fail(field, format!("must be a non-negative number (got {v})")));
+                return Err(fail(
+                    field,
+                    format!("must be a non-negative number (got {v})"),
+                ));
             }
         }
         if self.eval.per_family == 0 {
@@ -392,11 +398,11 @@ impl Config {
             positive(&format!("{field}.spring_n_per_mm"), h.spring_n_per_mm)?;
             positive(&format!("{field}.body_mass_kg"), h.body_mass_kg)?;
         }
-        if let Some(extra) = l
-            .harm
-            .keys()
-            .find(|k| rh_physics::strike::Region::ALL.iter().all(|r| r.name() != *k))
-        {
+        if let Some(extra) = l.harm.keys().find(|k| {
+            rh_physics::strike::Region::ALL
+                .iter()
+                .all(|r| r.name() != *k)
+        }) {
             return Err(fail(
                 &format!("labels.harm.{extra}"),
                 "is not a body region of the humanoid".into(),

@@ -100,9 +100,8 @@ pub fn run_group(
     // Selections planned from descriptions (`build --descriptions`): group g takes g mod D.
     let selection = match planned {
         Some(s) if !s.is_empty() => s[(g % s.len() as u64) as usize].clone(),
-        _ => {
-            plan_group_with(catalog, families, seed, g, &config.plan_policy()).map_err(|e| GroupError::Input(e.to_string()))?
-        }
+        _ => plan_group_with(catalog, families, seed, g, &config.plan_policy())
+            .map_err(|e| GroupError::Input(e.to_string()))?,
     };
     let (mut results, rejections) =
         produce_group_counted(&selection, seed, g * 4, count, catalog, config)
@@ -294,7 +293,10 @@ pub fn produce_group_counted(
             if std::env::var_os("RH_AIM_DEBUG").is_some() {
                 let failed: Vec<[bool; VALIDATOR_COLUMNS.len()]> =
                     results.iter().map(|r| r.verdicts.as_array()).collect();
-                eprintln!("aim fallback {} {}: {failed:?}", results[0].spec.family, results[0].spec.selection.object_id);
+                eprintln!(
+                    "aim fallback {} {}: {failed:?}",
+                    results[0].spec.family, results[0].spec.selection.object_id
+                );
             }
             let fallback = label_group(unaimed, config);
             if fallback.iter().all(|r| r.verdicts.all()) {

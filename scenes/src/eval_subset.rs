@@ -168,7 +168,11 @@ mod tests {
         }
         rows[19].valid = false;
         for i in 200..207u64 {
-            rows.push(row("c", i, ["CATCH", "DODGE", "NO_ACTION"][(i as usize).saturating_sub(200).min(2)]));
+            rows.push(row(
+                "c",
+                i,
+                ["CATCH", "DODGE", "NO_ACTION"][(i as usize).saturating_sub(200).min(2)],
+            ));
         }
         let (chosen, counts) = select(&rows, &cfg);
         assert_eq!(counts["a"], 10);
@@ -180,7 +184,14 @@ mod tests {
                 .filter(|&&r| rows[r].family == f && rows[r].action == k)
                 .count()
         };
-        assert_eq!((kinds("a", "CATCH"), kinds("a", "DODGE"), kinds("a", "NO_ACTION")), (3, 6, 1));
+        assert_eq!(
+            (
+                kinds("a", "CATCH"),
+                kinds("a", "DODGE"),
+                kinds("a", "NO_ACTION")
+            ),
+            (3, 6, 1)
+        );
         assert_eq!((kinds("b", "CATCH"), kinds("b", "DODGE")), (5, 5));
         assert!(!chosen.contains(&19));
         assert!(chosen

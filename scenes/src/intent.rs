@@ -40,7 +40,8 @@ impl Intent {
             || object.has_hazard("hot")
             || (object.has_hazard("fragile") && object.has_hazard("large"))
             || object.mass >= labels.heavy_mass_kg;
-        let too_large = labels.catch_radius_max > 0.0 && object.bounding_radius() > labels.catch_radius_max;
+        let too_large =
+            labels.catch_radius_max > 0.0 && object.bounding_radius() > labels.catch_radius_max;
         if near_miss {
             Intent::Miss
         } else if dangerous || too_large {

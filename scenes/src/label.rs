@@ -431,11 +431,11 @@ mod tests {
     use super::*;
     use crate::config::Config;
     use crate::randomize::{randomize, SceneKey};
+    use rh_catalog::Catalog;
     use rh_physics::body::Part;
     use rh_physics::simulate::{BodyState, TOUCH_FLOOR};
     use rh_physics::spec::Selection;
     use rh_physics::strike::Region;
-    use rh_catalog::Catalog;
 
     const G: f64 = 9.81;
 

@@ -6,8 +6,8 @@
 //! (see `cameras`), from their own stream.
 
 use crate::config::Config;
-use crate::intent::Intent;
 use crate::families::{self, FamilyInput};
+use crate::intent::Intent;
 use rand::RngExt;
 use rh_catalog::Catalog;
 use rh_physics::seeds;

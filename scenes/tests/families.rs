@@ -360,7 +360,11 @@ fn an_aimed_throw_meets_the_observer_at_the_sampled_height() {
     use families::thrown_object::{launch_velocity, longest_flight, FLIGHT_S};
     // Closed form: a throw at speed v from h0 whose launch velocity `launch_velocity`
     // gives for a flight t is at height h after t, at the speed v.
-    for (v, t, h0, h) in [(5.2, 1.05, 1.0, 0.9), (7.4, 1.1, 1.3, 1.2), (6.0, 1.0, 1.2, 0.75)] {
+    for (v, t, h0, h) in [
+        (5.2, 1.05, 1.0, 0.9),
+        (7.4, 1.1, 1.3, 1.2),
+        (6.0, 1.0, 1.2, 0.75),
+    ] {
         let (vh, vz) = launch_velocity(v, t, h0, h);
         assert!((vh.hypot(vz) - v).abs() < 1e-9);
         assert!((h0 + vz * t - 0.5 * GRAVITY * t * t - h).abs() < 1e-9);
@@ -373,23 +377,41 @@ fn an_aimed_throw_meets_the_observer_at_the_sampled_height() {
     // of mass is at the target point (beside the observer, at the sampled height) when
     // the flight ends.
     for band in 0..4 {
-        let spec = custom_scene("thrown_object", "tennis_ball", "gym", [5.2, 5.8, 6.4, 7.4], band);
+        let spec = custom_scene(
+            "thrown_object",
+            "tennis_ball",
+            "gym",
+            [5.2, 5.8, 6.4, 7.4],
+            band,
+        );
         let sim = plain(&spec);
         let v = sim.hazard_velocity(0);
         let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         assert!((speed - [5.2, 5.8, 6.4, 7.4][band as usize]).abs() < 1e-5);
         let p = &spec.family_params;
         let t = p["flight_s"];
-        assert!(t >= spec.observation_window_s + spec.labels.reaction_time_min, "flight {t} s");
+        assert!(
+            t >= spec.observation_window_s + spec.labels.reaction_time_min,
+            "flight {t} s"
+        );
         assert!(t <= FLIGHT_S[1] + 1e-9);
         let k = (t / spec.physics.dt).round() as u32;
         let at = sim.hazard_com(k);
         let target = [p["aim_target_x_m"], p["aim_target_y_m"], p["aim_height_m"]];
-        let miss = ((at[0] - target[0]).powi(2) + (at[1] - target[1]).powi(2) + (at[2] - target[2]).powi(2)).sqrt();
+        let miss = ((at[0] - target[0]).powi(2)
+            + (at[1] - target[1]).powi(2)
+            + (at[2] - target[2]).powi(2))
+        .sqrt();
         // Within one step's travel.
-        assert!(miss <= speed * spec.physics.dt, "band {band}: {miss} m from the target");
+        assert!(
+            miss <= speed * spec.physics.dt,
+            "band {band}: {miss} m from the target"
+        );
         let o = &spec.observer;
-        assert!(o.torso_axis_distance(target) <= 0.5, "the target is beside the observer");
+        assert!(
+            o.torso_axis_distance(target) <= 0.5,
+            "the target is beside the observer"
+        );
     }
 }
 

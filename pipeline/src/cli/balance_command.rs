@@ -30,15 +30,16 @@ pub fn run(
         }
     }
     let seed = seed.unwrap_or(config.build.seed);
-    let rows = rh_scenes::balance::label_balance(
-        catalog, config, seed, &families, per_family, pool,
-    )
-    .map_err(|e| Failure {
-        code: 1,
-        message: format!("{e:#}"),
-    })?;
+    let rows =
+        rh_scenes::balance::label_balance(catalog, config, seed, &families, per_family, pool)
+            .map_err(|e| Failure {
+                code: 1,
+                message: format!("{e:#}"),
+            })?;
     if json {
-        print_json(&rh_scenes::balance::Balance::of(seed, pool, per_family, rows));
+        print_json(&rh_scenes::balance::Balance::of(
+            seed, pool, per_family, rows,
+        ));
     } else {
         print!("{}", rh_scenes::balance::format_table(&rows));
     }

@@ -51,6 +51,10 @@ impl Family for ChainReaction {
         }
     }
 
+    fn timed(&self) -> bool {
+        true
+    }
+
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
         let object = input.object;
         let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
@@ -71,9 +75,19 @@ impl Family for ChainReaction {
         // drawn run-up of label rule v4: the target reaches the observer along the floor.
         let hands = input.intent == crate::intent::Intent::Hands;
         let t_strike = lerp(STRIKE_S, u);
-        let gap_of = |v: f64| if hands { gap_for(v, t_strike) } else { lerp(FLOOR_GAP_M, u) };
+        let gap_of = |v: f64| {
+            if hands {
+                gap_for(v, t_strike)
+            } else {
+                lerp(FLOOR_GAP_M, u)
+            }
+        };
         let gap = gap_of(input.speed);
-        let longest_gap = input.band_speeds.iter().map(|&v| gap_of(v)).fold(0.0, f64::max);
+        let longest_gap = input
+            .band_speeds
+            .iter()
+            .map(|&v| gap_of(v))
+            .fold(0.0, f64::max);
         let lateral = uniform(rng, -0.12, 0.12);
         let origin = event_origin(rng, input.room, dir, 0.4 + far_shift(input));
 
@@ -92,7 +106,11 @@ impl Family for ChainReaction {
         ];
         // The table reaches from behind the trigger to the edge.
         // Aimed at the hands, a table at least at hip height.
-        let height = if hands { height.max(TABLE_MIN_M) } else { height };
+        let height = if hands {
+            height.max(TABLE_MIN_M)
+        } else {
+            height
+        };
         let needed = 2.0 * trigger_half[0] + longest_gap + half_len * (1.0 + behind) + 0.15;
         let half_depth = (needed / 2.0).max(0.3);
         let table = table_block(

@@ -106,6 +106,12 @@ pub trait Family: Sync {
     fn self_aimed(&self) -> bool {
         false
     }
+    /// Whether the start of the body set in motion follows from the speed (label rule v5:
+    /// every band meets the same point, or leaves its edge at the same time, so a faster
+    /// band starts farther back). Everything else of the layout stays speed-independent.
+    fn timed(&self) -> bool {
+        self.self_aimed()
+    }
     /// Whether the family's intended event happened in the simulation.
     fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool;
 }
@@ -558,19 +564,31 @@ mod tests {
                     family.sample(&input, &mut seeds::stream(11, 0, "placement"))
                 })
                 .collect();
-            // A thrown object is aimed: its elevation, and (a fixed flight time) its
-            // release point and range, follow from the speed.
+            // A timed family (a thrown object, a ball rolled to leave the edge at a drawn
+            // time…) starts the body it sets in motion where the speed says; a throw's
+            // elevation, release point and range follow from the speed.
             let strip = |l: &Layout| {
                 let mut l = l.clone();
                 for b in &mut l.bodies {
+                    let moving = b.linvel != [0.0; 3];
                     b.linvel = [0.0; 3];
                     b.angvel = [0.0; 3];
-                    if family.self_aimed() {
+                    if family.timed() && moving {
                         b.position = [0.0; 3];
                     }
                 }
+                let timing = [
+                    "com_behind_edge_m",
+                    "trigger_gap_m",
+                    "run_up_m",
+                    "slide_distance_m",
+                ];
+                if family.timed() {
+                    l.params.retain(|k, _| !timing.contains(&k.as_str()));
+                }
                 l.params.retain(|k, _| !k.contains("elevation"));
-                l.params.retain(|k, _| k != "throw_distance_m" && k != "flight_s");
+                l.params
+                    .retain(|k, _| k != "throw_distance_m" && k != "flight_s");
                 // door_swing records the push impulse that gives its door the band's edge
                 // speed (`J = I_hinge·v/w²`): a momentum, like the velocities above.
                 l.params.retain(|k, _| k != "push_impulse_ns");

@@ -38,6 +38,10 @@ impl Family for MultiObject {
         }
     }
 
+    fn timed(&self) -> bool {
+        true
+    }
+
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
         let object = input.object;
         let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
@@ -64,19 +68,35 @@ impl Family for MultiObject {
         // Timed only while the long run-up keeps most of the shove (a rolling or slippery
         // object): a slider that loses more than `KEPT_SPEED` of the slowest shove no
         // longer pushes the row off the edge.
-        let slowest = input.band_speeds.iter().copied().fold(f64::INFINITY, f64::min);
+        let slowest = input
+            .band_speeds
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
         let hands = input.intent == crate::intent::Intent::Hands
             && decel * t_hit <= (1.0 - KEPT_SPEED) * slowest;
         let run_up = |v: f64| {
             if !hands {
                 return FLOOR_RUN_UP_M[0] + (FLOOR_RUN_UP_M[1] - FLOOR_RUN_UP_M[0]) * u;
             }
-            let t = t_hit.min(if decel > 0.0 { v / decel } else { f64::INFINITY });
+            let t = t_hit.min(if decel > 0.0 {
+                v / decel
+            } else {
+                f64::INFINITY
+            });
             v * t - 0.5 * decel * t * t
         };
-        let longest_run_up = input.band_speeds.iter().map(|&v| run_up(v)).fold(0.0, f64::max);
+        let longest_run_up = input
+            .band_speeds
+            .iter()
+            .map(|&v| run_up(v))
+            .fold(0.0, f64::max);
         gaps[0] += run_up(input.speed);
-        let height = if hands { height.max(TABLE_MIN_M) } else { height };
+        let height = if hands {
+            height.max(TABLE_MIN_M)
+        } else {
+            height
+        };
         let behind = uniform(rng, 0.15, 0.4);
         let lateral = uniform(rng, -0.12, 0.12);
         let origin = event_origin(rng, input.room, dir, 0.5 + far_shift(input));

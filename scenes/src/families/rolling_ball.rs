@@ -29,6 +29,10 @@ impl Family for RollingBall {
         }
     }
 
+    fn timed(&self) -> bool {
+        true
+    }
+
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
         let room = input.room;
         let heading_angle = diagonal_heading(rng, room, 0.2);
@@ -74,13 +78,14 @@ impl Family for RollingBall {
             board_thickness: None,
             rolling: true,
         };
-        let (bodies, edge, start) = launch.build(input.object, input.speed);
+        let (bodies, edge, _start) = launch.build(input.object, input.speed);
         let d = length - surface_half[0] * 2.0;
         let obs = ahead(ahead(edge, dir, d), left_of(dir), side);
         let observer = ObserverPose {
             x: obs[0],
             y: obs[1],
-            yaw: (start[1] - obs[1]).atan2(start[0] - obs[0]),
+            // Facing the table's centre (the ball's start follows from the band's speed).
+            yaw: (origin[1] - obs[1]).atan2(origin[0] - obs[0]),
         };
         Layout {
             bodies,

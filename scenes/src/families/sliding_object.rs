@@ -31,6 +31,10 @@ impl Family for SlidingObject {
         }
     }
 
+    fn timed(&self) -> bool {
+        true
+    }
+
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
         let object = input.object;
         let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
@@ -106,7 +110,11 @@ impl Family for SlidingObject {
             (2.4, 3.0),
             0.3,
             input.far_observer,
-            [position[0], position[1]],
+            // Facing the ramp's top start (where every band would start untimed).
+            {
+                let top = along(length - start_gap - half_len, 0.0);
+                [top[0], top[1]]
+            },
         );
         Layout {
             bodies: vec![ramp, hazard],

@@ -75,7 +75,11 @@ impl Family for ThrownObject {
             ),
             Intent::Miss => {
                 let off = uniform(rng, 1.8, 2.2);
-                let sign = if uniform(rng, 0.0, 1.0) < 0.5 { -1.0 } else { 1.0 };
+                let sign = if uniform(rng, 0.0, 1.0) < 0.5 {
+                    -1.0
+                } else {
+                    1.0
+                };
                 (0.0, off * sign, uniform(rng, 0.6, 1.2))
             }
         };
@@ -113,7 +117,11 @@ impl Family for ThrownObject {
             let t = range_of(v);
             launch_velocity(v, t, launch_height, height).0 * t
         };
-        let longest = input.band_speeds.iter().map(|&v| range(v)).fold(0.0, f64::max);
+        let longest = input
+            .band_speeds
+            .iter()
+            .map(|&v| range(v))
+            .fold(0.0, f64::max);
         let origin = span_start(rng, room, dir, longest + ahead_d.max(0.0), WALL_MARGIN);
         // The target's ground point, the torso axis `ahead_d` beyond it, and this band's
         // release point `range` before it.
