@@ -282,7 +282,7 @@ impl Renderer {
     }
 }
 
-fn link_xf(p: &LinkPose) -> Xf {
+pub(super) fn link_xf(p: &LinkPose) -> Xf {
     Xf::from_quat(p.rotation, p.position)
 }
 
@@ -297,7 +297,13 @@ fn check(done: Result<u32, String>, want: u32, path: &Path, errors: &mut Vec<Str
 
 /// The spec's ego camera moved with the body: the base's displacement and turn from the
 /// observer's `(x, y, yaw)`, and the pelvis drop.
-fn carried(ego: &CameraSpec, observer: Vec3, f: &ExecFrame, width: u32, height: u32) -> CameraSpec {
+pub(super) fn carried(
+    ego: &CameraSpec,
+    observer: Vec3,
+    f: &ExecFrame,
+    width: u32,
+    height: u32,
+) -> CameraSpec {
     let turn = quat::from_axis_angle([0.0, 0.0, 1.0], f.base[2] - observer[2]);
     let carry = |p: Vec3| {
         let local = [p[0] - observer[0], p[1] - observer[1], p[2]];

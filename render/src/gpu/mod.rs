@@ -5,6 +5,7 @@ mod post;
 mod setup;
 
 mod ids;
+mod moving;
 
 use super::mesh::Vertex;
 use super::RenderError;
