@@ -2,7 +2,7 @@
 //! ceiling) meshed once per scene, moving bodies meshed once in their body frames and
 //! posed per step, ropes, and what each camera sees.
 
-use super::camera::view_proj;
+use super::camera::{inverse_view_proj, view_proj};
 use super::gpu::{self, Uniforms, ViewJob};
 use super::lighting::Lighting;
 use super::mesh::*;
@@ -425,6 +425,25 @@ impl SceneGeometry {
             ],
             background: self.background,
             fill_rects: [[-1.0, -1.0, 1.0, 1.0]; gpu::MAX_REDRAW_RECTS],
+            inv_view_proj: inverse_view_proj(cam),
+            sweep_lo: [0.0; 4],
+            sweep_hi: [0.0; 4],
+        }
+    }
+
+    /// `uniforms` with the sweep box of moving geometry with bounds `moving`: grown by
+    /// the shading's reach (as `shadow_regions`) and by slack for rebuilding surface
+    /// points from a depth buffer (1 cm, against errors of well under a millimetre).
+    pub(super) fn with_sweep(&self, uniforms: Uniforms, [lo, hi]: [Vec3; 2]) -> Uniforms {
+        const SLACK: f64 = 0.01;
+        let pad = self.shadow_reach + SLACK;
+        let v = |p: Vec3, s: f64| {
+            [0, 1, 2, 3].map(|i| if i < 3 { (p[i] + s * pad) as f32 } else { 0.0 })
+        };
+        Uniforms {
+            sweep_lo: v(lo, -1.0),
+            sweep_hi: v(hi, 1.0),
+            ..uniforms
         }
     }
 }

@@ -342,7 +342,10 @@ impl Renderer {
                 let changed = moving.and_then(|m| scene.changed_rect(v, m, &redraw));
                 OverlayJob {
                     slot: v.slot,
-                    uniforms: v.uniforms,
+                    uniforms: match moving {
+                        Some(m) => scene.with_sweep(v.uniforms, m),
+                        None => v.uniforms,
+                    },
                     redraw,
                     dynamic: dyn_range.clone(),
                     changed,

@@ -30,6 +30,12 @@ pub struct Uniforms {
     pub background: [f32; 4],
     /// Set by `Gpu`: the fill pass's rectangles (NDC x0, y0, x1, y1), one per instance.
     pub fill_rects: [[f32; 4]; MAX_REDRAW_RECTS],
+    /// Inverse of `view_proj` (column-major): the mark pass rebuilds surface points.
+    pub inv_view_proj: [[f32; 4]; 4],
+    /// The moving bodies' box grown by the shading's reach (xyz; w unused): overlay
+    /// frames without MSAA re-shade only static pixels in its sweep along the sun.
+    pub sweep_lo: [f32; 4],
+    pub sweep_hi: [f32; 4],
 }
 
 /// One view to draw: the output slot (its own target), uniforms, the static vertex
@@ -95,6 +101,9 @@ pub struct Gpu {
     /// Lit, depth test `LessEqual` without depth writes: shades each pre-passed pixel once.
     main_over: wgpu::RenderPipeline,
     fill: wgpu::RenderPipeline,
+    /// The fill of overlay redraw rectangles: without MSAA only the pixels in the
+    /// moving casters' shadow sweep (`fs_mark`), with MSAA the plain fill.
+    mark: wgpu::RenderPipeline,
     shadow: wgpu::RenderPipeline,
     main_bgl: wgpu::BindGroupLayout,
     shadow_tex: wgpu::Texture,
@@ -227,7 +236,12 @@ impl Gpu {
             copy_only
         };
         let cache_color = tex(self.samples, COLOR_FORMAT, cache_usage);
-        let cache_depth = tex(self.samples, DEPTH_FORMAT, attachment);
+        let cache_depth = tex(
+            self.samples,
+            DEPTH_FORMAT,
+            attachment | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let cache_depth_view = cache_depth.create_view(&Default::default());
         let padded_row = (width * 4).div_ceil(256) * 256;
         let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: None,
@@ -251,6 +265,10 @@ impl Gpu {
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: wgpu::BindingResource::Sampler(&self.shadow_sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&cache_depth_view),
                 },
             ],
         });
@@ -531,11 +549,14 @@ impl Gpu {
             }
             Redraw::Regions(r) => r,
         };
+        // Without MSAA a redraw re-clears only the pixels the moving casters' shadow can
+        // reach (`fs_mark`); the others keep their cached depth and colour.
+        let fill = if whole { &self.fill } else { &self.mark };
         for (i, &([x, y, w, h], statics)) in rects.iter().enumerate() {
             pass.set_scissor_rect(x, y, w, h);
             // Clearing by drawing (not LoadOp::Clear's colour) keeps the background
             // bit-identical between whole frames and redrawn regions.
-            pass.set_pipeline(&self.fill);
+            pass.set_pipeline(fill);
             pass.draw(0..6, i as u32..i as u32 + 1);
             pass.set_pipeline(&self.main);
             for r in statics.iter().filter(|r| !r.is_empty()) {

@@ -108,7 +108,10 @@ fn open_device(
 
 /// The bind group layouts: the shadow pass's (uniforms) and the lit passes' (uniforms,
 /// shadow map, comparison sampler).
-fn bind_group_layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::BindGroupLayout) {
+fn bind_group_layouts(
+    device: &wgpu::Device,
+    samples: u32,
+) -> (wgpu::BindGroupLayout, wgpu::BindGroupLayout) {
     let uniform_entry = wgpu::BindGroupLayoutEntry {
         binding: 0,
         visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
@@ -141,6 +144,17 @@ fn bind_group_layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::Bi
                 binding: 2,
                 visibility: wgpu::ShaderStages::FRAGMENT,
                 ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                count: None,
+            },
+            // The view's cached static depth (read by `fs_mark`, used without MSAA).
+            wgpu::BindGroupLayoutEntry {
+                binding: 3,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Depth,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: samples > 1,
+                },
                 count: None,
             },
         ],
@@ -199,13 +213,13 @@ fn make_pipeline(
     })
 }
 
-/// The pipelines: (main, depth-only, main-over, fill, shadow).
+/// The pipelines: (main, depth-only, main-over, fill, mark, shadow).
 fn pipelines(
     device: &wgpu::Device,
     main_layout: &wgpu::PipelineLayout,
     shadow_layout: &wgpu::PipelineLayout,
     samples: u32,
-) -> [wgpu::RenderPipeline; 5] {
+) -> [wgpu::RenderPipeline; 6] {
     let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("rh-shader"),
         source: wgpu::ShaderSource::Wgsl(include_str!("../shader.wgsl").into()),
@@ -251,17 +265,14 @@ fn pipelines(
         samples,
     });
     // Re-clears a scissored region (depth 1, background colour) before it is redrawn.
-    let fill = pipeline(PipelineDesc {
-        label: "fill",
-        layout: main_layout,
-        vertex: "vs_fill",
-        vertex_buffer: false,
-        fragment: Some("fs_fill"),
-        depth_compare: wgpu::CompareFunction::Always,
-        depth_write: true,
-        color_writes: wgpu::ColorWrites::ALL,
-        depth_bias: Default::default(),
-        samples,
+    let fill = pipeline(fill_desc(main_layout, samples));
+    // The fill of overlay redraws. Without MSAA it re-clears only the pixels in the
+    // moving casters' shadow sweep (`fs_mark`, which reads the one-sample cached depth);
+    // with MSAA it is the plain fill.
+    let mark = pipeline(PipelineDesc {
+        label: "mark",
+        fragment: Some(if samples == 1 { "fs_mark" } else { "fs_fill" }),
+        ..fill_desc(main_layout, samples)
     });
     let shadow = pipeline(PipelineDesc {
         label: "shadow",
@@ -279,7 +290,23 @@ fn pipelines(
         },
         samples: 1,
     });
-    [main, depth_only, main_over, fill, shadow]
+    [main, depth_only, main_over, fill, mark, shadow]
+}
+
+/// The fill pass: rectangles at the far plane, depth and colour written everywhere.
+fn fill_desc(layout: &wgpu::PipelineLayout, samples: u32) -> PipelineDesc<'_> {
+    PipelineDesc {
+        label: "fill",
+        layout,
+        vertex: "vs_fill",
+        vertex_buffer: false,
+        fragment: Some("fs_fill"),
+        depth_compare: wgpu::CompareFunction::Always,
+        depth_write: true,
+        color_writes: wgpu::ColorWrites::ALL,
+        depth_bias: Default::default(),
+        samples,
+    }
 }
 
 impl Gpu {
@@ -290,7 +317,7 @@ impl Gpu {
         let (device, queue, adapter, samples) = open_device(samples, cpu_samples)?;
         let adapter_name = adapter.name.clone();
         let post = (fxaa && samples == 1).then(|| post::Post::new(&device));
-        let (shadow_bgl, main_bgl) = bind_group_layouts(&device);
+        let (shadow_bgl, main_bgl) = bind_group_layouts(&device, samples);
         let layout = |bgl: &wgpu::BindGroupLayout| {
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: None,
@@ -300,7 +327,7 @@ impl Gpu {
         };
         let main_layout = layout(&main_bgl);
         let shadow_layout = layout(&shadow_bgl);
-        let [main, depth_only, main_over, fill, shadow] =
+        let [main, depth_only, main_over, fill, mark, shadow] =
             pipelines(&device, &main_layout, &shadow_layout, samples);
         let shadow_map = |label| {
             device.create_texture(&wgpu::TextureDescriptor {
@@ -348,6 +375,7 @@ impl Gpu {
             depth_only,
             main_over,
             fill,
+            mark,
             shadow,
             main_bgl,
             shadow_tex,
