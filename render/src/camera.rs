@@ -30,9 +30,9 @@ fn view_proj_rows(cam: &CameraSpec) -> [[f64; 4]; 4] {
     ]
 }
 
-/// Inverse of [`view_proj`] (column-major): (NDC x, y, depth, 1) to homogeneous world
-/// coordinates; inverted in f64 by Gauss-Jordan elimination with partial pivoting.
-pub fn inverse_view_proj(cam: &CameraSpec) -> [[f32; 4]; 4] {
+/// Inverse of [`view_proj`] in f64, row-major: (NDC x, y, depth, 1) to homogeneous
+/// world coordinates (Gauss-Jordan elimination with partial pivoting).
+pub(super) fn inverse_view_proj_rows(cam: &CameraSpec) -> [[f64; 4]; 4] {
     let mut a = view_proj_rows(cam);
     let mut inv = [[0.0f64; 4]; 4];
     for (i, row) in inv.iter_mut().enumerate() {
@@ -57,7 +57,7 @@ pub fn inverse_view_proj(cam: &CameraSpec) -> [[f32; 4]; 4] {
             }
         }
     }
-    to_cols(inv)
+    inv
 }
 
 pub(super) fn to_cols(rows: [[f64; 4]; 4]) -> [[f32; 4]; 4] {

@@ -51,6 +51,7 @@ pub mod recipes;
 mod regions;
 mod renderer;
 mod sheet;
+mod tiles;
 
 use encode::EncodeSettings;
 use rh_scenes::config::RenderConfig;

@@ -11,20 +11,12 @@ struct U {
     background: vec4<f32>,
     // The fill pass's rectangles in normalised device coordinates (x0, y0, x1, y1),
     // one per instance.
-    fill_rects: array<vec4<f32>, 8>,
-    // Inverse of view_proj: (NDC x, y, depth, 1) to homogeneous world coordinates.
-    inv_view_proj: mat4x4<f32>,
-    // The moving bodies' box grown by the shading's reach and slack (xyz; w unused):
-    // the mark pass's sweep (see fs_mark).
-    sweep_lo: vec4<f32>,
-    sweep_hi: vec4<f32>,
+    fill_rects: array<vec4<f32>, 32>,
 };
 
 @group(0) @binding(0) var<uniform> u: U;
 @group(0) @binding(1) var shadow_tex: texture_depth_2d;
 @group(0) @binding(2) var shadow_smp: sampler_comparison;
-// The view's cached static depth (one sample per pixel; only fs_mark reads it).
-@group(0) @binding(3) var cache_depth: texture_depth_2d;
 
 struct VIn {
     @location(0) pos: vec3<f32>,
@@ -73,48 +65,6 @@ fn vs_fill(
 @fragment
 fn fs_fill() -> @location(0) vec4<f32> {
     return vec4<f32>(u.background.rgb, 1.0);
-}
-
-// Whether `w` lies in a translate B + d·t (t >= 0) of the sweep box B along the sun's
-// direction d, i.e. whether a moving caster inside B can shade the surface at `w`.
-fn sweep_axis(w: f32, d: f32, lo: f32, hi: f32, t: vec2<f32>) -> vec2<f32> {
-    if (abs(d) < 1e-6) {
-        return select(t, vec2<f32>(1.0, -1.0), w < lo || w > hi);
-    }
-    let a = (w - hi) / d;
-    let b = (w - lo) / d;
-    return vec2<f32>(max(t.x, min(a, b)), min(t.y, max(a, b)));
-}
-
-struct Marked {
-    @location(0) color: vec4<f32>,
-    @builtin(frag_depth) depth: f32,
-};
-
-// The fill of a redraw rectangle where MSAA is off: re-clears (background colour,
-// depth 1) only the pixels whose cached static surface lies in the moving casters'
-// shadow sweep, so the static geometry redrawn next is shaded only there (the other
-// pixels keep the cached depth, which the redraw's `Less` test fails: a CPU rasterizer
-// skips whole pixel groups failing it). The surface point is rebuilt from the cached
-// depth; `sweep_lo`/`sweep_hi` carry slack for that.
-@fragment
-fn fs_mark(@builtin(position) pos: vec4<f32>) -> Marked {
-    let d = textureLoad(cache_depth, vec2<i32>(pos.xy), 0);
-    let dims = vec2<f32>(textureDimensions(cache_depth));
-    let ndc = vec2<f32>(pos.x / dims.x * 2.0 - 1.0, 1.0 - pos.y / dims.y * 2.0);
-    let h = u.inv_view_proj * vec4<f32>(ndc, d, 1.0);
-    let w = h.xyz / h.w;
-    var t = vec2<f32>(0.0, 3.0e38);
-    t = sweep_axis(w.x, u.sun_dir.x, u.sweep_lo.x, u.sweep_hi.x, t);
-    t = sweep_axis(w.y, u.sun_dir.y, u.sweep_lo.y, u.sweep_hi.y, t);
-    t = sweep_axis(w.z, u.sun_dir.z, u.sweep_lo.z, u.sweep_hi.z, t);
-    if (d >= 1.0 || t.x > t.y) {
-        discard;
-    }
-    var o: Marked;
-    o.color = vec4<f32>(u.background.rgb, 1.0);
-    o.depth = 1.0;
-    return o;
 }
 
 @vertex

@@ -108,10 +108,7 @@ fn open_device(
 
 /// The bind group layouts: the shadow pass's (uniforms) and the lit passes' (uniforms,
 /// shadow map, comparison sampler).
-fn bind_group_layouts(
-    device: &wgpu::Device,
-    samples: u32,
-) -> (wgpu::BindGroupLayout, wgpu::BindGroupLayout) {
+fn bind_group_layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::BindGroupLayout) {
     let uniform_entry = wgpu::BindGroupLayoutEntry {
         binding: 0,
         visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
@@ -144,17 +141,6 @@ fn bind_group_layouts(
                 binding: 2,
                 visibility: wgpu::ShaderStages::FRAGMENT,
                 ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                count: None,
-            },
-            // The view's cached static depth (read by `fs_mark`, used without MSAA).
-            wgpu::BindGroupLayoutEntry {
-                binding: 3,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Depth,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: samples > 1,
-                },
                 count: None,
             },
         ],
@@ -213,13 +199,13 @@ fn make_pipeline(
     })
 }
 
-/// The pipelines: (main, depth-only, main-over, fill, mark, shadow).
+/// The pipelines: (main, depth-only, main-over, fill, shadow).
 fn pipelines(
     device: &wgpu::Device,
     main_layout: &wgpu::PipelineLayout,
     shadow_layout: &wgpu::PipelineLayout,
     samples: u32,
-) -> [wgpu::RenderPipeline; 6] {
+) -> [wgpu::RenderPipeline; 5] {
     let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("rh-shader"),
         source: wgpu::ShaderSource::Wgsl(include_str!("../shader.wgsl").into()),
@@ -265,14 +251,17 @@ fn pipelines(
         samples,
     });
     // Re-clears a scissored region (depth 1, background colour) before it is redrawn.
-    let fill = pipeline(fill_desc(main_layout, samples));
-    // The fill of overlay redraws. Without MSAA it re-clears only the pixels in the
-    // moving casters' shadow sweep (`fs_mark`, which reads the one-sample cached depth);
-    // with MSAA it is the plain fill.
-    let mark = pipeline(PipelineDesc {
-        label: "mark",
-        fragment: Some(if samples == 1 { "fs_mark" } else { "fs_fill" }),
-        ..fill_desc(main_layout, samples)
+    let fill = pipeline(PipelineDesc {
+        label: "fill",
+        layout: main_layout,
+        vertex: "vs_fill",
+        vertex_buffer: false,
+        fragment: Some("fs_fill"),
+        depth_compare: wgpu::CompareFunction::Always,
+        depth_write: true,
+        color_writes: wgpu::ColorWrites::ALL,
+        depth_bias: Default::default(),
+        samples,
     });
     let shadow = pipeline(PipelineDesc {
         label: "shadow",
@@ -290,23 +279,7 @@ fn pipelines(
         },
         samples: 1,
     });
-    [main, depth_only, main_over, fill, mark, shadow]
-}
-
-/// The fill pass: rectangles at the far plane, depth and colour written everywhere.
-fn fill_desc(layout: &wgpu::PipelineLayout, samples: u32) -> PipelineDesc<'_> {
-    PipelineDesc {
-        label: "fill",
-        layout,
-        vertex: "vs_fill",
-        vertex_buffer: false,
-        fragment: Some("fs_fill"),
-        depth_compare: wgpu::CompareFunction::Always,
-        depth_write: true,
-        color_writes: wgpu::ColorWrites::ALL,
-        depth_bias: Default::default(),
-        samples,
-    }
+    [main, depth_only, main_over, fill, shadow]
 }
 
 impl Gpu {
@@ -317,7 +290,7 @@ impl Gpu {
         let (device, queue, adapter, samples) = open_device(samples, cpu_samples)?;
         let adapter_name = adapter.name.clone();
         let post = (fxaa && samples == 1).then(|| post::Post::new(&device));
-        let (shadow_bgl, main_bgl) = bind_group_layouts(&device, samples);
+        let (shadow_bgl, main_bgl) = bind_group_layouts(&device);
         let layout = |bgl: &wgpu::BindGroupLayout| {
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: None,
@@ -327,7 +300,7 @@ impl Gpu {
         };
         let main_layout = layout(&main_bgl);
         let shadow_layout = layout(&shadow_bgl);
-        let [main, depth_only, main_over, fill, mark, shadow] =
+        let [main, depth_only, main_over, fill, shadow] =
             pipelines(&device, &main_layout, &shadow_layout, samples);
         let shadow_map = |label| {
             device.create_texture(&wgpu::TextureDescriptor {
@@ -375,7 +348,6 @@ impl Gpu {
             depth_only,
             main_over,
             fill,
-            mark,
             shadow,
             main_bgl,
             shadow_tex,
