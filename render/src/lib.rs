@@ -55,6 +55,7 @@ pub mod recipes;
 mod regions;
 mod renderer;
 mod sheet;
+mod tiles;
 
 use encode::EncodeSettings;
 use rh_scenes::config::RenderConfig;
