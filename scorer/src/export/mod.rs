@@ -151,8 +151,13 @@ pub fn run(opts: &ExportOptions) -> Result<Summary> {
         .into());
     }
     let Some(first) = first_scene(&files, opts.split, eval.as_ref())? else {
+        let why = if opts.split == Split::Train && eval.is_some() {
+            " (every valid scene is in the eval subset; --split all takes them)"
+        } else {
+            ""
+        };
         return Err(InputError(format!(
-            "{}: no valid scenes in --split {}",
+            "{}: no valid scenes in --split {}{why}",
             opts.dataset.display(),
             opts.split.name()
         ))

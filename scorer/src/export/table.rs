@@ -9,7 +9,7 @@ use arrow::datatypes::{DataType, Field, Fields, Schema};
 use parquet::arrow::ArrowWriter;
 use parquet::basic::Compression;
 use parquet::file::properties::WriterProperties;
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -24,8 +24,10 @@ pub struct Shape {
     pub images: bool,
 }
 
-fn utf8(name: &str, nullable: bool) -> Field {
-    Field::new(name, DataType::Utf8, nullable)
+/// Every field is nullable: `datasets` reads its columns as nullable and keeps the
+/// metadata's features only for fields equal to its own.
+fn utf8(name: &str) -> Field {
+    Field::new(name, DataType::Utf8, true)
 }
 
 fn list_of(item: DataType) -> DataType {
@@ -34,17 +36,17 @@ fn list_of(item: DataType) -> DataType {
 
 /// A content part `{type, text}` (text null for an image part).
 fn part_fields() -> Fields {
-    Fields::from(vec![utf8("type", false), utf8("text", true)])
+    Fields::from(vec![utf8("type"), utf8("text")])
 }
 
 /// A message `{role, content}`: content is a string (text-only) or a list of parts.
 fn message_fields(images: bool) -> Fields {
     let content = if images {
-        Field::new("content", list_of(DataType::Struct(part_fields())), false)
+        Field::new("content", list_of(DataType::Struct(part_fields())), true)
     } else {
-        utf8("content", false)
+        utf8("content")
     };
-    Fields::from(vec![utf8("role", false), content])
+    Fields::from(vec![utf8("role"), content])
 }
 
 fn messages_type(images: bool) -> DataType {
@@ -54,28 +56,24 @@ fn messages_type(images: bool) -> DataType {
 /// The Arrow schema of a shape, with the `huggingface` features attached.
 pub fn schema(shape: Shape) -> Schema {
     let messages = messages_type(shape.images);
-    let mut fields = vec![
-        utf8("scene_id", false),
-        utf8("family", false),
-        utf8("gt_action", false),
-    ];
+    let mut fields = vec![utf8("scene_id"), utf8("family"), utf8("gt_action")];
     if shape.preference {
         fields.extend([
-            Field::new("prompt", messages.clone(), false),
-            Field::new("chosen", messages.clone(), false),
-            Field::new("rejected", messages, false),
-            utf8("rejected_action", false),
-            Field::new("rejected_rules", list_of(DataType::Utf8), false),
-            utf8("rejected_reason", false),
+            Field::new("prompt", messages.clone(), true),
+            Field::new("chosen", messages.clone(), true),
+            Field::new("rejected", messages, true),
+            utf8("rejected_action"),
+            Field::new("rejected_rules", list_of(DataType::Utf8), true),
+            utf8("rejected_reason"),
         ]);
     } else {
-        fields.push(Field::new("messages", messages, false));
+        fields.push(Field::new("messages", messages, true));
     }
     if shape.images {
         fields.push(Field::new(
             "images",
             list_of(rh_contract::arrow_schema::image_type()),
-            false,
+            true,
         ));
     }
     let plain = Schema::new(fields);
@@ -85,40 +83,41 @@ pub fn schema(shape: Shape) -> Schema {
     plain.with_metadata(metadata)
 }
 
-/// The `datasets` feature of an Arrow type. Lists are written as a one-element JSON list
-/// (`[feature]`), the form every `datasets` version reads as a list of that feature
-/// (`Sequence` of a struct would mean a struct of lists before `datasets` 4).
-fn feature(dt: &DataType) -> Value {
+/// The `datasets` feature of an Arrow type, as JSON text with struct fields in the
+/// schema's order (`datasets` keeps the metadata's features only where their Arrow type,
+/// field order and nullability included, equals the file's). Lists are written as a
+/// one-element JSON list (`[feature]`), the form every `datasets` version reads as a list
+/// of that feature (`Sequence` of a struct meant a struct of lists before `datasets` 4).
+fn feature(dt: &DataType) -> String {
     match dt {
-        DataType::Utf8 => json!({"dtype": "string", "_type": "Value"}),
+        DataType::Utf8 => r#"{"dtype": "string", "_type": "Value"}"#.to_string(),
         DataType::Struct(f) if f.len() == 2 && f[0].name() == "bytes" && f[1].name() == "path" => {
-            json!({"_type": "Image"})
+            r#"{"_type": "Image"}"#.to_string()
         }
-        DataType::Struct(fields) => Value::Object(
-            fields
+        DataType::Struct(fields) => {
+            let entries: Vec<String> = fields
                 .iter()
-                .map(|f| (f.name().clone(), feature(f.data_type())))
-                .collect(),
-        ),
-        DataType::List(item) => json!([feature(item.data_type())]),
+                .map(|f| {
+                    format!(
+                        "{}: {}",
+                        Value::String(f.name().clone()),
+                        feature(f.data_type())
+                    )
+                })
+                .collect();
+            format!("{{{}}}", entries.join(", "))
+        }
+        DataType::List(item) => format!("[{}]", feature(item.data_type())),
         other => unreachable!("no export column has type {other}"),
     }
 }
 
 /// `{"info": {"features": {...}}}` with the columns in schema order.
 fn features(schema: &Schema) -> String {
-    let entries: Vec<String> = schema
-        .fields()
-        .iter()
-        .map(|f| {
-            format!(
-                "{}: {}",
-                Value::String(f.name().clone()),
-                feature(f.data_type())
-            )
-        })
-        .collect();
-    format!("{{\"info\": {{\"features\": {{{}}}}}}}", entries.join(", "))
+    feature(&DataType::Struct(schema.fields().clone()))
+        .strip_prefix('{')
+        .map(|inner| format!("{{\"info\": {{\"features\": {{{inner}}}}}"))
+        .expect("a struct's feature is an object")
 }
 
 fn strings<'a>(values: impl Iterator<Item = &'a str>) -> ArrayRef {
