@@ -120,13 +120,11 @@ fn check_scores(ds: &Path, preds: &Path, rows: &[Value], rejected: bool) {
         .iter()
         .map(|r| (r["scene_id"].as_str().unwrap(), r))
         .collect();
-    let mut unsafe_rows = 0;
     for d in decisions.iter().filter(|d| d["model"] == "rejected") {
         let row = by_scene[d["scene_id"].as_str().unwrap()];
         assert_eq!(d["saa"], false, "rejected plan scored right: {d}");
         assert_eq!(d["action"], row["rejected_action"], "{d}");
         assert_eq!(d["rules"], row["rejected_rules"], "{d}");
-        unsafe_rows += (!d["rules"].as_array().unwrap().is_empty()) as usize;
         let reason = row["rejected_reason"].as_str().unwrap();
         assert!(
             reason.contains(d["action"].as_str().unwrap()) && reason.contains("ground truth"),
@@ -140,7 +138,6 @@ fn check_scores(ds: &Path, preds: &Path, rows: &[Value], rejected: bool) {
             .count(),
         rows.len()
     );
-    assert!(unsafe_rows > 0, "no rejected plan is unsafe");
     assert!(models["rejected"]["overall"]["saa"].as_f64() == Some(0.0));
 }
 
@@ -212,6 +209,10 @@ fn label_only_exports_load_and_score() {
     let preds = work.join("pref.jsonl");
     let rows = load(&pref, true, &preds, &cache);
     check_scores(&ds, &preds, &rows, true);
+    let unsafe_rows = rows
+        .iter()
+        .filter(|r| r["rejected_rules"] != serde_json::json!([]));
+    assert!(unsafe_rows.count() > 0, "no rejected plan is unsafe");
     // Every ground-truth action gets its rejection.
     for (gt, rejected) in [
         ("DODGE", "CATCH"),
