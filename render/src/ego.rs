@@ -15,14 +15,14 @@
 //! Deterministic: the pixels are a function of the scene, the frame and the size on a
 //! given adapter (no clock, no randomness; the same GPU commands every time).
 
-use super::execution::{carried, link_xf};
+use super::execution::{carried, moving_vertices};
 use super::geometry::SceneGeometry;
 use super::gpu::Gpu;
 use super::mesh::Mesh;
 use super::observer::link_meshes;
 use super::{RenderError, RenderOptions, Shading};
 use rh_catalog::Catalog;
-use rh_physics::body::{Geometry, Part};
+use rh_physics::body::Geometry;
 use rh_physics::execute::ExecFrame;
 use rh_physics::simulate::Simulation;
 use rh_physics::spec::{BodyKind, CameraSpec, SceneSpec, Vec3};
@@ -125,15 +125,7 @@ impl EgoCamera {
                 ),
             ));
         }
-        let mut verts = s.scene.dynamic_from(&frame.bodies, false);
-        let head = Part::Head as usize;
-        for (i, (mesh, pose)) in s.links.iter().zip(&frame.links).enumerate() {
-            if i != head {
-                mesh.transformed_into(&link_xf(pose), &mut verts);
-            }
-        }
-        let without_head = verts.len() as u32;
-        s.links[head].transformed_into(&link_xf(&frame.links[head]), &mut verts);
+        let (verts, without_head) = moving_vertices(&s.scene, &frame.bodies, &s.links, frame);
         let all = self.gpu.set_dynamic(&verts)?;
         let cam = carried(&s.ego, s.observer, frame, self.width, self.height);
         let view = s.scene.view_job(

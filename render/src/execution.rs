@@ -245,15 +245,7 @@ impl Renderer {
             let f = &frames[(step - stage.decision) as usize];
             (&f.bodies, f)
         };
-        let mut verts = stage.scene.dynamic_from(states, false);
-        let head = Part::Head as usize;
-        for (i, (mesh, pose)) in stage.links.iter().zip(&frame.links).enumerate() {
-            if i != head {
-                mesh.transformed_into(&link_xf(pose), &mut verts);
-            }
-        }
-        let without_head = verts.len() as u32;
-        stage.links[head].transformed_into(&link_xf(&frame.links[head]), &mut verts);
+        let (verts, without_head) = moving_vertices(&stage.scene, states, &stage.links, frame);
         let all = self.gpu.set_dynamic(&verts)?;
         let ego_cam = carried(
             stage.ego,
@@ -280,6 +272,27 @@ impl Renderer {
         let outside = images.pop().unwrap_or_default();
         Ok([outside, ego])
     }
+}
+
+/// The vertices of the scene's moving bodies at `states` and of the humanoid posed as in
+/// `frame`, its head last, and how many come before the head (the ego camera, carried in
+/// the head, draws without it).
+pub(super) fn moving_vertices(
+    scene: &SceneGeometry,
+    states: &[BodyState],
+    links: &[Mesh],
+    frame: &ExecFrame,
+) -> (Vec<super::mesh::Vertex>, u32) {
+    let mut verts = scene.dynamic_from(states, false);
+    let head = Part::Head as usize;
+    for (i, (mesh, pose)) in links.iter().zip(&frame.links).enumerate() {
+        if i != head {
+            mesh.transformed_into(&link_xf(pose), &mut verts);
+        }
+    }
+    let without_head = verts.len() as u32;
+    links[head].transformed_into(&link_xf(&frame.links[head]), &mut verts);
+    (verts, without_head)
 }
 
 pub(super) fn link_xf(p: &LinkPose) -> Xf {
