@@ -15,14 +15,12 @@
 //! Deterministic: the pixels are a function of the scene, the frame and the size on a
 //! given adapter (no clock, no randomness; the same GPU commands every time).
 
-use super::execution::{carried, moving_vertices};
+use super::execution::{carried, moving_vertices, stage_humanoid_scene};
 use super::geometry::SceneGeometry;
 use super::gpu::Gpu;
 use super::mesh::Mesh;
-use super::observer::link_meshes;
 use super::{RenderError, RenderOptions, Shading};
 use rh_catalog::Catalog;
-use rh_physics::body::Geometry;
 use rh_physics::execute::ExecFrame;
 use rh_physics::simulate::Simulation;
 use rh_physics::spec::{BodyKind, CameraSpec, SceneSpec, Vec3};
@@ -86,13 +84,7 @@ impl EgoCamera {
             .ok_or_else(|| fail("no 'ego' camera in the spec"))?
             .clone();
         let slots = slots_of(spec);
-        let mut scene = SceneGeometry::build(spec, &slots, catalog);
-        scene.hide_observer();
-        let links = link_meshes(&Geometry::of(&spec.observer).shapes());
-        let link_verts: usize = links.iter().map(|m| m.verts.len()).sum();
-        self.gpu
-            .reserve(scene.statics.len() + scene.max_dynamic + link_verts + 1024);
-        self.gpu.set_static(&scene.statics);
+        let (scene, links) = stage_humanoid_scene(&mut self.gpu, spec, &slots, catalog);
         self.gpu
             .cache_static_shadow(scene.light_vp, &scene.static_casters())?;
         let o = &spec.observer;

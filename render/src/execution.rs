@@ -22,7 +22,7 @@
 use super::camera::outside_camera;
 use super::encode::{EncodeSettings, VideoJob};
 use super::geometry::SceneGeometry;
-use super::gpu::ViewJob;
+use super::gpu::{Gpu, ViewJob};
 use super::mesh::{Mesh, Xf};
 use super::observer::link_meshes;
 use super::renderer::Renderer;
@@ -132,13 +132,7 @@ impl Renderer {
             .map(|j| start + (j as f64 / fps as f64 / dt).round() as u32)
             .take_while(|&s| s <= end)
             .collect();
-        let mut scene = SceneGeometry::build(spec, sim, catalog);
-        scene.hide_observer();
-        let links = link_meshes(&Geometry::of(&spec.observer).shapes());
-        let link_verts: usize = links.iter().map(|m| m.verts.len()).sum();
-        self.gpu
-            .reserve(scene.statics.len() + scene.max_dynamic + link_verts + 1024);
-        self.gpu.set_static(&scene.statics);
+        let (scene, links) = stage_humanoid_scene(&mut self.gpu, spec, sim, catalog);
         let o = &spec.observer;
         let stage = Stage {
             outside: execution_camera(spec, sim, decision, tracks, opts),
@@ -272,6 +266,24 @@ impl Renderer {
         let outside = images.pop().unwrap_or_default();
         Ok([outside, ego])
     }
+}
+
+/// The scene's geometry with its observer hidden (the executing humanoid is drawn from
+/// its links instead) and the humanoid's link meshes; `gpu`'s buffers are sized for both
+/// and the static vertices uploaded.
+pub(super) fn stage_humanoid_scene(
+    gpu: &mut Gpu,
+    spec: &SceneSpec,
+    sim: &Simulation,
+    catalog: &Catalog,
+) -> (SceneGeometry, Vec<Mesh>) {
+    let mut scene = SceneGeometry::build(spec, sim, catalog);
+    scene.hide_observer();
+    let links = link_meshes(&Geometry::of(&spec.observer).shapes());
+    let link_verts: usize = links.iter().map(|m| m.verts.len()).sum();
+    gpu.reserve(scene.statics.len() + scene.max_dynamic + link_verts + 1024);
+    gpu.set_static(&scene.statics);
+    (scene, links)
 }
 
 /// The vertices of the scene's moving bodies at `states` and of the humanoid posed as in
