@@ -32,7 +32,7 @@
 use crate::body::{REST_LEFT, REST_RIGHT};
 use crate::execute::motion::{plan_targets, reference_base, Reference};
 use crate::execute::outcome::Execution;
-use crate::execute::{ExecConfig, ExecPlan, Outcome, Replay};
+use crate::execute::{ExecConfig, ExecFrame, ExecPlan, Outcome, Replay};
 use crate::spec::{vec3, Vec3};
 
 /// One control period's whole-body command.
@@ -247,6 +247,12 @@ impl Session {
             self.end = Some(End::Truncated(self.ex.outcome(self.reach)));
         }
         Ok(self.end.as_ref())
+    }
+
+    /// The world now (every moving body, the humanoid's links, base and pelvis drop):
+    /// what the ego camera draws (`rh_render::EgoCamera`).
+    pub fn frame(&self) -> ExecFrame {
+        self.ex.frame()
     }
 
     /// The robot's own state: base `(x, y, yaw)` relative to its pose at Δ (in that

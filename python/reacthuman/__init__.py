@@ -15,8 +15,9 @@ A thin layer over the benchmark's Rust crates (the scorer ``rh-score`` and the p
   :mod:`reacthuman.env`).
 
 Bad input raises ``ValueError`` (naming the field), an unknown scene ``KeyError``, a
-missing dataset or file ``FileNotFoundError``; a bug in the Rust code raises
-``RuntimeError`` instead of taking the interpreter down. Long calls release the GIL.
+missing dataset or file ``FileNotFoundError``, an image observation without a renderer
+``RendererUnavailableError``; a bug in the Rust code raises ``RuntimeError`` instead of
+taking the interpreter down. Long calls release the GIL.
 """
 
 from __future__ import annotations
@@ -35,6 +36,8 @@ __all__ = [
     "prompt",
     "execute",
     "versions",
+    "RendererUnavailableError",
+    "HAS_RENDERER",
     "generation",
     "ACTION_RULE_VERSION",
     "EXECUTOR_VERSION",
@@ -42,6 +45,13 @@ __all__ = [
 ]
 
 ACTION_RULE_VERSION, EXECUTOR_VERSION, PROMPT_VERSION = _native.versions()
+
+#: Raised when the ego camera image is asked for and there is no renderer: no GPU adapter
+#: (no Vulkan driver, not even Mesa's lavapipe), or a wheel built without the ``render``
+#: feature (then ``HAS_RENDERER`` is False). A ``RuntimeError``.
+RendererUnavailableError = _native.RendererUnavailableError
+#: Whether this build has the renderer built in (an adapter may still be missing).
+HAS_RENDERER: bool = _native.HAS_RENDERER
 
 PathLike = Union[str, "os.PathLike[str]"]
 Plan = Union[Mapping[str, Any], str]

@@ -24,8 +24,14 @@ Observations (a ``Dict``): ``"robot"`` (14 numbers: base x, y, yaw relative to t
 at Δ; base vx, vy in the body frame and yaw rate; pelvis drop; left and right palm in
 the body frame; seconds since Δ) and, with ``privileged=True`` (default), ``"hazard"``
 (9 numbers: position relative to the base and velocity, both in the body frame; angular
-velocity). There is no image observation (the renderer needs a GPU or lavapipe and is
-not wired in; ``render_mode`` must be None).
+velocity) and, with ``image=True``, ``"image"``: the humanoid's ego camera at the step's
+end, ``image_height`` × ``image_width`` × 3 ``uint8`` RGB (128 × 128 by default), drawn by
+the dataset's renderer (``rh_render::EgoCamera``: wgpu on Vulkan, Mesa's lavapipe on a
+CPU) — the spec's ``ego`` camera carried by the base and the pelvis drop, the executing
+body's links drawn, the dataset's lighting and shadows. Without a renderer (no Vulkan
+driver, or a wheel built without the ``render`` feature) ``image=True`` raises
+:class:`reacthuman.RendererUnavailableError` at construction; state observations need
+none. ``render_mode`` must be None.
 
 Reward: at the end, ``rewards[outcome]`` (``struck`` −1; ``caught`` +1 on CATCH scenes,
 ``caught_other`` 0 elsewhere; ``missed`` and ``clear`` 0) minus ``step_cost`` per step,
@@ -113,12 +119,15 @@ class ReactHumanEnv(gym.Env):
         step_cost: float = 0.0,
         shaping: Optional[Callable[[dict, np.ndarray, dict], float]] = None,
         render_mode: Optional[str] = None,
+        image: bool = False,
+        image_width: int = 128,
+        image_height: int = 128,
     ) -> None:
         from . import Dataset
 
         if render_mode is not None:
             raise ValueError(
-                f"render_mode {render_mode!r}: ReactHuman-v0 has no renderer wired in (state observations only)"
+                f"render_mode {render_mode!r}: ReactHuman-v0 has no render modes (the ego camera is an observation: image=True)"
             )
         self.dataset = dataset if isinstance(dataset, Dataset) else Dataset(dataset)
         if scene_ids is None:
@@ -157,6 +166,16 @@ class ReactHumanEnv(gym.Env):
         obs = {"robot": _robot_space()}
         if self.privileged:
             obs["hazard"] = _hazard_space()
+        self.image = bool(image)
+        self._ego: Optional[_native.NativeEgoCamera] = None
+        if self.image:
+            for name, v in (("image_width", image_width), ("image_height", image_height)):
+                if not isinstance(v, (int, np.integer)) or isinstance(v, bool):
+                    raise ValueError(f"{name} must be an int (pixels), got {v!r}")
+            # RendererUnavailableError without a renderer; ValueError outside 1..=4096.
+            self._ego = _native.NativeEgoCamera(int(image_width), int(image_height))
+            self.image_shape = (int(image_height), int(image_width), 3)
+            obs["image"] = spaces.Box(0, 255, shape=self.image_shape, dtype=np.uint8)
         self.observation_space = spaces.Dict(obs)
         self._labels = {r["scene_id"]: r for r in self._label_rows()}
         self._session: Optional[_native.NativeSession] = None
@@ -188,6 +207,8 @@ class ReactHumanEnv(gym.Env):
         obs = {"robot": np.asarray(s.robot_state(), dtype=np.float64)}
         if self.privileged:
             obs["hazard"] = np.asarray(s.hazard_state(), dtype=np.float64)
+        if self._ego is not None:
+            obs["image"] = np.frombuffer(self._ego.draw(s), dtype=np.uint8).reshape(self.image_shape)
         return obs
 
     def _info(self, labels: bool) -> dict:

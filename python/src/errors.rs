@@ -5,6 +5,13 @@
 
 use pyo3::exceptions::{PyFileNotFoundError, PyKeyError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
+
+pyo3::create_exception!(
+    _native,
+    RendererUnavailableError,
+    PyRuntimeError,
+    "No renderer for the ego camera image: no GPU adapter (no Vulkan driver, not even Mesa's lavapipe), or a build without the `render` feature."
+);
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 /// What went wrong, by the Python exception it becomes.
@@ -16,6 +23,8 @@ pub enum Error {
     Key(String),
     /// A missing dataset or file: `FileNotFoundError`.
     NotFound(String),
+    /// No renderer (no adapter, or not built in): `RendererUnavailableError`.
+    NoRenderer(String),
     /// Anything else (an I/O failure, a bug): `RuntimeError`.
     Internal(String),
 }
@@ -39,6 +48,7 @@ impl From<Error> for PyErr {
             Error::Value(m) => PyValueError::new_err(m),
             Error::Key(m) => PyKeyError::new_err(m),
             Error::NotFound(m) => PyFileNotFoundError::new_err(m),
+            Error::NoRenderer(m) => RendererUnavailableError::new_err(m),
             Error::Internal(m) => PyRuntimeError::new_err(m),
         }
     }

@@ -4,12 +4,15 @@
 //!
 //! * [`dataset`] — `NativeDataset`: load, score, classify, prompt, execute;
 //! * [`session`] — `NativeSession`: one closed-loop episode (`rh_physics::control`);
+//! * [`ego`] — `NativeEgoCamera`: the episode's ego camera image (`rh_render::EgoCamera`,
+//!   feature `render`; `RendererUnavailableError` without a renderer);
 //! * [`errors`] — Rust errors and panics as named Python exceptions, the GIL released
 //!   around the work.
 //!
-//! Module graph: `session → dataset → errors`.
+//! Module graph: `ego → session → dataset → errors`.
 
 pub mod dataset;
+pub mod ego;
 pub mod errors;
 pub mod session;
 
@@ -68,6 +71,12 @@ fn _panic_for_tests(py: Python<'_>) -> PyResult<()> {
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<dataset::NativeDataset>()?;
     m.add_class::<session::NativeSession>()?;
+    m.add_class::<ego::NativeEgoCamera>()?;
+    m.add(
+        "RendererUnavailableError",
+        m.py().get_type::<errors::RendererUnavailableError>(),
+    )?;
+    m.add("HAS_RENDERER", cfg!(feature = "render"))?;
     m.add_function(wrap_pyfunction!(classify_plan, m)?)?;
     m.add_function(wrap_pyfunction!(versions, m)?)?;
     m.add_function(wrap_pyfunction!(execution_config, m)?)?;

@@ -5,7 +5,8 @@ use crate::dataset::{parse_plan, NativeDataset};
 use crate::errors::{guard, run, Error, Result};
 use pyo3::prelude::*;
 use rh_physics::control::{plan_command, Command, End, Session};
-use std::sync::Mutex;
+use rh_physics::execute::{ExecFrame, Replay};
+use std::sync::{Arc, Mutex};
 
 /// Numbers in an action: twist (3), left hand (3), right hand (3), knee bend.
 pub const ACTION_LEN: usize = 10;
@@ -40,6 +41,8 @@ fn flat(c: &Command) -> Vec<f64> {
 #[pyclass(module = "reacthuman._native", frozen)]
 pub struct NativeSession {
     session: Mutex<Session>,
+    /// The scene replayed to Δ (its spec: what the ego camera draws).
+    replay: Arc<Replay>,
 }
 
 impl NativeSession {
@@ -49,6 +52,11 @@ impl NativeSession {
             .lock()
             .map_err(|_| Error::Internal("the session was poisoned by an earlier panic".into()))?;
         f(&mut s)
+    }
+
+    /// The world now and the scene's replay (for the ego camera, `crate::ego`).
+    pub fn frame(&self) -> Result<(ExecFrame, Arc<Replay>)> {
+        self.with(|s| Ok((s.frame(), self.replay.clone())))
     }
 }
 
@@ -67,6 +75,7 @@ impl NativeSession {
                 Session::new(&replay, &dataset.cfg.execution, control_hz).map_err(Error::Value)?;
             Ok(NativeSession {
                 session: Mutex::new(s),
+                replay,
             })
         })
     }

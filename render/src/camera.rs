@@ -10,6 +10,11 @@ use rh_scenes::view;
 /// Column-major view-projection matrix agreeing with `view::View::project`:
 /// clip x/w and y/w are exactly its normalised coordinates; depth maps [near, far] to [0, 1].
 pub fn view_proj(cam: &CameraSpec) -> [[f32; 4]; 4] {
+    to_cols(view_proj_rows(cam))
+}
+
+/// [`view_proj`] in f64, row-major.
+fn view_proj_rows(cam: &CameraSpec) -> [[f64; 4]; 4] {
     let (r, u, f) = view::draw_basis(cam);
     let e = cam.position;
     let ty = (cam.fov_y / 2.0).tan();
@@ -17,13 +22,42 @@ pub fn view_proj(cam: &CameraSpec) -> [[f32; 4]; 4] {
     let (near, far) = (0.05, 60.0);
     let a = far / (far - near);
     let b = -near * far / (far - near);
-    let rows = [
+    [
         [r[0] / tx, r[1] / tx, r[2] / tx, -dot(r, e) / tx],
         [u[0] / ty, u[1] / ty, u[2] / ty, -dot(u, e) / ty],
         [a * f[0], a * f[1], a * f[2], -a * dot(f, e) + b],
         [f[0], f[1], f[2], -dot(f, e)],
-    ];
-    to_cols(rows)
+    ]
+}
+
+/// Inverse of [`view_proj`] in f64, row-major: (NDC x, y, depth, 1) to homogeneous
+/// world coordinates (Gauss-Jordan elimination with partial pivoting).
+pub(super) fn inverse_view_proj_rows(cam: &CameraSpec) -> [[f64; 4]; 4] {
+    let mut a = view_proj_rows(cam);
+    let mut inv = [[0.0f64; 4]; 4];
+    for (i, row) in inv.iter_mut().enumerate() {
+        row[i] = 1.0;
+    }
+    for c in 0..4 {
+        let p = (c..4)
+            .max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))
+            .unwrap_or(c);
+        a.swap(c, p);
+        inv.swap(c, p);
+        let d = a[c][c];
+        for j in 0..4 {
+            a[c][j] /= d;
+            inv[c][j] /= d;
+        }
+        for r in (0..4).filter(|&r| r != c) {
+            let f = a[r][c];
+            for j in 0..4 {
+                a[r][j] -= f * a[c][j];
+                inv[r][j] -= f * inv[c][j];
+            }
+        }
+    }
+    inv
 }
 
 pub(super) fn to_cols(rows: [[f64; 4]; 4]) -> [[f32; 4]; 4] {

@@ -1,10 +1,18 @@
 //! H.264 (libx264) yuv420p MP4 writing with ffmpeg-next: RGBA frames in, a
 //! browser-playable file (`+faststart`) out, written to a temporary sibling and renamed.
+//! Without the crate's `video` feature (no FFmpeg linked: the Python wheel's ego camera)
+//! the encoder is `encode_off`'s, which refuses at [`init`] and never writes a file.
 
+#[cfg(not(feature = "video"))]
+pub use super::encode_off::{init, Mp4Writer};
+#[cfg(feature = "video")]
 use ffmpeg_next as ff;
-use std::path::{Path, PathBuf};
+#[cfg(feature = "video")]
+use std::path::Path;
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{sync_channel, SyncSender};
+#[cfg(feature = "video")]
 use std::sync::Once;
 use std::thread::JoinHandle;
 
@@ -17,8 +25,10 @@ pub struct EncodeSettings {
     pub threads: u32,
 }
 
+#[cfg(feature = "video")]
 static INIT: Once = Once::new();
 
+#[cfg(feature = "video")]
 pub fn init() -> Result<(), String> {
     let mut err = None;
     INIT.call_once(|| {
@@ -34,6 +44,7 @@ pub fn init() -> Result<(), String> {
 }
 
 /// One MP4 being written.
+#[cfg(feature = "video")]
 pub struct Mp4Writer {
     octx: ff::format::context::Output,
     encoder: ff::encoder::Video,
@@ -50,10 +61,12 @@ pub struct Mp4Writer {
     path: PathBuf,
 }
 
+#[cfg(feature = "video")]
 fn fferr(what: &str, e: ff::Error) -> String {
     format!("{what}: {e}")
 }
 
+#[cfg(feature = "video")]
 impl Mp4Writer {
     pub fn create(
         path: &Path,
@@ -219,6 +232,7 @@ impl Mp4Writer {
     }
 }
 
+#[cfg(feature = "video")]
 impl Drop for Mp4Writer {
     fn drop(&mut self) {
         // A writer dropped without `finish` leaves no partial file behind.

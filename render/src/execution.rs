@@ -22,7 +22,7 @@
 use super::camera::outside_camera;
 use super::encode::{EncodeSettings, VideoJob};
 use super::geometry::SceneGeometry;
-use super::gpu::ViewJob;
+use super::gpu::{Gpu, ViewJob};
 use super::mesh::{Mesh, Xf};
 use super::observer::link_meshes;
 use super::renderer::Renderer;
@@ -132,13 +132,7 @@ impl Renderer {
             .map(|j| start + (j as f64 / fps as f64 / dt).round() as u32)
             .take_while(|&s| s <= end)
             .collect();
-        let mut scene = SceneGeometry::build(spec, sim, catalog);
-        scene.hide_observer();
-        let links = link_meshes(&Geometry::of(&spec.observer).shapes());
-        let link_verts: usize = links.iter().map(|m| m.verts.len()).sum();
-        self.gpu
-            .reserve(scene.statics.len() + scene.max_dynamic + link_verts + 1024);
-        self.gpu.set_static(&scene.statics);
+        let (scene, links) = stage_humanoid_scene(&mut self.gpu, spec, sim, catalog);
         let o = &spec.observer;
         let stage = Stage {
             outside: execution_camera(spec, sim, decision, tracks, opts),
@@ -245,15 +239,7 @@ impl Renderer {
             let f = &frames[(step - stage.decision) as usize];
             (&f.bodies, f)
         };
-        let mut verts = stage.scene.dynamic_from(states, false);
-        let head = Part::Head as usize;
-        for (i, (mesh, pose)) in stage.links.iter().zip(&frame.links).enumerate() {
-            if i != head {
-                mesh.transformed_into(&link_xf(pose), &mut verts);
-            }
-        }
-        let without_head = verts.len() as u32;
-        stage.links[head].transformed_into(&link_xf(&frame.links[head]), &mut verts);
+        let (verts, without_head) = moving_vertices(&stage.scene, states, &stage.links, frame);
         let all = self.gpu.set_dynamic(&verts)?;
         let ego_cam = carried(
             stage.ego,
@@ -282,7 +268,46 @@ impl Renderer {
     }
 }
 
-fn link_xf(p: &LinkPose) -> Xf {
+/// The scene's geometry with its observer hidden (the executing humanoid is drawn from
+/// its links instead) and the humanoid's link meshes; `gpu`'s buffers are sized for both
+/// and the static vertices uploaded.
+pub(super) fn stage_humanoid_scene(
+    gpu: &mut Gpu,
+    spec: &SceneSpec,
+    sim: &Simulation,
+    catalog: &Catalog,
+) -> (SceneGeometry, Vec<Mesh>) {
+    let mut scene = SceneGeometry::build(spec, sim, catalog);
+    scene.hide_observer();
+    let links = link_meshes(&Geometry::of(&spec.observer).shapes());
+    let link_verts: usize = links.iter().map(|m| m.verts.len()).sum();
+    gpu.reserve(scene.statics.len() + scene.max_dynamic + link_verts + 1024);
+    gpu.set_static(&scene.statics);
+    (scene, links)
+}
+
+/// The vertices of the scene's moving bodies at `states` and of the humanoid posed as in
+/// `frame`, its head last, and how many come before the head (the ego camera, carried in
+/// the head, draws without it).
+pub(super) fn moving_vertices(
+    scene: &SceneGeometry,
+    states: &[BodyState],
+    links: &[Mesh],
+    frame: &ExecFrame,
+) -> (Vec<super::mesh::Vertex>, u32) {
+    let mut verts = scene.dynamic_from(states, false);
+    let head = Part::Head as usize;
+    for (i, (mesh, pose)) in links.iter().zip(&frame.links).enumerate() {
+        if i != head {
+            mesh.transformed_into(&link_xf(pose), &mut verts);
+        }
+    }
+    let without_head = verts.len() as u32;
+    links[head].transformed_into(&link_xf(&frame.links[head]), &mut verts);
+    (verts, without_head)
+}
+
+pub(super) fn link_xf(p: &LinkPose) -> Xf {
     Xf::from_quat(p.rotation, p.position)
 }
 
@@ -297,7 +322,13 @@ fn check(done: Result<u32, String>, want: u32, path: &Path, errors: &mut Vec<Str
 
 /// The spec's ego camera moved with the body: the base's displacement and turn from the
 /// observer's `(x, y, yaw)`, and the pelvis drop.
-fn carried(ego: &CameraSpec, observer: Vec3, f: &ExecFrame, width: u32, height: u32) -> CameraSpec {
+pub(super) fn carried(
+    ego: &CameraSpec,
+    observer: Vec3,
+    f: &ExecFrame,
+    width: u32,
+    height: u32,
+) -> CameraSpec {
     let turn = quat::from_axis_angle([0.0, 0.0, 1.0], f.base[2] - observer[2]);
     let carry = |p: Vec3| {
         let local = [p[0] - observer[0], p[1] - observer[1], p[2]];

@@ -1,8 +1,9 @@
 // FXAA-style post-process anti-aliasing (after Lottes' FXAA, the compact variant):
-// a full-screen pass over a resolved frame, in display (sRGB-encoded) values. Pixels
+// full-screen passes over a resolved frame, in display (sRGB-encoded) values. Pixels
 // whose four neighbours differ little in luma are copied unchanged (most pixels: five
 // texel loads); on an edge, the blur direction is taken from the luma gradient (four
-// diagonal loads) and the frame is sampled along it (four filtered taps).
+// diagonal loads) and the frame is sampled along it (four filtered taps). Two passes:
+// `fs_fxaa_mark` copies and marks edges, `fs_fxaa_edge` blends only those.
 
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var smp: sampler;
@@ -35,26 +36,62 @@ const REDUCE_MUL: f32 = 0.125;
 const REDUCE_MIN: f32 = 0.0078125;
 const SPAN_MAX: f32 = 8.0;
 
-@fragment
-fn fs_fxaa(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let dims = vec2<i32>(textureDimensions(src));
-    let p = vec2<i32>(pos.xy);
+// The four neighbours' lumas and the frame's (lmin, lmax) around `p`.
+struct Cross {
+    m: vec3<f32>,
+    lmin: f32,
+    lmax: f32,
+};
+
+fn cross_at(p: vec2<i32>, dims: vec2<i32>) -> Cross {
     let m = textureLoad(src, p, 0).rgb;
     let lm = luma(m);
     let ln = luma(near(p, dims, vec2<i32>(0, -1)));
     let ls = luma(near(p, dims, vec2<i32>(0, 1)));
     let lw = luma(near(p, dims, vec2<i32>(-1, 0)));
     let le = luma(near(p, dims, vec2<i32>(1, 0)));
-    let lmin = min(lm, min(min(ln, ls), min(lw, le)));
-    let lmax = max(lm, max(max(ln, ls), max(lw, le)));
-    if (lmax - lmin < max(EDGE_MIN, lmax * EDGE_REL)) {
-        return vec4<f32>(m, 1.0);
-    }
+    var c: Cross;
+    c.m = m;
+    c.lmin = min(lm, min(min(ln, ls), min(lw, le)));
+    c.lmax = max(lm, max(max(ln, ls), max(lw, le)));
+    return c;
+}
+
+fn is_edge(c: Cross) -> bool {
+    return !(c.lmax - c.lmin < max(EDGE_MIN, c.lmax * EDGE_REL));
+}
+
+struct Marked {
+    @location(0) color: vec4<f32>,
+    @builtin(frag_depth) depth: f32,
+};
+
+// First of two passes (a CPU rasterizer runs both sides of every branch, so the edge
+// blend of a one-pass shader would cost every pixel): every pixel is copied, and edge
+// pixels get depth 0, the others 1. The second pass, `fs_fxaa_edge`, drawn at depth 0
+// with an `Equal` test, blends only the edge pixels (whole pixel groups without an edge
+// are skipped). Together: the one-pass FXAA's pixels exactly.
+@fragment
+fn fs_fxaa_mark(@builtin(position) pos: vec4<f32>) -> Marked {
+    let c = cross_at(vec2<i32>(pos.xy), vec2<i32>(textureDimensions(src)));
+    var o: Marked;
+    o.color = vec4<f32>(c.m, 1.0);
+    o.depth = select(1.0, 0.0, is_edge(c));
+    return o;
+}
+
+// The blend of an edge pixel (see `fs_fxaa_mark`).
+@fragment
+fn fs_fxaa_edge(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    let dims = vec2<i32>(textureDimensions(src));
+    let p = vec2<i32>(pos.xy);
+    let c = cross_at(p, dims);
+    let lmin = c.lmin;
+    let lmax = c.lmax;
     let inv = 1.0 / vec2<f32>(dims);
     let uv = pos.xy * inv;
-    // Diagonal neighbours: the gradient's direction. Texel centres, so loads (a CPU
-    // rasterizer runs both sides of the branch above, and a load costs a fraction of a
-    // filtered sample).
+    // Diagonal neighbours: the gradient's direction. Texel centres, so loads (a
+    // load costs a fraction of a filtered sample on a CPU rasterizer).
     let lnw = luma(near(p, dims, vec2<i32>(-1, -1)));
     let lne = luma(near(p, dims, vec2<i32>(1, -1)));
     let lsw = luma(near(p, dims, vec2<i32>(-1, 1)));

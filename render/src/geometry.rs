@@ -2,13 +2,14 @@
 //! ceiling) meshed once per scene, moving bodies meshed once in their body frames and
 //! posed per step, ropes, and what each camera sees.
 
-use super::camera::view_proj;
+use super::camera::{inverse_view_proj_rows, view_proj};
 use super::gpu::{self, Uniforms, ViewJob};
 use super::lighting::Lighting;
 use super::mesh::*;
 use super::observer::observer_mesh;
 use super::recipes;
 use super::regions::{bounds, rects_meet, screen_rect, shadow_regions};
+use super::tiles::SurfaceTiles;
 use super::Shading;
 use rh_catalog::Catalog;
 use rh_contract::layout::instance;
@@ -53,6 +54,18 @@ pub(super) struct FixedView<'a> {
     visible: Vec<(Range<u32>, [u32; 4])>,
     /// Their receiver boxes (`Piece::receivers`).
     receivers: Vec<[Vec3; 2]>,
+    /// Where its static surfaces are, per screen tile (without MSAA: `set_surface`).
+    tiles: Option<SurfaceTiles>,
+}
+
+impl FixedView<'_> {
+    /// Takes the view's cached static depth (one sample per pixel): redraws are then
+    /// the screen tiles whose surface the moving casters' shadow can reach.
+    pub(super) fn set_surface(&mut self, depth: &[f32]) {
+        let inv = inverse_view_proj_rows(self.cam);
+        let (w, h) = (self.cam.width, self.cam.height);
+        self.tiles = Some(SurfaceTiles::from_depth(depth, w, h, inv));
+    }
 }
 
 struct Wall {
@@ -293,6 +306,7 @@ impl SceneGeometry {
                 .map(|(p, rect)| (p.range.clone(), rect))
                 .collect(),
             view,
+            tiles: None,
         }
     }
 
@@ -304,14 +318,17 @@ impl SceneGeometry {
         v: &FixedView,
         moving: [Vec3; 2],
     ) -> Vec<([u32; 4], Vec<Range<u32>>)> {
-        shadow_regions(
-            v.cam,
-            v.view.as_ref(),
-            moving,
-            self.shadow_reach,
-            self.sun_dir,
-            &v.receivers,
-        )
+        match &v.tiles {
+            Some(tiles) => tiles.redraw_rects(moving, self.shadow_reach, self.sun_dir),
+            None => shadow_regions(
+                v.cam,
+                v.view.as_ref(),
+                moving,
+                self.shadow_reach,
+                self.sun_dir,
+                &v.receivers,
+            ),
+        }
         .into_iter()
         .map(|rect| {
             let ranges = v

@@ -33,12 +33,16 @@
 //! | `regions` | shadow-tile rectangle maths: where a moving shadow can change pixels |
 //! | `measure` | the instance-id pass at the observation frames: hazard visibility, masks, depth |
 //! | `gpu` | the wgpu device, pipelines, static cache and overlay drawing |
-//! | `encode` | H.264 encoding through FFmpeg |
+//! | `encode` | H.264 encoding through FFmpeg (feature `video`, default; `encode_off` without it) |
 //! | `execution` | execution videos: outside and ego views of executed plans, tiled ([`Renderer::render_executions`]) |
+//! | `ego` | [`EgoCamera`]: the ego view of a closed-loop episode, one step at a time (the Gym env's image) |
 //! | `sheet` | the contact sheet (`rh-pipeline sheet`) |
 
 mod camera;
+mod ego;
 pub mod encode;
+#[cfg(not(feature = "video"))]
+mod encode_off;
 mod execution;
 mod font;
 mod geometry;
@@ -51,12 +55,14 @@ pub mod recipes;
 mod regions;
 mod renderer;
 mod sheet;
+mod tiles;
 
 use encode::EncodeSettings;
 use rh_scenes::config::RenderConfig;
 use std::collections::BTreeMap;
 
 pub use camera::{full_event_camera, view_proj};
+pub use ego::EgoCamera;
 pub use execution::{ExecTrack, ExecVideoOptions, ExecVideos, TiledVideo};
 pub use gpu::probe_adapter;
 pub use measure::Observed;

@@ -55,7 +55,7 @@ pub(super) fn screen_rect(
 
 /// Merges rectangles pairwise, cheapest first (least area added), while a merge adds
 /// no area or more than `max` remain.
-fn merge_rects(rects: &mut Vec<[u32; 4]>, max: usize) {
+pub(super) fn merge_rects(rects: &mut Vec<[u32; 4]>, max: usize) {
     loop {
         let mut best: Option<(i64, usize, usize)> = None;
         for i in 0..rects.len() {
@@ -117,23 +117,10 @@ pub(super) fn shadow_regions(
     let d = [sun_dir[0] as f64, sun_dir[1] as f64, sun_dir[2] as f64];
     let mut rects: Vec<[u32; 4]> = Vec::new();
     for [rlo, rhi] in receivers {
-        // The translates B + d·t that overlap R: t in [t0, t1], per axis.
-        let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
-        for i in 0..3 {
-            let (rlo, rhi) = (rlo[i] - PAD, rhi[i] + PAD);
-            if d[i].abs() < 1e-9 {
-                if hi[i] < rlo || lo[i] > rhi {
-                    t1 = -1.0;
-                }
-                continue;
-            }
-            let (a, b) = ((rlo - hi[i]) / d[i], (rhi - lo[i]) / d[i]);
-            t0 = t0.max(a.min(b));
-            t1 = t1.min(a.max(b));
-        }
-        if t1 < t0 {
+        let receiver = [rlo.map(|v| v - PAD), rhi.map(|v| v + PAD)];
+        let Some((t0, t1)) = sweep_interval([lo, hi], d, receiver) else {
             continue;
-        }
+        };
         let mut box_lo = [0.0; 3];
         let mut box_hi = [0.0; 3];
         for i in 0..3 {
@@ -152,6 +139,31 @@ pub(super) fn shadow_regions(
     rects
 }
 
+/// The translates B + d·t (t >= 0) of box `b` that meet box `r`: t in `[t0, t1]`
+/// (`None` when none do).
+fn sweep_interval(b: [Vec3; 2], d: Vec3, r: [Vec3; 2]) -> Option<(f64, f64)> {
+    let ([lo, hi], [rlo, rhi]) = (b, r);
+    let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+    for i in 0..3 {
+        if d[i].abs() < 1e-9 {
+            if hi[i] < rlo[i] || lo[i] > rhi[i] {
+                return None;
+            }
+            continue;
+        }
+        let (a, b) = ((rlo[i] - hi[i]) / d[i], (rhi[i] - lo[i]) / d[i]);
+        t0 = t0.max(a.min(b));
+        t1 = t1.min(a.max(b));
+    }
+    (t1 >= t0).then_some((t0, t1))
+}
+
+/// Whether the shadow sweep of box `b` along `d` (its translates B + d·t, t >= 0)
+/// meets box `r`.
+pub(super) fn sweep_meets(b: [Vec3; 2], d: Vec3, r: [Vec3; 2]) -> bool {
+    sweep_interval(b, d, r).is_some()
+}
+
 /// Side of the screen tiles `cover_with_tiles` snaps to (pixels).
 const REDRAW_TILE: u32 = 16;
 
@@ -168,6 +180,20 @@ fn cover_with_tiles(rects: &[[u32; 4]], width: u32, height: u32) -> Vec<[u32; 4]
             }
         }
     }
+    runs_to_rects(&marked, cols, rows, REDRAW_TILE, width, height)
+}
+
+/// Rectangles (pixels) covering the marked tiles (`cols` × `rows`, row-major, side
+/// `tile`): each tile row's runs, runs with the same span in consecutive rows stacked
+/// into one rectangle.
+pub(super) fn runs_to_rects(
+    marked: &[bool],
+    cols: u32,
+    rows: u32,
+    tile: u32,
+    width: u32,
+    height: u32,
+) -> Vec<[u32; 4]> {
     // Open rectangles in tile units: (first column, end column, first row, end row).
     let mut done: Vec<[u32; 4]> = Vec::new();
     let mut open: Vec<[u32; 4]> = Vec::new();
@@ -202,11 +228,8 @@ fn cover_with_tiles(rects: &[[u32; 4]], width: u32, height: u32) -> Vec<[u32; 4]
     done.append(&mut open);
     done.into_iter()
         .map(|[c0, c1, r0, r1]| {
-            let (x0, y0) = (c0 * REDRAW_TILE, r0 * REDRAW_TILE);
-            let (x1, y1) = (
-                (c1 * REDRAW_TILE).min(width),
-                (r1 * REDRAW_TILE).min(height),
-            );
+            let (x0, y0) = (c0 * tile, r0 * tile);
+            let (x1, y1) = ((c1 * tile).min(width), (r1 * tile).min(height));
             [x0, y0, x1 - x0, y1 - y0]
         })
         .collect()

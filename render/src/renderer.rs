@@ -109,11 +109,16 @@ impl Renderer {
         self.gpu
             .cache_static(scene.light_vp, &scene.static_casters(), &static_views)?;
         // What each view needs per frame that does not change within the scene.
-        let fixed_views: Vec<FixedView> = all_cams
+        let mut fixed_views: Vec<FixedView> = all_cams
             .iter()
             .enumerate()
             .map(|(slot, cam)| scene.fixed_view(slot, cam))
             .collect();
+        for v in &mut fixed_views {
+            if let Some(depth) = self.gpu.cached_depth(v.slot)? {
+                v.set_surface(&depth);
+            }
+        }
         let (window_views, full_view) = fixed_views.split_at(cams.len());
         // The id pass at the observation frames: measured visibility, and the mask and
         // depth PNGs (written on their own thread while the frames below render).

@@ -11,7 +11,7 @@ struct U {
     background: vec4<f32>,
     // The fill pass's rectangles in normalised device coordinates (x0, y0, x1, y1),
     // one per instance.
-    fill_rects: array<vec4<f32>, 8>,
+    fill_rects: array<vec4<f32>, 32>,
 };
 
 @group(0) @binding(0) var<uniform> u: U;

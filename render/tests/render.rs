@@ -401,20 +401,35 @@ fn preview() {
 /// static surfaces only where moving bodies can cast shadows. The observation frames
 /// it writes must be pixel-identical to drawing the whole scene from scratch, in every
 /// family (each has its own moving geometry, heights and shadow directions).
+/// Four samples: the harder case for the redraw rectangles (multisampled scissor edges),
+/// what a GPU draws.
 #[test]
 fn cached_static_frames_equal_whole_scene_frames_in_every_family() {
+    cached_frames_equal_whole_frames(4, false);
+}
+
+/// The same with one sample and FXAA, what lavapipe draws: redraws re-shade only the
+/// pixels whose cached surface lies in the moving casters' shadow sweep (`fs_mark`),
+/// and the two-pass FXAA is redone around what changed.
+#[test]
+fn cached_static_frames_equal_whole_scene_frames_without_msaa() {
+    cached_frames_equal_whole_frames(1, true);
+}
+
+fn cached_frames_equal_whole_frames(samples: u32, fxaa: bool) {
     let mut config = small_config();
     config.render.width = 192;
     config.render.height = 108;
-    // Four samples: the harder case (multisampled scissor edges), on any adapter.
-    config.render.msaa = 4;
-    config.render.msaa_cpu = 4;
+    config.render.msaa = samples;
+    config.render.msaa_cpu = samples;
+    config.render.fxaa = fxaa;
     let mut r = Renderer::new(RenderOptions::from_config(&config.render)).unwrap();
-    assert_eq!(r.samples(), 4);
+    assert_eq!(r.samples(), samples);
     let catalog = Catalog::embedded().unwrap();
     let families = config.build.families.clone();
     assert_eq!(families.len(), 17);
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render-cache-test");
+    let dir =
+        PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("render-cache-test-{samples}"));
     let _ = std::fs::remove_dir_all(&dir);
     let mut compared = 0;
     for (fi, family) in families.iter().enumerate() {

@@ -220,80 +220,89 @@ fn read_parquet(file: &Path) -> Result<Vec<SceneInput>> {
     let mut out = Vec::new();
     for batch in reader {
         let batch = batch.map_err(|e| InputError(format!("{}: {e}", file.display())))?;
-        let scene_id = required_strings(&batch, file, col::SCENE_ID)?;
-        let group_id = required_strings(&batch, file, col::GROUP_ID)?;
-        let family = required_strings(&batch, file, col::FAMILY)?;
-        let speed_band = required_strings(&batch, file, col::SPEED_BAND)?;
-        let speed_sweep = bools(&batch, file, col::SPEED_SWEEP)?;
-        let object_id = required_strings(&batch, file, col::OBJECT_ID)?;
-        let looks_like = strings(&batch, file, col::LOOKS_LIKE)?;
-        let adversarial = bools(&batch, file, col::ADVERSARIAL)?;
-        let gt_action = required_strings(&batch, file, col::GT_ACTION)?;
-        let dangerous = bools(&batch, file, col::DANGEROUS)?;
-        let danger_present = bools(&batch, file, col::DANGER_PRESENT)?;
-        let impact_point = vec3s(&batch, file, col::IMPACT_POINT)?;
-        let object_start = vec3s(&batch, file, col::OBJECT_START)?;
-        let observer_pose = vec3s(&batch, file, col::OBSERVER_POSE)?;
-        let valid = if batch.column_by_name(col::VALID).is_some() {
-            bools(&batch, file, col::VALID)?
-        } else {
-            vec![true; batch.num_rows()]
-        };
-        for i in 0..batch.num_rows() {
-            let gt = Action::parse(&gt_action[i]).ok_or_else(|| {
-                bad(
-                    file,
-                    col::GT_ACTION,
-                    format!(
-                        "has value {:?} in row {i}, expected CATCH, DODGE or NO_ACTION",
-                        gt_action[i]
-                    ),
-                )
-            })?;
-            let object_start = object_start[i]
-                .ok_or_else(|| bad(file, col::OBJECT_START, format!("is null in row {i}")))?;
-            let observer_pose = observer_pose[i]
-                .ok_or_else(|| bad(file, col::OBSERVER_POSE, format!("is null in row {i}")))?;
-            let finite = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
-            if !finite(&object_start) {
-                return Err(bad(
-                    file,
-                    col::OBJECT_START,
-                    format!("is not finite in row {i}"),
-                ));
-            }
-            if !finite(&observer_pose) {
-                return Err(bad(
-                    file,
-                    col::OBSERVER_POSE,
-                    format!("is not finite in row {i}"),
-                ));
-            }
-            if impact_point[i].is_some_and(|p| !finite(&p)) {
-                return Err(bad(
-                    file,
-                    col::IMPACT_POINT,
-                    format!("is not finite in row {i}"),
-                ));
-            }
-            out.push(SceneInput {
-                scene_id: scene_id[i].clone(),
-                group_id: group_id[i].clone(),
-                family: family[i].clone(),
-                speed_band: speed_band[i].clone(),
-                speed_sweep: speed_sweep[i],
-                object_id: object_id[i].clone(),
-                looks_like: looks_like[i].clone(),
-                adversarial: adversarial[i],
-                gt_action: gt,
-                dangerous: dangerous[i],
-                danger_present: danger_present[i],
-                impact_point: impact_point[i],
-                object_start,
-                observer_pose,
-                valid: valid[i],
-            });
+        out.extend(scenes_of_batch(&batch, file)?);
+    }
+    Ok(out)
+}
+
+/// The scenes of one batch of scene-table rows read from `file` (named in errors), in
+/// row order: the reader of [`Dataset::load`], and of readers that stream a table batch
+/// by batch (`export`) so that memory does not grow with the table.
+pub fn scenes_of_batch(batch: &RecordBatch, file: &Path) -> Result<Vec<SceneInput>> {
+    let mut out = Vec::with_capacity(batch.num_rows());
+    let scene_id = required_strings(batch, file, col::SCENE_ID)?;
+    let group_id = required_strings(batch, file, col::GROUP_ID)?;
+    let family = required_strings(batch, file, col::FAMILY)?;
+    let speed_band = required_strings(batch, file, col::SPEED_BAND)?;
+    let speed_sweep = bools(batch, file, col::SPEED_SWEEP)?;
+    let object_id = required_strings(batch, file, col::OBJECT_ID)?;
+    let looks_like = strings(batch, file, col::LOOKS_LIKE)?;
+    let adversarial = bools(batch, file, col::ADVERSARIAL)?;
+    let gt_action = required_strings(batch, file, col::GT_ACTION)?;
+    let dangerous = bools(batch, file, col::DANGEROUS)?;
+    let danger_present = bools(batch, file, col::DANGER_PRESENT)?;
+    let impact_point = vec3s(batch, file, col::IMPACT_POINT)?;
+    let object_start = vec3s(batch, file, col::OBJECT_START)?;
+    let observer_pose = vec3s(batch, file, col::OBSERVER_POSE)?;
+    let valid = if batch.column_by_name(col::VALID).is_some() {
+        bools(batch, file, col::VALID)?
+    } else {
+        vec![true; batch.num_rows()]
+    };
+    for i in 0..batch.num_rows() {
+        let gt = Action::parse(&gt_action[i]).ok_or_else(|| {
+            bad(
+                file,
+                col::GT_ACTION,
+                format!(
+                    "has value {:?} in row {i}, expected CATCH, DODGE or NO_ACTION",
+                    gt_action[i]
+                ),
+            )
+        })?;
+        let object_start = object_start[i]
+            .ok_or_else(|| bad(file, col::OBJECT_START, format!("is null in row {i}")))?;
+        let observer_pose = observer_pose[i]
+            .ok_or_else(|| bad(file, col::OBSERVER_POSE, format!("is null in row {i}")))?;
+        let finite = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
+        if !finite(&object_start) {
+            return Err(bad(
+                file,
+                col::OBJECT_START,
+                format!("is not finite in row {i}"),
+            ));
         }
+        if !finite(&observer_pose) {
+            return Err(bad(
+                file,
+                col::OBSERVER_POSE,
+                format!("is not finite in row {i}"),
+            ));
+        }
+        if impact_point[i].is_some_and(|p| !finite(&p)) {
+            return Err(bad(
+                file,
+                col::IMPACT_POINT,
+                format!("is not finite in row {i}"),
+            ));
+        }
+        out.push(SceneInput {
+            scene_id: scene_id[i].clone(),
+            group_id: group_id[i].clone(),
+            family: family[i].clone(),
+            speed_band: speed_band[i].clone(),
+            speed_sweep: speed_sweep[i],
+            object_id: object_id[i].clone(),
+            looks_like: looks_like[i].clone(),
+            adversarial: adversarial[i],
+            gt_action: gt,
+            dangerous: dangerous[i],
+            danger_present: danger_present[i],
+            impact_point: impact_point[i],
+            object_start,
+            observer_pose,
+            valid: valid[i],
+        });
     }
     Ok(out)
 }
@@ -317,30 +326,42 @@ pub fn read_replay_keys(dir: &Path) -> Result<FastMap<String, ReplayKey>> {
         let reader = open_parquet(file, 8192)?;
         for batch in reader {
             let batch = batch.map_err(|e| InputError(format!("{}: {e}", file.display())))?;
-            let optional = |name: &str| -> Result<Vec<Option<String>>> {
-                if batch.column_by_name(name).is_some() {
-                    strings(&batch, file, name)
-                } else {
-                    Ok(vec![None; batch.num_rows()])
-                }
-            };
-            let ids = required_strings(&batch, file, col::SCENE_ID)?;
-            let specs = optional(col::SPEC_FILE)?;
-            let full = optional(col::STATE_HASH)?;
-            let decision = optional(col::DECISION_STATE_HASH)?;
-            for (i, id) in ids.into_iter().enumerate() {
-                let key = ReplayKey {
-                    spec_file: specs[i]
-                        .clone()
-                        .unwrap_or_else(|| rh_contract::layout::spec_path(&id)),
-                    state_hash: full[i].clone(),
-                    decision_state_hash: decision[i].clone(),
-                };
+            for (id, key) in replay_keys_of_batch(&batch, file)? {
                 out.entry(id).or_insert(key);
             }
         }
     }
     Ok(out)
+}
+
+/// The replay columns of one batch of scene-table rows (see [`read_replay_keys`]), in row
+/// order.
+pub fn replay_keys_of_batch(batch: &RecordBatch, file: &Path) -> Result<Vec<(String, ReplayKey)>> {
+    let optional = |name: &str| -> Result<Vec<Option<String>>> {
+        if batch.column_by_name(name).is_some() {
+            strings(batch, file, name)
+        } else {
+            Ok(vec![None; batch.num_rows()])
+        }
+    };
+    let ids = required_strings(batch, file, col::SCENE_ID)?;
+    let specs = optional(col::SPEC_FILE)?;
+    let full = optional(col::STATE_HASH)?;
+    let decision = optional(col::DECISION_STATE_HASH)?;
+    Ok(ids
+        .into_iter()
+        .enumerate()
+        .map(|(i, id)| {
+            let key = ReplayKey {
+                spec_file: specs[i]
+                    .clone()
+                    .unwrap_or_else(|| rh_contract::layout::spec_path(&id)),
+                state_hash: full[i].clone(),
+                decision_state_hash: decision[i].clone(),
+            };
+            (id, key)
+        })
+        .collect())
 }
 
 /// Which scenes a run covers: the eval subset or every valid scene.

@@ -46,6 +46,8 @@ pub mod error;
 pub mod execute_scored;
 pub mod execution;
 pub mod explain;
+#[cfg(feature = "predict")]
+pub mod export;
 pub mod fast_map;
 pub mod figures;
 pub mod html;

@@ -24,13 +24,15 @@
 //! * **NO_ACTION** — stand still, hands at rest.
 
 use crate::config::Config;
-use crate::dataset::{open_parquet, parquet_files, read_replay_keys, Dataset, Scene};
+use crate::dataset::{open_parquet, parquet_files, read_replay_keys, Dataset, ReplayKey, Scene};
+use crate::fast_map::FastMap;
 use crate::plan_json::{kf, plan, solve_walk, wrap_angle};
 use anyhow::Result;
-use arrow::array::{Array, FixedSizeListArray, Float32Array, Float64Array, ListArray};
+use arrow::array::{Array, FixedSizeListArray, Float32Array, Float64Array, ListArray, RecordBatch};
 use rh_contract::Action;
 use serde_json::Value;
 use std::collections::BTreeMap;
+use std::path::Path;
 
 /// CATCH stance: the impact point this far ahead of the pelvis when the arm allows (m).
 pub const CATCH_STANDOFF: f64 = 0.40;
@@ -205,14 +207,56 @@ pub fn load_hints(ds: &Dataset, cfg: &Config) -> Result<BTreeMap<String, OracleH
         hints.entry(id).or_default().dodge = Some(plan);
     }
     #[cfg(not(feature = "execute"))]
-    if ds.dir.join("specs").is_dir() {
-        let _ = cfg;
+    refuse_without_physics(&ds.dir, cfg)?;
+    Ok(hints)
+}
+
+/// [`load_hints`] for one batch of scene rows of the dataset at `dir` (a reader that
+/// streams the table, `export`): the hazard's motion from the batch's columns, Δ from the
+/// scenes' specs, then the physics-checked dodges of `scenes` (the batch's) — the hints
+/// [`load_hints`] gives these scenes.
+pub fn batch_hints(
+    dir: &Path,
+    batch: &RecordBatch,
+    keys: &FastMap<String, ReplayKey>,
+    scenes: &[Scene],
+    cfg: &Config,
+) -> Result<BTreeMap<String, OracleHints>> {
+    let delta = |id: &str| {
+        keys.get(id)
+            .and_then(|k| decision_time(dir, k))
+            .unwrap_or(DEFAULT_DELTA)
+    };
+    #[cfg_attr(not(feature = "execute"), allow(unused_mut))]
+    let mut hints: BTreeMap<String, OracleHints> = motions_of_batch(batch, &delta)?
+        .unwrap_or_default()
+        .into_iter()
+        .collect();
+    #[cfg(feature = "execute")]
+    {
+        let scenes: Vec<&Scene> = scenes.iter().collect();
+        for (id, plan) in physics_dodges_of(dir, &scenes, keys, &hints, cfg) {
+            hints.entry(id).or_default().dodge = Some(plan);
+        }
+    }
+    #[cfg(not(feature = "execute"))]
+    {
+        let _ = scenes;
+        refuse_without_physics(dir, cfg)?;
+    }
+    Ok(hints)
+}
+
+/// Without `execute` the oracle cannot check its dodges: a dataset with specs is refused.
+#[cfg(not(feature = "execute"))]
+fn refuse_without_physics(dir: &Path, _cfg: &Config) -> Result<()> {
+    if dir.join("specs").is_dir() {
         return Err(crate::error::InputError(
             "the oracle checks its dodges in physics, but this rh-score was built without the `execute` feature; rebuild with default features".into(),
         )
         .into());
     }
-    Ok(hints)
+    Ok(())
 }
 
 /// DODGE plans checked in physics with `--execute`'s executor (`cfg.execution`): for every
@@ -227,21 +271,34 @@ pub fn physics_dodges(
     hints: &BTreeMap<String, OracleHints>,
     cfg: &Config,
 ) -> BTreeMap<String, Value> {
-    use rayon::prelude::*;
-    use rh_physics::execute::escape::{escape_plans, first_unstruck};
     let Ok(keys) = read_replay_keys(&ds.dir) else {
         return BTreeMap::new();
     };
-    let dodges: Vec<&Scene> = ds
-        .scenes
+    let scenes: Vec<&Scene> = ds.scenes.iter().collect();
+    physics_dodges_of(&ds.dir, &scenes, &keys, hints, cfg)
+}
+
+/// [`physics_dodges`] of the valid DODGE scenes among `scenes`, with their replay keys.
+#[cfg(feature = "execute")]
+fn physics_dodges_of(
+    dir: &Path,
+    scenes: &[&Scene],
+    keys: &FastMap<String, ReplayKey>,
+    hints: &BTreeMap<String, OracleHints>,
+    cfg: &Config,
+) -> BTreeMap<String, Value> {
+    use rayon::prelude::*;
+    use rh_physics::execute::escape::{escape_plans, first_unstruck};
+    let dodges: Vec<&Scene> = scenes
         .iter()
+        .copied()
         .filter(|s| s.valid && s.gt_action == Action::Dodge)
         .collect();
     let found: Vec<Option<(String, Value)>> = dodges
         .par_iter()
         .map(|s| {
             let key = keys.get(&s.scene_id)?;
-            let (replay, _) = crate::execution::checked_replay(&ds.dir, key, &s.scene_id).ok()?;
+            let (replay, _) = crate::execution::checked_replay(dir, key, &s.scene_id).ok()?;
             let heuristic = heuristic_dodge(s, hints.get(&s.scene_id), cfg);
             let parsed = crate::plan::plan_from_value(&heuristic, cfg).ok()?;
             let mut plans = vec![crate::execution::exec_plan(&parsed)];
@@ -275,6 +332,7 @@ fn escape_json(p: &rh_contract::execution::ExecPlan) -> Value {
 /// `trajectory`) and `DIR/specs/` (Δ); a dataset without those columns gives none.
 fn read_hints(ds: &Dataset) -> Result<BTreeMap<String, OracleHints>> {
     let deltas = decision_times(ds);
+    let delta = |id: &str| deltas.get(id).copied().unwrap_or(DEFAULT_DELTA);
     let mut out = BTreeMap::new();
     let Ok(files) = parquet_files(&ds.dir.join("data")) else {
         return Ok(out);
@@ -282,41 +340,53 @@ fn read_hints(ds: &Dataset) -> Result<BTreeMap<String, OracleHints>> {
     for file in files {
         let reader = open_parquet(&file, 8192)?;
         for batch in reader {
-            let batch = batch?;
-            let (Some(ids), Some(tti), Some(traj)) = (
-                batch.column_by_name("scene_id"),
-                batch.column_by_name("time_to_impact"),
-                batch.column_by_name("trajectory"),
-            ) else {
-                return Ok(out);
-            };
-            let ids = arrow::compute::cast(ids, &arrow::datatypes::DataType::Utf8)?;
-            let ids = ids
-                .as_any()
-                .downcast_ref::<arrow::array::StringArray>()
-                .expect("cast to Utf8");
-            let (Some(tti), Some(traj)) = (
-                tti.as_any().downcast_ref::<Float64Array>(),
-                traj.as_any().downcast_ref::<ListArray>(),
-            ) else {
-                return Ok(out);
-            };
-            for i in 0..batch.num_rows() {
-                let id = ids.value(i).to_string();
-                let delta = deltas.get(&id).copied().unwrap_or(DEFAULT_DELTA);
-                let t_end = (!tti.is_null(i)).then(|| tti.value(i));
-                let motion = hazard_motion(&traj.value(i), delta, t_end);
-                out.insert(
-                    id,
-                    OracleHints {
-                        hazard_motion: motion,
-                        dodge: None,
-                    },
-                );
+            match motions_of_batch(&batch?, &delta)? {
+                Some(hints) => out.extend(hints),
+                None => return Ok(out),
             }
         }
     }
     Ok(out)
+}
+
+/// The hazard motions of one batch of rows, Δ of a scene from `delta`; `None` when the
+/// batch lacks `time_to_impact` or `trajectory` (or they have other types).
+fn motions_of_batch(
+    batch: &RecordBatch,
+    delta: &dyn Fn(&str) -> f64,
+) -> Result<Option<Vec<(String, OracleHints)>>> {
+    let (Some(ids), Some(tti), Some(traj)) = (
+        batch.column_by_name("scene_id"),
+        batch.column_by_name("time_to_impact"),
+        batch.column_by_name("trajectory"),
+    ) else {
+        return Ok(None);
+    };
+    let ids = arrow::compute::cast(ids, &arrow::datatypes::DataType::Utf8)?;
+    let ids = ids
+        .as_any()
+        .downcast_ref::<arrow::array::StringArray>()
+        .expect("cast to Utf8");
+    let (Some(tti), Some(traj)) = (
+        tti.as_any().downcast_ref::<Float64Array>(),
+        traj.as_any().downcast_ref::<ListArray>(),
+    ) else {
+        return Ok(None);
+    };
+    let mut out = Vec::with_capacity(batch.num_rows());
+    for i in 0..batch.num_rows() {
+        let id = ids.value(i).to_string();
+        let t_end = (!tti.is_null(i)).then(|| tti.value(i));
+        let motion = hazard_motion(&traj.value(i), delta(&id), t_end);
+        out.push((
+            id,
+            OracleHints {
+                hazard_motion: motion,
+                dodge: None,
+            },
+        ));
+    }
+    Ok(Some(out))
 }
 
 /// Displacement of the trajectory's (t, x, y, z) samples from the one nearest `from` to
@@ -346,20 +416,16 @@ fn hazard_motion(samples: &dyn Array, from: f64, to: Option<f64>) -> Option<[f64
 
 /// Δ per scene from `specs/<id>.json` (`observation_window_s`), where readable.
 fn decision_times(ds: &Dataset) -> BTreeMap<String, f64> {
-    let mut out = BTreeMap::new();
     let Ok(keys) = read_replay_keys(&ds.dir) else {
-        return out;
+        return BTreeMap::new();
     };
-    for (id, key) in keys.iter() {
-        let path = ds.dir.join(&key.spec_file);
-        let Ok(text) = std::fs::read_to_string(&path) else {
-            continue;
-        };
-        if let Ok(v) = serde_json::from_str::<Value>(&text) {
-            if let Some(d) = v["observation_window_s"].as_f64() {
-                out.insert(id.clone(), d);
-            }
-        }
-    }
-    out
+    keys.iter()
+        .filter_map(|(id, key)| Some((id.clone(), decision_time(&ds.dir, key)?)))
+        .collect()
+}
+
+/// Δ of one scene from its spec file (`observation_window_s`), where readable.
+fn decision_time(dir: &Path, key: &ReplayKey) -> Option<f64> {
+    let text = std::fs::read_to_string(dir.join(&key.spec_file)).ok()?;
+    serde_json::from_str::<Value>(&text).ok()?["observation_window_s"].as_f64()
 }

@@ -5,7 +5,7 @@ use crate::report::{MetricsRow, ModelReport, Report};
 use crate::safety_rule::SafetyRule;
 use std::fmt::Write as _;
 
-use crate::text_table::{csv_field, num, num_ci, pct, pct_ci, Table};
+use crate::text_table::{num, num_ci, pct, pct_ci, Table};
 
 /// The report's models, then the pooled row when there is more than one model (the
 /// order of every per-model table).
@@ -634,10 +634,12 @@ pub fn markdown(r: &Report) -> String {
 /// The CSV report: one row per (model, breakdown, group); rates are fractions; empty
 /// cells are undefined values.
 pub fn csv(r: &Report) -> String {
-    let mut s = String::from(
-        "model,breakdown,group,decisions,lost,saa,safety,d_end,d_end_n,d_end_missing,aia,d_min,closing,hde_n,hde_missing,freeze_rate,first_R1,first_R2,first_R3,first_R4,fired_R1,fired_R2,fired_R3,fired_R4,pred_CATCH,pred_DODGE,pred_NO_ACTION,pred_unparseable,expected,unanswered,complete,answered_only,saa_lo,saa_hi,safety_lo,safety_hi,aia_lo,aia_hi,d_end_lo,d_end_hi,d_min_lo,d_min_hi,freeze_rate_lo,freeze_rate_hi,balanced_accuracy,balanced_accuracy_lo,balanced_accuracy_hi\n",
-    );
+    let mut t = Table::new(&CSV_HEAD);
     let f = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x}"));
+    let ci = |v: Option<[f64; 2]>| match v {
+        Some([a, b]) => [format!("{a}"), format!("{b}")],
+        None => [String::new(), String::new()],
+    };
     let models: Vec<&ModelReport> = r.models.iter().chain(std::iter::once(&r.pooled)).collect();
     for m in models {
         let sets: [(&str, Vec<&MetricsRow>); 5] = [
@@ -648,53 +650,77 @@ pub fn csv(r: &Report) -> String {
             ("adversarial", m.by_adversarial.iter().collect()),
         ];
         for (bd, rows) in sets {
+            let overall = bd == "overall";
+            let only_overall = |v: String| if overall { v } else { String::new() };
             for x in rows {
-                let overall = bd == "overall";
-                let lost = if overall {
-                    m.lost.to_string()
-                } else {
-                    String::new()
-                };
-                let ci = |v: Option<[f64; 2]>| match v {
-                    Some([a, b]) => format!("{a},{b}"),
-                    None => ",".into(),
-                };
-                let ba = if overall {
-                    format!("{},{}", f(m.balanced_accuracy), ci(m.balanced_accuracy_ci))
-                } else {
-                    ",,".into()
-                };
-                let extra = format!(
-                    "{},{},{},{},{},{},{},{},{},{},{}",
+                let mut row = vec![
+                    m.model.clone(),
+                    bd.to_string(),
+                    x.group.clone(),
+                    x.decisions.to_string(),
+                    only_overall(m.lost.to_string()),
+                    f(x.saa),
+                    f(x.safety),
+                    f(x.d_end),
+                    x.d_end_n.to_string(),
+                    x.d_end_missing.to_string(),
+                    f(x.aia),
+                    f(x.d_min),
+                    f(x.closing),
+                    x.hde_n.to_string(),
+                    x.hde_missing.to_string(),
+                    f(x.freeze_rate),
+                ];
+                let counts = [
+                    x.first_rule.r1,
+                    x.first_rule.r2,
+                    x.first_rule.r3,
+                    x.first_rule.r4,
+                    x.rules_fired.r1,
+                    x.rules_fired.r2,
+                    x.rules_fired.r3,
+                    x.rules_fired.r4,
+                    x.predicted.catch,
+                    x.predicted.dodge,
+                    x.predicted.no_action,
+                    x.predicted.unparseable,
                     x.expected,
                     x.unanswered,
-                    if overall {
-                        m.coverage.complete.to_string()
-                    } else {
-                        String::new()
-                    },
-                    r.coverage.answered_only,
-                    ci(x.saa_ci),
-                    ci(x.safety_ci),
-                    ci(x.aia_ci),
-                    ci(x.d_end_ci),
-                    ci(x.d_min_ci),
-                    ci(x.freeze_rate_ci),
-                    ba
-                );
-                let _ = writeln!(
-                    s,
-                    "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-                    csv_field(&m.model), bd, csv_field(&x.group), x.decisions, lost,
-                    f(x.saa), f(x.safety), f(x.d_end), x.d_end_n, x.d_end_missing, f(x.aia),
-                    f(x.d_min), f(x.closing), x.hde_n, x.hde_missing, f(x.freeze_rate),
-                    x.first_rule.r1, x.first_rule.r2, x.first_rule.r3, x.first_rule.r4,
-                    x.rules_fired.r1, x.rules_fired.r2, x.rules_fired.r3, x.rules_fired.r4,
-                    x.predicted.catch, x.predicted.dodge, x.predicted.no_action, x.predicted.unparseable,
-                    extra,
-                );
+                ];
+                row.extend(counts.iter().map(|c| c.to_string()));
+                row.push(only_overall(m.coverage.complete.to_string()));
+                row.push(r.coverage.answered_only.to_string());
+                for v in [
+                    x.saa_ci,
+                    x.safety_ci,
+                    x.aia_ci,
+                    x.d_end_ci,
+                    x.d_min_ci,
+                    x.freeze_rate_ci,
+                ] {
+                    row.extend(ci(v));
+                }
+                if overall {
+                    row.push(f(m.balanced_accuracy));
+                    row.extend(ci(m.balanced_accuracy_ci));
+                } else {
+                    row.extend([String::new(), String::new(), String::new()]);
+                }
+                t.row(row);
             }
         }
     }
-    s
+    t.csv()
 }
+
+/// The CSV report's columns.
+#[rustfmt::skip]
+const CSV_HEAD: [&str; 47] = [
+    "model", "breakdown", "group", "decisions", "lost", "saa", "safety", "d_end", "d_end_n",
+    "d_end_missing", "aia", "d_min", "closing", "hde_n", "hde_missing", "freeze_rate",
+    "first_R1", "first_R2", "first_R3", "first_R4", "fired_R1", "fired_R2", "fired_R3",
+    "fired_R4", "pred_CATCH", "pred_DODGE", "pred_NO_ACTION", "pred_unparseable", "expected",
+    "unanswered", "complete", "answered_only", "saa_lo", "saa_hi", "safety_lo", "safety_hi",
+    "aia_lo", "aia_hi", "d_end_lo", "d_end_hi", "d_min_lo", "d_min_hi", "freeze_rate_lo",
+    "freeze_rate_hi", "balanced_accuracy", "balanced_accuracy_lo", "balanced_accuracy_hi",
+];

@@ -5,6 +5,7 @@ mod post;
 mod setup;
 
 mod ids;
+mod moving;
 
 use super::mesh::Vertex;
 use super::RenderError;
@@ -44,7 +45,7 @@ pub struct ViewJob {
 }
 
 /// Most rectangles one overlay view redraws (more are merged by the caller).
-pub const MAX_REDRAW_RECTS: usize = 8;
+pub const MAX_REDRAW_RECTS: usize = 32;
 
 /// One view drawn over its cached static image (see [`Gpu::cache_static`]): each
 /// `redraw` rectangle (x, y, width, height in pixels: where moving bodies may cast
@@ -303,6 +304,35 @@ impl Gpu {
         Ok(())
     }
 
+    /// A view's cached static depth (one sample per pixel: `None` with MSAA), row-major
+    /// (1 = no surface); read back once per scene (`tiles::SurfaceTiles`).
+    pub fn cached_depth(&self, slot: usize) -> Result<Option<Vec<f32>>, RenderError> {
+        let t = self.targets[slot].as_ref().unwrap();
+        if self.samples > 1 {
+            return Ok(None);
+        }
+        let mut enc = self.encoder();
+        let source = wgpu::TexelCopyTextureInfo {
+            aspect: wgpu::TextureAspect::DepthOnly,
+            ..whole(&t.cache_depth)
+        };
+        let layout = wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(t.padded_row),
+            rows_per_image: Some(t.height),
+        };
+        let buffer = wgpu::TexelCopyBufferInfo {
+            buffer: &t.readback,
+            layout,
+        };
+        enc.copy_texture_to_buffer(source, buffer, t.cache_depth.size());
+        self.queue.submit([enc.finish()]);
+        let bytes = self.read_back(std::iter::once(slot))?.remove(0);
+        let depth = bytemuck::pod_collect_to_vec::<u8, f32>(&bytes);
+        self.frames.give(bytes);
+        Ok(Some(depth))
+    }
+
     /// Encodes the shadow map from `casters` and every view drawn from a cleared
     /// target; then either keeps shadow map and views as the static cache (`cache`) or
     /// queues each view's read-back.
@@ -531,14 +561,24 @@ impl Gpu {
             }
             Redraw::Regions(r) => r,
         };
-        for (i, &([x, y, w, h], statics)) in rects.iter().enumerate() {
+        // Clearing by drawing (not LoadOp::Clear's colour) keeps the background
+        // bit-identical between whole frames and redrawn regions.
+        pass.set_pipeline(&self.fill);
+        for (i, &([x, y, w, h], _)) in rects.iter().enumerate() {
             pass.set_scissor_rect(x, y, w, h);
-            // Clearing by drawing (not LoadOp::Clear's colour) keeps the background
-            // bit-identical between whole frames and redrawn regions.
-            pass.set_pipeline(&self.fill);
             pass.draw(0..6, i as u32..i as u32 + 1);
+        }
+        // Then every static piece any rectangle needs, once, in draw order, over their
+        // bounding rectangle: outside the re-cleared pixels the copied-in depth equals
+        // the static surface's, which `Less` rejects, so those pixels keep their image
+        // (drawing per rectangle ran the vertex work of a piece once per rectangle).
+        let mut statics: Vec<&Range<u32>> = rects.iter().flat_map(|(_, s)| s.iter()).collect();
+        statics.sort_by_key(|r| (r.start, r.end));
+        statics.dedup();
+        if let Some([x, y, w, h]) = rects.iter().map(|(r, _)| *r).reduce(union) {
+            pass.set_scissor_rect(x, y, w, h);
             pass.set_pipeline(&self.main);
-            for r in statics.iter().filter(|r| !r.is_empty()) {
+            for r in statics.into_iter().filter(|r| !r.is_empty()) {
                 pass.draw(r.clone(), 0..1);
             }
         }
@@ -626,6 +666,16 @@ impl Target {
             None => &self.resolve,
         }
     }
+}
+
+/// The bounding rectangle of two (x, y, width, height).
+fn union(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
+    let (x0, y0) = (a[0].min(b[0]), a[1].min(b[1]));
+    let (x1, y1) = (
+        (a[0] + a[2]).max(b[0] + b[2]),
+        (a[1] + a[3]).max(b[1] + b[3]),
+    );
+    [x0, y0, x1 - x0, y1 - y0]
 }
 
 /// `r` grown by `by` pixels on every side, clamped to the target (`None` if empty).

@@ -1,5 +1,6 @@
 //! Post-process anti-aliasing: an FXAA-style full-screen pass (`fxaa.wgsl`) from a
-//! target's resolved frame into the image that is read back. Used where MSAA is off
+//! target's resolved frame into the image that is read back, in two passes (copy and
+//! mark edges, then blend only the edges: see `fxaa.wgsl`). Used where MSAA is off
 //! (a CPU rasterizer). Like the lit pass, it runs over the whole static image once per
 //! view and scene (`cache`), and per frame only around what changed.
 
@@ -7,9 +8,15 @@
 /// frame is read through a non-sRGB view, so FXAA works on display values).
 const POST_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
-/// The FXAA pipeline, its bind group layout and its (bilinear, clamped) sampler.
+/// The edge mask of the two FXAA passes (0: edge, 1: copied as is).
+const MASK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth16Unorm;
+
+/// The FXAA pipelines (`mark`: copy every pixel and mark edges in the depth mask;
+/// `edge`: blend the marked pixels), their bind group layout and the (bilinear,
+/// clamped) sampler.
 pub(super) struct Post {
-    pipeline: wgpu::RenderPipeline,
+    mark: wgpu::RenderPipeline,
+    edge: wgpu::RenderPipeline,
     bgl: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
 }
@@ -20,6 +27,8 @@ pub(super) struct PostTarget {
     pub out: wgpu::Texture,
     pub cache: wgpu::Texture,
     view: wgpu::TextureView,
+    /// The edge mask (depth) of the two passes.
+    mask: wgpu::TextureView,
     bind: wgpu::BindGroup,
 }
 
@@ -64,31 +73,42 @@ impl Post {
             label: Some("fxaa"),
             source: wgpu::ShaderSource::Wgsl(include_str!("../fxaa.wgsl").into()),
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("fxaa"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_post"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_fxaa"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: POST_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = |entry: &str, compare, write| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &shader,
+                    entry_point: Some("vs_post"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: MASK_FORMAT,
+                    depth_write_enabled: Some(write),
+                    depth_compare: Some(compare),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &shader,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: POST_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        // The triangle lies at depth 0: the edge pass draws where the mask holds 0.
+        let mark = pipeline("fs_fxaa_mark", wgpu::CompareFunction::Always, true);
+        let edge = pipeline("fs_fxaa_edge", wgpu::CompareFunction::Equal, false);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("fxaa-sampler"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -96,7 +116,8 @@ impl Post {
             ..Default::default()
         });
         Post {
-            pipeline,
+            mark,
+            edge,
             bgl,
             sampler,
         }
@@ -128,6 +149,18 @@ impl Post {
             view_formats: &[],
         });
         let view = out.create_view(&Default::default());
+        let mask = device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("fxaa-mask"),
+                size: source.size(),
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: MASK_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            })
+            .create_view(&Default::default());
         let source_view = source.create_view(&wgpu::TextureViewDescriptor {
             format: Some(SOURCE_VIEW_FORMAT),
             ..Default::default()
@@ -150,6 +183,7 @@ impl Post {
             out,
             cache,
             view,
+            mask,
             bind,
         }
     }
@@ -178,16 +212,26 @@ impl Post {
                     store: wgpu::StoreOp::Store,
                 },
             })],
-            depth_stencil_attachment: None,
+            // Written by the mark pass wherever the edge pass reads it.
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &t.mask,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &t.bind, &[]);
         if let Some([x, y, w, h]) = rect {
             pass.set_scissor_rect(x, y, w, h);
         }
+        pass.set_pipeline(&self.mark);
+        pass.draw(0..3, 0..1);
+        pass.set_pipeline(&self.edge);
         pass.draw(0..3, 0..1);
     }
 }

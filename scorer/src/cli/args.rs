@@ -174,6 +174,13 @@ pub enum Cmd {
     /// missing.
     #[cfg(feature = "predict")]
     Predict(Box<PredictArgs>),
+    /// Write a dataset's scenes as fine-tuning data: a Hugging Face dataset in TRL's
+    /// conversational format (`datasets.load_dataset(OUT)`), the canonical prompt with the
+    /// oracle's plan as the answer (sft) or paired with a plan the benchmark scores as
+    /// wrong (preference). Rendered builds carry the observation frames; label-only builds
+    /// give text-only examples. Streams the table: memory does not grow with its size.
+    #[cfg(feature = "predict")]
+    Export(Box<ExportArgs>),
     /// Write a synthetic dataset with the rh-pipeline column contract (tests).
     #[cfg(feature = "synthetic")]
     #[command(hide = true)]
@@ -272,4 +279,34 @@ pub struct PredictArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+#[cfg(feature = "predict")]
+#[derive(clap::Args, Debug)]
+pub struct ExportArgs {
+    /// Dataset directory (data/*.parquet, and frames/ for images) or Hub dataset id
+    /// owner/name[@revision]. Default: $RH_DATASET, else the released dataset.
+    #[arg(long, value_name = "DIR|owner/name")]
+    pub dataset: Option<String>,
+    /// Output directory (new or empty): data/train-00000-of-00001.parquet, README.md,
+    /// export.json.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// sft: `messages` (system, user, assistant); preference: `prompt`, `chosen`,
+    /// `rejected` (DPO).
+    #[arg(long, value_enum, default_value = "sft")]
+    pub format: crate::export::Format,
+    /// Which valid scenes: train (outside the eval subset, so the benchmark's scenes stay
+    /// unseen), eval (the subset) or all.
+    #[arg(long, value_enum, default_value = "train")]
+    pub split: crate::export::Split,
+    /// Text-only examples even when the dataset has frames.
+    #[arg(long)]
+    pub text_only: bool,
+    /// Scoring configuration (body constants, thresholds) the oracle plans with.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Print the summary as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
 }

@@ -6,6 +6,8 @@
 pub mod args;
 pub mod baseline_command;
 pub mod dataset_arg;
+#[cfg(feature = "predict")]
+pub mod export_command;
 pub mod leaderboard_command;
 pub mod output;
 #[cfg(feature = "predict")]
@@ -37,6 +39,8 @@ pub fn run(cli: Cli) -> Result<()> {
         }) => leaderboard_command::run(&files, html.as_deref(), markdown.as_deref(), json),
         #[cfg(feature = "predict")]
         Some(Cmd::Predict(a)) => predict_command::run(*a),
+        #[cfg(feature = "predict")]
+        Some(Cmd::Export(a)) => export_command::run(*a),
         #[cfg(feature = "synthetic")]
         Some(Cmd::MakeFixture { out, n, seed, drop }) => {
             let rows = crate::synthetic::synth_rows(n, seed);

@@ -7,7 +7,7 @@
 use super::config::{subsampling, PromptConfig};
 use base64::Engine;
 use serde_json::{json, Value};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// One scene's messages, ready to send.
 #[derive(Debug, Clone)]
@@ -213,46 +213,87 @@ pub fn frame_stage_cpu_s(
     })
 }
 
-/// The messages for one scene of the dataset at `dir`.
-pub fn build(cfg: &PromptConfig, dir: &Path, scene_id: &str) -> Result<BuiltPrompt, String> {
-    let cpu0 = thread_cpu_s();
-    let sub = subsampling(&cfg.images.chroma_subsampling).ok_or_else(|| {
-        format!(
-            "unknown chroma subsampling {:?}",
-            cfg.images.chroma_subsampling
-        )
-    })?;
-    let mut content = vec![json!({"type": "text", "text": fill(&cfg.text.user_intro, cfg)})];
+/// One part of the canonical user message, in order.
+#[derive(Debug, Clone, PartialEq)]
+pub enum UserPart {
+    Text(String),
+    /// The observation frame of `camera` at `t` (s): `frames/<id>/<camera>_t<t>.png`.
+    Frame {
+        camera: String,
+        t: f64,
+    },
+}
+
+/// The canonical user message's parts: the intro, then per time and camera the frame's
+/// label and the frame, then the outro. [`build`] sends them (frames as JPEG data URLs);
+/// `rh-score export` writes them as training examples (text-only: the texts alone).
+pub fn user_parts(cfg: &PromptConfig) -> Vec<UserPart> {
+    let mut parts = vec![UserPart::Text(fill(&cfg.text.user_intro, cfg))];
     for &t in &cfg.images.times {
         for cam in &cfg.images.cameras {
-            let path = dir.join(frame_rel_path(scene_id, cam, t));
-            if !path.is_file() {
-                return Err(format!(
-                    "missing observation frame {} (was the dataset built with rendering? \
-                     `rh-pipeline build` without --no-render writes frames/)",
-                    path.display()
-                ));
-            }
-            let jpeg = encode_frame(&path, cfg.images.max_side, cfg.images.jpeg_quality, sub)?;
             let label = cfg
                 .text
                 .frame_label
                 .replace("{t}", &format!("{t:.2}"))
                 .replace("{camera}", cam);
-            content.push(json!({"type": "text", "text": label}));
-            content.push(json!({
-                "type": "image_url",
-                "image_url": {
-                    "url": format!(
-                        "data:image/jpeg;base64,{}",
-                        base64::engine::general_purpose::STANDARD.encode(&jpeg)
-                    ),
-                    "detail": cfg.images.detail,
-                }
-            }));
+            parts.push(UserPart::Text(label));
+            parts.push(UserPart::Frame {
+                camera: cam.clone(),
+                t,
+            });
         }
     }
-    content.push(json!({"type": "text", "text": fill(&cfg.text.user_outro, cfg)}));
+    parts.push(UserPart::Text(fill(&cfg.text.user_outro, cfg)));
+    parts
+}
+
+/// The frame file of a [`UserPart::Frame`], or an error naming it when it is missing.
+pub fn frame_file(dir: &Path, scene_id: &str, camera: &str, t: f64) -> Result<PathBuf, String> {
+    let path = dir.join(frame_rel_path(scene_id, camera, t));
+    if !path.is_file() {
+        return Err(format!(
+            "missing observation frame {} (was the dataset built with rendering? \
+             `rh-pipeline build` without --no-render writes frames/)",
+            path.display()
+        ));
+    }
+    Ok(path)
+}
+
+/// The frame encoder's chroma subsampling from the prompt configuration.
+pub fn subsampling_of(cfg: &PromptConfig) -> Result<turbojpeg::Subsamp, String> {
+    subsampling(&cfg.images.chroma_subsampling).ok_or_else(|| {
+        format!(
+            "unknown chroma subsampling {:?}",
+            cfg.images.chroma_subsampling
+        )
+    })
+}
+
+/// The messages for one scene of the dataset at `dir`.
+pub fn build(cfg: &PromptConfig, dir: &Path, scene_id: &str) -> Result<BuiltPrompt, String> {
+    let cpu0 = thread_cpu_s();
+    let sub = subsampling_of(cfg)?;
+    let mut content = Vec::new();
+    for part in user_parts(cfg) {
+        match part {
+            UserPart::Text(text) => content.push(json!({"type": "text", "text": text})),
+            UserPart::Frame { camera, t } => {
+                let path = frame_file(dir, scene_id, &camera, t)?;
+                let jpeg = encode_frame(&path, cfg.images.max_side, cfg.images.jpeg_quality, sub)?;
+                content.push(json!({
+                    "type": "image_url",
+                    "image_url": {
+                        "url": format!(
+                            "data:image/jpeg;base64,{}",
+                            base64::engine::general_purpose::STANDARD.encode(&jpeg)
+                        ),
+                        "detail": cfg.images.detail,
+                    }
+                }));
+            }
+        }
+    }
     let messages = json!([
         {"role": "system", "content": system_text(cfg)},
         {"role": "user", "content": content},

@@ -1,0 +1,45 @@
+//! `rh-score export`: a dataset's scenes as fine-tuning data (`crate::export`).
+
+use super::args::ExportArgs;
+use super::dataset_arg::resolve_dataset;
+use super::output::load_config;
+use crate::export::{run as export, ExportOptions};
+use crate::predict::config::PromptConfig;
+use anyhow::Result;
+
+/// Writes the export and prints its summary (a line, or JSON with `--json`).
+pub fn run(a: ExportArgs) -> Result<()> {
+    let opts = ExportOptions {
+        dataset: resolve_dataset(a.dataset)?,
+        out: a.out,
+        format: a.format,
+        split: a.split,
+        text_only: a.text_only,
+        prompt: PromptConfig::load(None)?,
+        config: load_config(a.config.as_deref())?,
+    };
+    let summary = export(&opts)?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        println!(
+            "wrote {} {} rows ({} scenes, {}) to {}",
+            summary.rows,
+            summary.format,
+            summary.split,
+            if summary.images {
+                "with images"
+            } else {
+                "text-only"
+            },
+            opts.out.join(&summary.file).display()
+        );
+        if summary.no_eval_subset && summary.split == "train" {
+            eprintln!(
+                "rh-score: note: {} has no eval/ subset, so --split train took every valid scene",
+                opts.dataset.display()
+            );
+        }
+    }
+    Ok(())
+}
