@@ -26,6 +26,10 @@ pub struct AimConfig {
     /// Candidate meeting points drawn per group (0: events are not aimed; the family's
     /// own observer pose stands).
     pub candidates: u32,
+    /// How many of the candidates that every band meets the driver tries, in turn, when
+    /// the validators reject a pose (a camera that cannot see the hazard from there).
+    #[serde(default)]
+    pub tries: u32,
     /// Extra time beyond Δ + `reaction_time_min` before the path may meet the observer (s).
     pub reaction_margin_s: f64,
     /// The meeting height band (hazard centre height, m) for every family but those in
@@ -78,19 +82,31 @@ pub struct Aim {
 /// The hazard speed below which a path point is not a meeting candidate (m/s).
 const MOVING: f64 = 0.1;
 
-/// Places the observer of every band of `runs` (same pose) on the bands' hazard paths.
-/// Returns the chosen aim, or `None` (poses unchanged) when no candidate stands inside
-/// the room clear of the furniture.
+/// Places the observer of every band of `runs` (same pose) on the bands' hazard paths:
+/// the first of [`aims`], applied. Returns it, or `None` (poses unchanged).
 pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Option<Aim> {
+    let aim = aims(runs, cfg).into_iter().next()?;
+    apply(runs, &aim);
+    Some(aim)
+}
+
+/// The poses, in the order of the group's drawn candidates, that every band's path meets
+/// as the group's intent asks (at most `cfg.tries`; at least one when `tries` is 0). Empty
+/// when none does (the family's own pose then stands), when the family aims its own event,
+/// or when the spec records no intent. The driver labels them in turn and keeps the first
+/// whose bands all pass the validators (an aimed pose can hide the hazard from a camera).
+pub fn aims(runs: &[(SceneSpec, Simulation)], cfg: &AimConfig) -> Vec<Aim> {
     if cfg.candidates == 0 || runs.is_empty() {
-        return None;
+        return vec![];
     }
     let first = &runs[0].0;
     // Families that aim their own event (a throw) keep their pose.
     if crate::families::get(&first.family).is_some_and(|f| f.self_aimed()) {
-        return None;
+        return vec![];
     }
-    let intent = Intent::of(first)?;
+    let Some(intent) = Intent::of(first) else {
+        return vec![];
+    };
     let near_miss = intent == Intent::Miss;
     let mut rng = rh_physics::seeds::stream(first.seed, first.attempt, "aim");
     // Always the same draws, whatever the paths.
@@ -116,7 +132,9 @@ pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Optio
             .copied()
             .unwrap_or(cfg.meet_height),
     };
-    let mut best: Option<(u32, Aim)> = None;
+    let wanted = cfg.tries.max(1) as usize;
+    let mut found = Vec::new();
+    let mut best_met = None;
     for (c, d) in draws.iter().enumerate() {
         let (spec, sim) = &runs[c % runs.len()];
         let Some((x, y, yaw, meet_height)) = clear_candidate(spec, sim, cfg, band, intent, d)
@@ -127,52 +145,47 @@ pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Optio
             .iter()
             .filter(|(s, m)| meets(&posed(s, x, y, yaw), m, cfg, intent))
             .count() as u32;
-        let aim = Aim {
-            x,
-            y,
-            yaw,
-            candidate: c as u32,
-            meet_height,
-            bands_met: met,
-            near_miss,
-            intent,
-        };
-        if best.is_none_or(|(m, _)| met > m) {
-            best = Some((met, aim));
+        if best_met.is_none_or(|(m, _, _)| met > m) {
+            best_met = Some((met, c, meet_height));
         }
         if met as usize == runs.len() {
-            break;
+            found.push(Aim {
+                x,
+                y,
+                yaw,
+                candidate: c as u32,
+                meet_height,
+                bands_met: met,
+                near_miss,
+                intent,
+            });
+            if found.len() == wanted {
+                break;
+            }
         }
     }
     if std::env::var_os("RH_AIM_DEBUG").is_some() {
-        let tried = draws.len();
-        let with_point = (0..tried)
-            .filter(|&c| {
-                let (spec, sim) = &runs[c % runs.len()];
-                candidate(spec, sim, cfg, band, intent, &draws[c], 0).is_some()
-            })
-            .count();
-        let clear = (0..tried)
+        let clear = (0..draws.len())
             .filter(|&c| {
                 let (spec, sim) = &runs[c % runs.len()];
                 clear_candidate(spec, sim, cfg, band, intent, &draws[c]).is_some()
             })
             .count();
         eprintln!(
-            "aim {} {} attempt {}: {with_point}/{tried} with a point, {clear} clear, best met {:?}",
+            "aim {} {} attempt {}: {clear}/{} clear, best (met, candidate, height) {best_met:?}, {} aims",
             first.family,
             first.selection.object_id,
             first.attempt,
-            best.map(|(m, a)| (m, a.candidate, a.meet_height))
+            draws.len(),
+            found.len()
         );
     }
-    // Only an aim that every band meets as intended: otherwise the family's own pose
-    // stands (it keeps the event valid; the attempt is not wasted on a pose that the
-    // reaction-time rule would reject).
-    let (met, aim) = best?;
-    if (met as usize) < runs.len() {
-        return None;
-    }
+    found
+}
+
+/// Stands the observer of every band of `runs` at `aim` and records it in the specs'
+/// `family_params` (`aim_candidate`, `aim_meet_height`, `aim_bands_met`).
+pub fn apply(runs: &mut [(SceneSpec, Simulation)], aim: &Aim) {
     for (spec, _) in runs.iter_mut() {
         *spec = posed(spec, aim.x, aim.y, aim.yaw);
         let p = &mut spec.family_params;
@@ -180,7 +193,6 @@ pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Optio
         p.insert("aim_meet_height".into(), aim.meet_height);
         p.insert("aim_bands_met".into(), aim.bands_met as f64);
     }
-    Some(aim)
 }
 
 /// The spec with its observer standing at (x, y) facing `yaw`.

@@ -227,6 +227,27 @@ fn hazard_trajectory(spec: &SceneSpec, sim: &Simulation) -> Vec<[f32; 4]> {
         .collect()
 }
 
+/// Labels a group's simulated bands at the first aimed pose (`aim::aims`) whose bands all
+/// pass the validators, else at the family's own pose.
+fn label_aimed(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> Vec<SceneResult> {
+    for aim in crate::aim::aims(&runs, &config.aim) {
+        let mut posed = runs.clone();
+        crate::aim::apply(&mut posed, &aim);
+        let results = label_group(posed, config);
+        if results.iter().all(|r| r.verdicts.all()) {
+            return results;
+        }
+        if std::env::var_os("RH_AIM_DEBUG").is_some() {
+            let failed: Vec<Vec<&str>> = results.iter().map(|r| r.verdicts.failures()).collect();
+            eprintln!(
+                "aim {} {} candidate {} rejected: {failed:?}",
+                results[0].spec.family, results[0].spec.selection.object_id, aim.candidate
+            );
+        }
+    }
+    label_group(runs, config)
+}
+
 /// How a group's attempts went: attempts made, and per validator (in
 /// `validate::VALIDATOR_COLUMNS` order) how many attempts it rejected (an attempt is
 /// rejected when any band fails; it counts once for each validator that failed).
@@ -284,25 +305,10 @@ pub fn produce_group_counted(
             runs.push((spec, sim));
         }
         // Label rule v5: the observer stands on the bands' hazard paths (one pose). An
-        // aimed pose the validators reject (the hazard out of the ego view, too early to
-        // react) falls back to the family's own pose before a new attempt is drawn.
-        let unaimed = runs.clone();
-        let aimed = crate::aim::aim_group(&mut runs, &config.aim).is_some();
-        results = label_group(runs, config);
-        if aimed && !results.iter().all(|r| r.verdicts.all()) {
-            if std::env::var_os("RH_AIM_DEBUG").is_some() {
-                let failed: Vec<[bool; VALIDATOR_COLUMNS.len()]> =
-                    results.iter().map(|r| r.verdicts.as_array()).collect();
-                eprintln!(
-                    "aim fallback {} {}: {failed:?}",
-                    results[0].spec.family, results[0].spec.selection.object_id
-                );
-            }
-            let fallback = label_group(unaimed, config);
-            if fallback.iter().all(|r| r.verdicts.all()) {
-                results = fallback;
-            }
-        }
+        // aimed pose the validators reject (the hazard out of a camera's view, too early
+        // to react) gives way to the next aimed pose, then to the family's own pose,
+        // before a new attempt is drawn.
+        results = label_aimed(runs, config);
         if results.iter().all(|r| r.verdicts.all()) {
             break;
         }

@@ -63,19 +63,28 @@ fn every_family_is_valid_and_replays_bit_for_bit_in_all_bands() {
     assert_eq!(names, canonical, "families::all() is in canonical order");
     let sweeps = families::all().iter().filter(|f| f.speed_sweep()).count();
     assert_eq!(sweeps, 12);
+    let mut invalid = Vec::new();
     for name in &names {
         for r in scenes(name, 1) {
-            assert!(
-                r.verdicts.all(),
-                "{name} {} {}: {:?}",
-                r.spec.scene_id,
-                r.spec.speed_band.name(),
-                r.verdicts.failures()
-            );
+            if !r.verdicts.all() {
+                invalid.push(format!(
+                    "{name} {} {}: {:?}",
+                    r.spec.scene_id,
+                    r.spec.speed_band.name(),
+                    r.verdicts.failures()
+                ));
+            }
             let again = plain(&r.spec);
             assert_eq!(again.state_hash, r.state_hash, "{name} replay differs");
         }
     }
+    // Label rule v5: a group whose every attempt fails a validator keeps its last attempt,
+    // marked invalid (left out of the evaluation subset). Only thrown_object's aimed
+    // throws still do so here (a slow band out of a camera's view; issue #23).
+    assert!(
+        invalid.len() <= 1 && invalid.iter().all(|s| s.starts_with("thrown_object")),
+        "{invalid:?}"
+    );
 }
 
 /// Distance the hazard's centre of mass has moved from its start by step `k`.
@@ -475,9 +484,12 @@ fn stair_tumble_descends_monotonically_between_steps() {
         checked += 1;
     }
     assert!(checked >= 14, "only {checked} valid scenes");
+    // Label rule v5's planner draws benign and dangerous objects in equal shares: light
+    // benign ones bound over steps, so fewer than half (7 of 16 at seed 7) cross three
+    // step edges one by one.
     assert!(
-        2 * long >= checked,
-        "most tumble past three step edges ({long} of {checked})"
+        3 * long >= checked,
+        "a third tumble past three step edges ({long} of {checked})"
     );
 }
 
@@ -488,7 +500,7 @@ fn chain_reaction_target_rests_until_struck_then_moves() {
         let strike =
             families::chain_reaction::first_strike_step(&sim).expect("the trigger strikes");
         assert!(strike > 0);
-        // At rest until struck: it stays put (< 0.1 mm), and its speed is solver noise.
+        // At rest until struck: it stays put (< 2 mm), and its speed is solver noise.
         // Rapier's soft contacts settle a body set exactly on a surface with a residual
         // of about 1 mm/s in the first steps (1.4 mm/s for a 50 g plastic wine glass),
         // hence 2 mm/s rather than 1.
@@ -499,8 +511,10 @@ fn chain_reaction_target_rests_until_struck_then_moves() {
             let p = sim.hazard_position(k);
             let moved =
                 ((p[0] - p0[0]).powi(2) + (p[1] - p0[1]).powi(2) + (p[2] - p0[2]).powi(2)).sqrt();
+            // The timed run-up (rule v5) strikes it up to 0.9 s in: a settling creep at
+            // that noise speed (0.2 mm in the first 0.1 s for a hatchet) stays under 2 mm.
             assert!(
-                speed < 2e-3 && moved < 1e-4,
+                speed < 2e-3 && moved < families::chain_reaction::REST_CREEP_M,
                 "{} step {k}: target not at rest (v {speed}, moved {moved})",
                 r.spec.selection.object_id
             );
@@ -565,18 +579,35 @@ fn surface_cascade_touches_the_stool_between_table_and_floor() {
 fn label_balance_covers_every_family() {
     let (catalog, config) = setup();
     let rows = rh_scenes::balance::label_balance(&catalog, &config, 0, &[], 18, 680).unwrap();
+    println!("{}", rh_scenes::balance::format_table(&rows));
     assert_eq!(rows.len(), 17);
     let mut totals = [0usize; 3];
     for r in &rows {
-        assert_eq!(r.total(), 18, "{}", r.family);
+        // A family short of real decisions stays short (never padded with NO_ACTION).
+        assert!(
+            (1..=18).contains(&r.total()) && r.no_action <= 1,
+            "{}",
+            r.family
+        );
         totals[0] += r.catch;
         totals[1] += r.dodge;
         totals[2] += r.no_action;
     }
+    // Label rule v5's shape of the evaluation subset (issue #23): CATCH 40–52%, DODGE
+    // 42–56%, NO_ACTION 2–8%, and most families give real decisions of both kinds.
+    let n: usize = totals.iter().sum();
+    let share = |k: usize| totals[k] as f64 / n as f64;
+    assert!(n >= 230, "subset of {n} scenes: {totals:?}");
+    assert!((0.40..=0.52).contains(&share(0)), "CATCH share {totals:?}");
+    assert!((0.42..=0.56).contains(&share(1)), "DODGE share {totals:?}");
     assert!(
-        totals.iter().all(|&t| t > 0),
-        "every action occurs: {totals:?}"
+        (0.02..=0.08).contains(&share(2)),
+        "NO_ACTION share {totals:?}"
     );
+    let with = |f: fn(&rh_scenes::balance::FamilyBalance) -> usize| {
+        rows.iter().filter(|r| f(r) >= 3).count()
+    };
+    assert!(with(|r| r.catch) >= 11, "families with >= 3 CATCH");
+    assert!(with(|r| r.dodge) >= 13, "families with >= 3 DODGE");
     let _ = Action::Catch;
-    println!("{}", rh_scenes::balance::format_table(&rows));
 }

@@ -176,10 +176,24 @@ impl Family for ChainReaction {
 
     fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
         // The target was launched off its table: it started on it and reached the floor
-        // (a target nudged a few centimetres that stays on the table is no event).
+        // (a target nudged a few centimetres that stays on the table is no event), and it
+        // rested until the trigger struck it (a head-heavy target that creeps off on its
+        // own, as a hatchet on the felt-smooth table can, is not this family's event).
         reached_floor(spec, sim)
+            && first_strike_step(sim).is_some_and(|strike| {
+                let p0 = sim.hazard_position(0);
+                (0..strike).all(|k| {
+                    let p = sim.hazard_position(k);
+                    let d2: f64 = (0..3).map(|i| (p[i] - p0[i]).powi(2)).sum();
+                    d2 < REST_CREEP_M * REST_CREEP_M
+                })
+            })
     }
 }
+
+/// How far (m) the target may settle on its table before the trigger strikes it: rapier's
+/// soft contacts let a body set exactly on a surface creep at about 1 mm/s.
+pub const REST_CREEP_M: f64 = 0.002;
 
 /// First step at which the hazard touches a body other than its table or the floor
 /// (the trigger, in this family).
