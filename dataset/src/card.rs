@@ -278,23 +278,7 @@ pub fn text(input: &CardInput) -> String {
         );
     }
     if let Some(eval) = input.eval {
-        let short: Vec<String> = m
-            .families
-            .iter()
-            .filter(|f| counts.contains_key(*f))
-            .filter(|f| eval.get(*f).copied().unwrap_or(0) < per_family)
-            .map(|f| format!("`{f}` ({})", eval.get(f).copied().unwrap_or(0)))
-            .collect();
-        if !short.is_empty() {
-            let _ = write!(
-                scope,
-                "\n\n**Note:** the `eval` config takes up to {per_family} valid scenes per family; \
-                 this build has fewer in {} of its {} families, so the subset holds all valid scenes of: {}.",
-                short.len(),
-                counts.len(),
-                short.join(", ")
-            );
-        }
+        scope.push_str(&eval_short_note(m, &counts, eval, &eval_cfg));
     }
     v.insert("scope", scope);
     v.insert("video_note", VIDEO_NOTE.trim_end().to_string());
@@ -340,6 +324,36 @@ pub fn text(input: &CardInput) -> String {
 }
 
 /// The build summary table and the command that rebuilds this dataset.
+/// The card's note on families with fewer than `per_family` scenes in the eval subset
+/// (empty when every family has them).
+fn eval_short_note(
+    m: &Manifest,
+    counts: &BTreeMap<String, FamilyCounts>,
+    eval: &BTreeMap<String, usize>,
+    eval_cfg: &EvalConfig,
+) -> String {
+    let per_family = eval_cfg.per_family;
+    let short: Vec<String> = m
+        .families
+        .iter()
+        .filter(|f| counts.contains_key(*f))
+        .filter(|f| eval.get(*f).copied().unwrap_or(0) < per_family)
+        .map(|f| format!("`{f}` ({})", eval.get(f).copied().unwrap_or(0)))
+        .collect();
+    if short.is_empty() {
+        return String::new();
+    }
+    format!(
+        "\n\n**Note:** the `eval` config takes up to {per_family} valid scenes per family, at \
+         most {} NO_ACTION; this build has fewer real decisions in {} of its {} families, so \
+         the subset holds fewer scenes of: {}.",
+        eval_cfg.no_action_per_family,
+        short.len(),
+        counts.len(),
+        short.join(", ")
+    )
+}
+
 fn insert_provenance(input: &CardInput, v: &mut BTreeMap<&str, String>) {
     let m = input.manifest;
     let default_config = rh_scenes::config::Config::embedded()

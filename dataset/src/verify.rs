@@ -21,8 +21,7 @@ use rayon::prelude::*;
 use rh_catalog::Catalog;
 use rh_physics::simulate::{simulate, SimOptions};
 use rh_physics::spec::SceneSpec;
-use rh_scenes::driver::{produce_group, SceneResult};
-use rh_scenes::selection::plan_group_with;
+use rh_scenes::driver::{plan_and_produce, SceneResult};
 use serde::Serialize;
 use std::path::Path;
 
@@ -145,28 +144,17 @@ pub fn verify(dir: &Path, catalog: &Catalog) -> Result<VerifyReport, String> {
     let per_group: Vec<Result<(usize, Vec<Mismatch>), String>> = groups
         .par_iter()
         .map(|&g| {
-            // As `scene::run_group`: a build from descriptions stored its planned
-            // selections (group g takes g mod len); else the lexicon plans the group.
-            let selection = match manifest.selections.as_deref() {
-                Some(s) if !s.is_empty() => s[(g % s.len() as u64) as usize].clone(),
-                _ => plan_group_with(
-                    catalog,
-                    &manifest.families,
-                    manifest.seed,
-                    g,
-                    &config.plan_policy(),
-                )
-                .map_err(|e| e.to_string())?,
-            };
-            let mut results = produce_group(
-                &selection,
-                manifest.seed,
-                g * 4,
-                manifest.group_size(g),
+            // As a build (`driver::plan_and_produce`): a build from descriptions stored
+            // its planned selections; else the lexicon plans (and replans) the group.
+            let (mut results, _) = plan_and_produce(
                 catalog,
+                &manifest.families,
+                manifest.selections.as_deref(),
+                manifest.seed,
+                g,
+                manifest.group_size(g),
                 &config,
-            )
-            .map_err(|e| e.to_string())?;
+            )?;
             let stored = match (&rows, &index) {
                 (Some(rows), Some(index)) => {
                     let picks: Vec<u32> = (0..rows.num_rows() as u32)

@@ -15,8 +15,7 @@ use rh_physics::simulate::{simulate, SimOptions, Simulation};
 use rh_physics::spec::SceneSpec;
 use rh_render::{RenderOptions, Renderer, CAMERAS, FRAME_TIMES};
 use rh_scenes::config::Config;
-use rh_scenes::driver::produce_group;
-use rh_scenes::selection::plan_group;
+use rh_scenes::driver::plan_and_produce;
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::sync::{Mutex, OnceLock};
@@ -34,10 +33,12 @@ fn renderer() -> &'static Mutex<Renderer> {
 /// Scene `band` of group `g` (families dealt round-robin), labelled and validated.
 fn scene(config: &Config, catalog: &Catalog, g: u64, band: u64) -> (SceneSpec, Simulation, bool) {
     let families = config.build.families.clone();
-    let selection = plan_group(catalog, &families, SEED, g).unwrap();
-    let r = produce_group(&selection, SEED, g * 4 + band, 1, catalog, config).unwrap();
-    let sim = simulate(&r[0].spec, SimOptions::default());
-    (r[0].spec.clone(), sim, r[0].verdicts.all())
+    // As a build: the whole group (one observer pose and camera set for its bands), replanned
+    // if no attempt passes.
+    let (r, _) = plan_and_produce(catalog, &families, None, SEED, g, 4, config).unwrap();
+    let r = &r[band as usize];
+    let sim = simulate(&r.spec, SimOptions::default());
+    (r.spec.clone(), sim, r.verdicts.all())
 }
 
 #[test]

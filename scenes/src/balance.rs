@@ -13,11 +13,10 @@
 //! `catch_radius_max`).
 
 use crate::config::Config;
-use crate::driver::produce_group_counted;
+use crate::driver::plan_and_produce;
 use crate::eval_subset::{EvalConfig, EvalRow};
 use crate::families;
 use crate::label::Action;
-use crate::selection::plan_group_with;
 use rayon::prelude::*;
 use rh_catalog::Catalog;
 use serde::Serialize;
@@ -159,16 +158,8 @@ pub fn label_balance(
         let built: Vec<anyhow::Result<_>> = groups
             .par_iter()
             .map(|&group| {
-                let selection =
-                    plan_group_with(catalog, &all, build_seed, group, &config.plan_policy())?;
-                Ok(produce_group_counted(
-                    &selection,
-                    build_seed,
-                    group * 4,
-                    4,
-                    catalog,
-                    config,
-                )?)
+                plan_and_produce(catalog, &all, None, build_seed, group, 4, config)
+                    .map_err(anyhow::Error::msg)
             })
             .collect();
         let mut balance = FamilyBalance {

@@ -25,7 +25,7 @@ pub struct BuildSection {
     pub families: Vec<String>,
     pub far_observer_share: f64,
     /// Label rule v5: the share of a family's groups the embedded planner gives a benign
-    /// object (`selection::PlanPolicy`). Absent (older builds): objects are drawn
+    /// object (the planner's policy). Absent (older builds): objects are drawn
     /// uniformly, whatever their kind.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub benign_share: Option<f64>,
@@ -70,6 +70,10 @@ fn default_visible_px_min() -> u32 {
 #[serde(deny_unknown_fields)]
 pub struct ValidatorConfig {
     pub max_attempts: u32,
+    /// A group whose `max_attempts` all fail is planned afresh (another object and room of
+    /// its family) up to this many times (label rule v5).
+    #[serde(default)]
+    pub replans: u32,
     pub penetration_tolerance: f64,
     pub energy_gain_relative: f64,
     pub energy_gain_absolute: f64,
@@ -256,15 +260,6 @@ pub struct Config {
 }
 
 impl Config {
-    /// What the embedded planner balances (`selection::plan_group`).
-    pub fn plan_policy(&self) -> crate::selection::PlanPolicy {
-        crate::selection::PlanPolicy {
-            benign_share: self.build.benign_share,
-            benign_share_by_family: self.build.benign_share_by_family.clone(),
-            heavy_mass_kg: self.labels.heavy_mass_kg,
-        }
-    }
-
     /// The configuration compiled into the binary (`configs/default.toml`).
     pub fn embedded() -> Result<Config, ConfigError> {
         let raw: RawConfig = parse("configs/default.toml", DEFAULT_TOML)?;
@@ -314,39 +309,7 @@ impl Config {
             }
         };
         positive("physics.dt", self.physics.dt)?;
-        let a = &self.aim;
-        let range = |field: &str, r: [f64; 2]| {
-            if r[0].is_finite() && r[1].is_finite() && r[0] <= r[1] {
-                Ok(())
-            } else {
-                Err(fail(
-                    field,
-                    format!("must be [low, high] with low <= high (got {r:?})"),
-                ))
-            }
-        };
-        range("aim.meet_height", a.meet_height)?;
-        range("aim.ahead", a.ahead)?;
-        range("aim.miss_clearance", a.miss_clearance)?;
-        range("aim.body_meet_height", a.body_meet_height)?;
-        range("aim.body_ahead", a.body_ahead)?;
-        for (family, r) in &a.meet_height_by_family {
-            range(&format!("aim.meet_height_by_family.{family}"), *r)?;
-        }
-        for (field, v) in [
-            ("aim.reaction_margin_s", a.reaction_margin_s),
-            ("aim.lateral", a.lateral),
-            ("aim.body_lateral", a.body_lateral),
-            ("aim.wall_margin", a.wall_margin),
-            ("aim.touch_slack", a.touch_slack),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(fail(
-                    field,
-                    format!("must be a non-negative number (got {v})"),
-                ));
-            }
-        }
+        self.validate_aim(name)?;
         if self.eval.per_family == 0 {
             return Err(fail("eval.per_family", "must be at least 1".into()));
         }
@@ -360,64 +323,7 @@ impl Config {
         positive("physics.horizon_s", self.physics.horizon_s)?;
         positive("physics.min_duration_s", self.physics.min_duration_s)?;
         positive("observation.window_s", self.observation.window_s)?;
-        let l = &self.labels;
-        for (field, v) in [
-            (
-                "labels.envelope_shoulder_offset",
-                l.envelope_shoulder_offset,
-            ),
-            ("labels.envelope_step", l.envelope_step),
-            ("labels.envelope_arm_reach", l.envelope_arm_reach),
-            ("labels.envelope_crouch", l.envelope_crouch),
-            ("labels.envelope_min_height", l.envelope_min_height),
-            ("labels.catch_walk_speed", l.catch_walk_speed),
-            ("labels.catch_walk_accel", l.catch_walk_accel),
-            ("labels.catch_prepare_s", l.catch_prepare_s),
-            ("labels.catch_radius_max", l.catch_radius_max),
-            ("labels.escape_speed", l.escape_speed),
-            ("labels.escape_distance", l.escape_distance),
-            ("labels.escape_directions", l.escape_directions as f64),
-            ("labels.escape_check_within_s", l.escape_check_within_s),
-            ("labels.interception_tolerance", l.interception_tolerance),
-            ("labels.reaction_time_min", l.reaction_time_min),
-            ("labels.floor_contact_eps", l.floor_contact_eps),
-            ("labels.strike_window_s", l.strike_window_s),
-            ("labels.harm_transient_factor", l.harm_transient_factor),
-        ] {
-            positive(field, v)?;
-        }
-        for region in rh_physics::strike::Region::ALL {
-            let field = format!("labels.harm.{}", region.name());
-            let Some(h) = l.harm.get(region.name()) else {
-                return Err(fail(
-                    &field,
-                    "is missing (one table per body region)".into(),
-                ));
-            };
-            positive(&format!("{field}.force_n"), h.force_n)?;
-            positive(&format!("{field}.spring_n_per_mm"), h.spring_n_per_mm)?;
-            positive(&format!("{field}.body_mass_kg"), h.body_mass_kg)?;
-        }
-        if let Some(extra) = l.harm.keys().find(|k| {
-            rh_physics::strike::Region::ALL
-                .iter()
-                .all(|r| r.name() != *k)
-        }) {
-            return Err(fail(
-                &format!("labels.harm.{extra}"),
-                "is not a body region of the humanoid".into(),
-            ));
-        }
-        positive("labels.reach_radius", self.labels.reach_radius)?;
-        positive(
-            "labels.closest_approach_max",
-            self.labels.closest_approach_max,
-        )?;
-        positive("labels.heavy_mass_kg", self.labels.heavy_mass_kg)?;
-        positive("labels.heavy_momentum", self.labels.heavy_momentum)?;
-        positive("labels.catch_speed_max", self.labels.catch_speed_max)?;
-        positive("labels.catch_energy_max", self.labels.catch_energy_max)?;
-        positive("observer.torso_radius", self.observer.torso_radius)?;
+        self.validate_labels(name)?;
         if self.physics.horizon_s < self.physics.min_duration_s {
             return Err(fail(
                 "physics.horizon_s",
@@ -502,6 +408,120 @@ impl Config {
                 ));
             }
         }
+        Ok(())
+    }
+
+    fn validate_aim(&self, name: &str) -> Result<(), ConfigError> {
+        let fail = |field: &str, message: String| ConfigError {
+            location: format!("{name}: field '{field}'"),
+            message,
+        };
+        let a = &self.aim;
+        let range = |field: &str, r: [f64; 2]| {
+            if r[0].is_finite() && r[1].is_finite() && r[0] <= r[1] {
+                Ok(())
+            } else {
+                Err(fail(
+                    field,
+                    format!("must be [low, high] with low <= high (got {r:?})"),
+                ))
+            }
+        };
+        range("aim.meet_height", a.meet_height)?;
+        range("aim.ahead", a.ahead)?;
+        range("aim.miss_clearance", a.miss_clearance)?;
+        range("aim.body_meet_height", a.body_meet_height)?;
+        range("aim.body_ahead", a.body_ahead)?;
+        for (family, r) in &a.meet_height_by_family {
+            range(&format!("aim.meet_height_by_family.{family}"), *r)?;
+        }
+        for (field, v) in [
+            ("aim.reaction_margin_s", a.reaction_margin_s),
+            ("aim.lateral", a.lateral),
+            ("aim.body_lateral", a.body_lateral),
+            ("aim.wall_margin", a.wall_margin),
+            ("aim.touch_slack", a.touch_slack),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(fail(
+                    field,
+                    format!("must be a non-negative number (got {v})"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_labels(&self, name: &str) -> Result<(), ConfigError> {
+        let fail = |field: &str, message: String| ConfigError {
+            location: format!("{name}: field '{field}'"),
+            message,
+        };
+        let positive = |field: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(fail(field, format!("must be a positive number (got {v})")))
+            }
+        };
+        let l = &self.labels;
+        for (field, v) in [
+            (
+                "labels.envelope_shoulder_offset",
+                l.envelope_shoulder_offset,
+            ),
+            ("labels.envelope_step", l.envelope_step),
+            ("labels.envelope_arm_reach", l.envelope_arm_reach),
+            ("labels.envelope_crouch", l.envelope_crouch),
+            ("labels.envelope_min_height", l.envelope_min_height),
+            ("labels.catch_walk_speed", l.catch_walk_speed),
+            ("labels.catch_walk_accel", l.catch_walk_accel),
+            ("labels.catch_prepare_s", l.catch_prepare_s),
+            ("labels.catch_radius_max", l.catch_radius_max),
+            ("labels.escape_speed", l.escape_speed),
+            ("labels.escape_distance", l.escape_distance),
+            ("labels.escape_directions", l.escape_directions as f64),
+            ("labels.escape_check_within_s", l.escape_check_within_s),
+            ("labels.interception_tolerance", l.interception_tolerance),
+            ("labels.reaction_time_min", l.reaction_time_min),
+            ("labels.floor_contact_eps", l.floor_contact_eps),
+            ("labels.strike_window_s", l.strike_window_s),
+            ("labels.harm_transient_factor", l.harm_transient_factor),
+        ] {
+            positive(field, v)?;
+        }
+        for region in rh_physics::strike::Region::ALL {
+            let field = format!("labels.harm.{}", region.name());
+            let Some(h) = l.harm.get(region.name()) else {
+                return Err(fail(
+                    &field,
+                    "is missing (one table per body region)".into(),
+                ));
+            };
+            positive(&format!("{field}.force_n"), h.force_n)?;
+            positive(&format!("{field}.spring_n_per_mm"), h.spring_n_per_mm)?;
+            positive(&format!("{field}.body_mass_kg"), h.body_mass_kg)?;
+        }
+        if let Some(extra) = l.harm.keys().find(|k| {
+            rh_physics::strike::Region::ALL
+                .iter()
+                .all(|r| r.name() != *k)
+        }) {
+            return Err(fail(
+                &format!("labels.harm.{extra}"),
+                "is not a body region of the humanoid".into(),
+            ));
+        }
+        positive("labels.reach_radius", self.labels.reach_radius)?;
+        positive(
+            "labels.closest_approach_max",
+            self.labels.closest_approach_max,
+        )?;
+        positive("labels.heavy_mass_kg", self.labels.heavy_mass_kg)?;
+        positive("labels.heavy_momentum", self.labels.heavy_momentum)?;
+        positive("labels.catch_speed_max", self.labels.catch_speed_max)?;
+        positive("labels.catch_energy_max", self.labels.catch_energy_max)?;
+        positive("observer.torso_radius", self.observer.torso_radius)?;
         Ok(())
     }
 

@@ -9,7 +9,7 @@ use crate::config::Config;
 use crate::families;
 use crate::label::{label, Labels};
 use crate::randomize::{randomize, RandomizeError, SceneKey};
-use crate::selection::plan_group_with;
+use crate::selection::replan_group;
 use crate::validate::{validate, Verdicts, VALIDATOR_COLUMNS};
 use rh_catalog::Catalog;
 use rh_physics::simulate::{simulate, SimOptions, Simulation};
@@ -97,21 +97,55 @@ pub fn run_group(
     config: &Config,
     render: Option<&RenderStage>,
 ) -> Result<(Vec<SceneResult>, Rejections), GroupError> {
-    // Selections planned from descriptions (`build --descriptions`): group g takes g mod D.
-    let selection = match planned {
-        Some(s) if !s.is_empty() => s[(g % s.len() as u64) as usize].clone(),
-        _ => plan_group_with(catalog, families, seed, g, &config.plan_policy())
-            .map_err(|e| GroupError::Input(e.to_string()))?,
-    };
     let (mut results, rejections) =
-        produce_group_counted(&selection, seed, g * 4, count, catalog, config)
-            .map_err(|e| GroupError::Input(e.to_string()))?;
+        plan_and_produce(catalog, families, planned, seed, g, count, config)
+            .map_err(GroupError::Input)?;
     if let Some(render) = render {
         for r in results.iter_mut() {
             r.media = render(r).map_err(GroupError::Render)?;
         }
     }
     Ok((results, rejections))
+}
+
+/// Plans group `g` and produces its scenes ([`produce_group_counted`]). Selections
+/// planned from descriptions (`build --descriptions`): group g takes g mod D. Otherwise a
+/// group none of whose attempts passes every validator (a heavy pillow thrown at the
+/// chest that no walk escapes) is planned afresh ([`replan_group`]), up to
+/// `validators.replans` times, and the first plan whose bands all pass is kept (else the
+/// last, marked invalid). The one planning path of builds, `verify` and `balance`.
+pub fn plan_and_produce(
+    catalog: &Catalog,
+    families: &[String],
+    planned: Option<&[Selection]>,
+    seed: u64,
+    g: u64,
+    count: u64,
+    config: &Config,
+) -> Result<(Vec<SceneResult>, Rejections), String> {
+    if let Some(s) = planned.filter(|s| !s.is_empty()) {
+        let selection = &s[(g % s.len() as u64) as usize];
+        return produce_group_counted(selection, seed, g * 4, count, catalog, config)
+            .map_err(|e| e.to_string());
+    }
+    let policy = crate::selection::PlanPolicy::of(config);
+    let mut total = Rejections::default();
+    let mut replan = 0;
+    loop {
+        let selection =
+            replan_group(catalog, families, seed, g, &policy, replan).map_err(|e| e.to_string())?;
+        let (results, rejections) =
+            produce_group_counted(&selection, seed, g * 4, count, catalog, config)
+                .map_err(|e| e.to_string())?;
+        total.attempts += rejections.attempts;
+        for (t, r) in total.rejected_by.iter_mut().zip(rejections.rejected_by) {
+            *t += r;
+        }
+        if replan >= config.validators.replans || results.iter().all(|r| r.verdicts.all()) {
+            return Ok((results, total));
+        }
+        replan += 1;
+    }
 }
 
 /// Frames one set of cameras for a group's bands and labels and validates each band.

@@ -50,6 +50,18 @@ pub struct PlanPolicy {
     pub heavy_mass_kg: f64,
 }
 
+impl PlanPolicy {
+    /// What a build configuration's planner balances (`[build]`, the label rule's
+    /// `heavy_mass_kg`).
+    pub fn of(config: &crate::config::Config) -> PlanPolicy {
+        PlanPolicy {
+            benign_share: config.build.benign_share,
+            benign_share_by_family: config.build.benign_share_by_family.clone(),
+            heavy_mass_kg: config.labels.heavy_mass_kg,
+        }
+    }
+}
+
 /// Whether an object is dangerous by its properties alone (the label rule's `dangerous`
 /// before any impact momentum): sharp, hot, large and fragile, or heavy.
 pub fn intrinsically_dangerous(object: &Object, heavy_mass_kg: f64) -> bool {
@@ -72,9 +84,9 @@ pub fn plan_group(
 ) -> Result<Selection, PlanError> {
     static EMBEDDED: std::sync::OnceLock<PlanPolicy> = std::sync::OnceLock::new();
     let policy = EMBEDDED.get_or_init(|| {
-        crate::config::Config::embedded()
-            .expect("the embedded configuration is valid")
-            .plan_policy()
+        PlanPolicy::of(
+            &crate::config::Config::embedded().expect("the embedded configuration is valid"),
+        )
     });
     plan_group_with(catalog, families, build_seed, group, policy)
 }
@@ -87,8 +99,22 @@ pub fn plan_group_with(
     group: u64,
     policy: &PlanPolicy,
 ) -> Result<Selection, PlanError> {
+    replan_group(catalog, families, build_seed, group, policy, 0)
+}
+
+/// [`plan_group_with`]'s plan number `replan` (0: the group's plan): the same family, the
+/// object kind, object and room drawn again from the "plan" stream's `replan`-th index.
+/// The driver replans a group none of whose attempts passes the validators.
+pub fn replan_group(
+    catalog: &Catalog,
+    families: &[String],
+    build_seed: u64,
+    group: u64,
+    policy: &PlanPolicy,
+    replan: u32,
+) -> Result<Selection, PlanError> {
     let family = &families[(group % families.len() as u64) as usize];
-    let mut rng = seeds::stream(seeds::group_seed(build_seed, group), 0, "plan");
+    let mut rng = seeds::stream(seeds::group_seed(build_seed, group), replan, "plan");
     let all: Vec<&Object> = catalog.objects_for_family(family).collect();
     let candidates = match policy.benign_share {
         None => all,

@@ -6,7 +6,7 @@ use rh_catalog::Catalog;
 use rh_physics::simulate::{simulate, SimOptions, Simulation, TOUCH_FLOOR, TOUCH_SOURCE};
 use rh_physics::spec::{quat, Selection, ShapeSpec};
 use rh_scenes::config::Config;
-use rh_scenes::driver::{produce_group, run_scene, SceneResult};
+use rh_scenes::driver::{plan_and_produce, produce_group, run_scene, SceneResult};
 use rh_scenes::label::Action;
 use rh_scenes::selection::plan_group;
 
@@ -22,8 +22,9 @@ fn scenes(family: &str, groups: u64, seed: u64) -> Vec<SceneResult> {
     let families = vec![family.to_string()];
     let results: Vec<SceneResult> = (0..groups)
         .flat_map(|g| {
-            let selection = plan_group(&catalog, &families, seed, g).unwrap();
-            produce_group(&selection, seed, g * 4, 4, &catalog, &config).unwrap()
+            plan_and_produce(&catalog, &families, None, seed, g, 4, &config)
+                .unwrap()
+                .0
         })
         .collect();
     for r in &results {

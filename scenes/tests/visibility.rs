@@ -5,7 +5,7 @@
 
 use rh_catalog::Catalog;
 use rh_scenes::config::Config;
-use rh_scenes::driver::produce_group_counted;
+use rh_scenes::driver::plan_and_produce;
 use rh_scenes::selection::plan_group;
 use rh_scenes::validate::VALIDATOR_COLUMNS;
 use rh_scenes::visibility;
@@ -25,11 +25,12 @@ fn a_default_340_scene_build_is_all_valid_and_bands_share_their_cameras() {
     // family → (attempts, attempts rejected by visibility)
     let mut per_family: BTreeMap<String, (u32, u32)> = BTreeMap::new();
     for g in 0..85u64 {
-        let selection = plan_group(&catalog, &families, seed, g).unwrap();
         let (results, rejections) =
-            produce_group_counted(&selection, seed, g * 4, 4, &catalog, &config).unwrap();
+            plan_and_produce(&catalog, &families, None, seed, g, 4, &config).unwrap();
         assert_eq!(results.len(), 4);
-        let entry = per_family.entry(selection.family.clone()).or_default();
+        let entry = per_family
+            .entry(results[0].spec.family.clone())
+            .or_default();
         entry.0 += rejections.attempts;
         entry.1 += rejections.rejected_by[visible];
         let first = &results[0].spec;

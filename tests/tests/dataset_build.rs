@@ -93,7 +93,7 @@ fn dataset_build_layout_card_and_manifest() {
         "path: eval/test-*.parquet",
         "n<1K",
         "| `impact_point` | float64[3], nullable |",
-        "Label rule `v4`",
+        "Label rule `v5`",
         "the articulated humanoid the executor moves",
         "where the hands can hold it",
         "`valid_escapable`",

@@ -55,6 +55,10 @@ fn html_site_opens_in_headless_chromium() {
         ],
     );
     let ds = dataset.to_str().unwrap();
+    // The scenes rh-score scores and the site lists: the evaluation subset (label rule v5
+    // keeps at most one NO_ACTION per family there).
+    let scored = eval_rows(&dataset);
+    assert!(scored >= 4, "{scored} scenes in the eval subset");
     let mut preds = String::new();
     for b in BASELINES {
         preds += &run_ok("rh-score", &["baseline", b, "--dataset", ds, "--model", b]);
@@ -124,9 +128,9 @@ fn html_site_opens_in_headless_chromium() {
     // Scene browser: a filter changes the number of listed scenes.
     b.goto(&url(&site, "scenes.html"));
     let all = count(&mut b);
-    assert_eq!(all, 12, "every valid scene is listed");
+    assert_eq!(all, scored, "every scored scene is listed");
     let listed = b.eval("document.querySelectorAll('#scene-list tbody tr').length");
-    assert_eq!(listed.as_u64(), Some(12));
+    assert_eq!(listed.as_u64(), Some(scored));
     b.eval(
         "(() => { const s = document.getElementById('f-family'); s.value = 'thrown_object'; \
          s.dispatchEvent(new Event('change', {bubbles: true})); })()",
@@ -310,7 +314,10 @@ fn html_site_opens_in_headless_chromium() {
         "[...document.querySelectorAll('#leaderboard tbody tr:first-child td')].map(td => td.textContent).join('|')",
     );
     let cells = cells.as_str().unwrap_or_default();
-    assert!(cells.contains("12/12") && cells.contains("–"), "{cells}");
+    assert!(
+        cells.contains(&format!("{scored}/{scored}")) && cells.contains("–"),
+        "{cells}"
+    );
 
     // With --execute the leaderboard gains the outcome columns and still fits 1400 px.
     let exec_site = tmp.path().join("site-exec");
@@ -353,4 +360,22 @@ fn html_site_opens_in_headless_chromium() {
         std::fs::write(docs.join("leaderboard.png"), &shot_board).unwrap();
         std::fs::write(docs.join("scene.png"), &shot_scene).unwrap();
     }
+}
+
+/// Rows of a dataset's `eval` config (pyarrow reads the Parquet footer).
+fn eval_rows(dataset: &std::path::Path) -> u64 {
+    let out = std::process::Command::new("python3")
+        .arg("-c")
+        .arg(format!(
+            "import glob, pyarrow.parquet as pq; print(sum(pq.read_metadata(f).num_rows for f in glob.glob({:?} + '/eval/*.parquet')))",
+            dataset.display().to_string()
+        ))
+        .output()
+        .expect("python3 with pyarrow (scripts/setup.sh)");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).trim().parse().unwrap()
 }

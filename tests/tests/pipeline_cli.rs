@@ -411,16 +411,36 @@ fn balance_reports_counts_per_action_per_family() {
             FOUNDATION_FAMILIES,
         ],
     );
-    let rows: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let rows = rows.as_array().unwrap();
+    let report: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let rows = report["families"].as_array().unwrap();
     assert_eq!(rows.len(), 6);
     for r in rows {
-        let total = ["catch", "dodge", "no_action", "invalid"]
+        // The subset's scenes of a family (at most 8, at most one NO_ACTION), chosen from
+        // its share of the 680-scene pool, which is counted whole.
+        let subset = ["catch", "dodge", "no_action"]
             .iter()
-            .map(|k| r[*k].as_u64().unwrap_or(0))
+            .map(|k| r[*k].as_u64().unwrap())
             .sum::<u64>();
-        assert_eq!(total, 8, "{r}");
+        let pool = ["pool_catch", "pool_dodge", "pool_no_action", "invalid"]
+            .iter()
+            .map(|k| r[*k].as_u64().unwrap())
+            .sum::<u64>();
+        assert!(
+            (1..=8).contains(&subset) && r["no_action"].as_u64().unwrap() <= 1,
+            "{r}"
+        );
+        assert_eq!(pool, 40, "{r}");
     }
+    let eval = &report["eval"];
+    assert_eq!(
+        eval["scenes"].as_u64().unwrap(),
+        rows.iter()
+            .map(|r| ["catch", "dodge", "no_action"]
+                .iter()
+                .map(|k| r[*k].as_u64().unwrap())
+                .sum::<u64>())
+            .sum::<u64>()
+    );
     let text = run_ok(
         "rh-pipeline",
         &["balance", "--per-family", "4", "--families", "object_drop"],
@@ -467,7 +487,7 @@ fn docs_label_balance_matches_the_balance_command() {
         &["balance", "--json", "--seed", "0"],
     ))
     .unwrap();
-    let rows = rows.as_array().unwrap();
+    let rows = rows["families"].as_array().unwrap();
     assert_eq!(rows.len(), 17);
     let sum = |k: &str| rows.iter().map(|r| r[k].as_u64().unwrap_or(0)).sum::<u64>();
     let actual = (sum("catch"), sum("dodge"), sum("no_action"));

@@ -57,7 +57,10 @@ fn truth(ds: &Path) -> Truth {
         r#"
 import glob, json, pyarrow.parquet as pq
 rows = []
-for f in sorted(glob.glob({dir:?} + "/data/*.parquet")):
+# What rh-score scores by default: the evaluation subset (label rule v5 keeps at most one
+# NO_ACTION per family there), else every valid scene.
+files = sorted(glob.glob({dir:?} + "/eval/*.parquet")) or sorted(glob.glob({dir:?} + "/data/*.parquet"))
+for f in files:
     for r in pq.read_table(f).to_pylist():
         if r.get("valid", True):
             rows.append([r["scene_id"], r["gt_action"], r["danger_present"], r["impact_point"] is not None])
