@@ -179,3 +179,87 @@ pub fn twin_spec(
 pub fn twin_of(spec: &SceneSpec) -> Option<u64> {
     spec.family_params.get(TWIN_PARAM).map(|&i| i as u64)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Config;
+
+    fn pair(adversarial: &str, family: &str, twin: bool) -> ProbePair {
+        ProbePair {
+            adversarial: adversarial.into(),
+            family: family.into(),
+            twin,
+        }
+    }
+
+    #[test]
+    fn pairs_take_their_family_groups_in_order() {
+        let families: Vec<String> = ["a", "b", "c"].map(String::from).to_vec();
+        let probes = ProbeConfig {
+            pairs: vec![
+                pair("x", "b", true),
+                pair("y", "b", false),
+                pair("z", "b", true),
+            ],
+        };
+        // Family b owns groups 1, 4, 7, 10, 13, 16, …: x takes 1 and 4, y 7, z 10 and 13.
+        let roles: Vec<(u64, &str, Role, u64)> = (0..20)
+            .filter_map(|g| {
+                slot(&probes, &families, g)
+                    .map(|s| (g, s.pair.adversarial.as_str(), s.role, s.probe_group))
+            })
+            .collect();
+        assert_eq!(
+            roles,
+            vec![
+                (1, "x", Role::Probe, 1),
+                (4, "x", Role::Twin, 1),
+                (7, "y", Role::Probe, 7),
+                (10, "z", Role::Probe, 10),
+                (13, "z", Role::Twin, 10),
+            ]
+        );
+        assert_eq!(slot(&probes, &families, 4).unwrap().twin_group, 4);
+        assert_eq!(slot(&probes, &[], 4), None);
+    }
+
+    #[test]
+    fn every_adversarial_object_is_in_every_680_scene_build() {
+        let config = Config::embedded().unwrap();
+        let catalog = Catalog::embedded().unwrap();
+        let families = &config.build.families;
+        let groups = 680 / 4;
+        let mut shown = std::collections::BTreeSet::new();
+        for g in 0..groups {
+            if let Some(s) = slot(&config.probes, families, g) {
+                let (adversarial, genuine) = objects(s.pair, &catalog).unwrap();
+                assert_eq!(genuine.id, adversarial.looks_like.clone().unwrap());
+                if s.pair.twin {
+                    // Both groups of a twin pair are in the build.
+                    assert!(s.twin_group < groups, "{:?}", s.pair);
+                }
+                shown.insert(adversarial.id.clone());
+            }
+        }
+        let all: std::collections::BTreeSet<String> = catalog
+            .objects
+            .iter()
+            .filter(|o| o.is_adversarial())
+            .map(|o| o.id.clone())
+            .collect();
+        assert_eq!(shown, all);
+        assert!(config.probes.pairs.iter().filter(|p| p.twin).count() >= 10);
+    }
+
+    #[test]
+    fn a_pair_naming_a_genuine_or_unknown_object_is_a_clear_error() {
+        let catalog = Catalog::embedded().unwrap();
+        let e = objects(&pair("apple", "object_drop", true), &catalog).unwrap_err();
+        assert_eq!(e, ProbeError::NotAdversarial("apple".into()));
+        let e = objects(&pair("ghost", "object_drop", true), &catalog).unwrap_err();
+        assert!(e.to_string().contains("'ghost'"), "{e}");
+        let e = objects(&pair("steel_apple", "door_swing", true), &catalog).unwrap_err();
+        assert!(matches!(e, ProbeError::NotInFamily { .. }), "{e}");
+    }
+}
