@@ -21,8 +21,7 @@ use rayon::prelude::*;
 use rh_catalog::Catalog;
 use rh_physics::simulate::{simulate, SimOptions};
 use rh_physics::spec::SceneSpec;
-use rh_scenes::driver::{produce_group, SceneResult};
-use rh_scenes::selection::plan_group_with;
+use rh_scenes::driver::{produce_group, produce_planned_group, GroupError, SceneResult};
 use serde::Serialize;
 use std::path::Path;
 
@@ -145,28 +144,35 @@ pub fn verify(dir: &Path, catalog: &Catalog) -> Result<VerifyReport, String> {
     let per_group: Vec<Result<(usize, Vec<Mismatch>), String>> = groups
         .par_iter()
         .map(|&g| {
-            // As `scene::run_group`: a build from descriptions stored its planned
-            // selections (group g takes g mod len); else the lexicon plans the group.
-            let selection = match manifest.selections.as_deref() {
-                Some(s) if !s.is_empty() => s[(g % s.len() as u64) as usize].clone(),
-                _ => plan_group_with(
-                    catalog,
-                    &manifest.families,
+            // As `driver::run_group`: a build from descriptions stored its planned
+            // selections (group g takes g mod len); else the embedded planner deals the
+            // group (an adversarial probe pair's group included: `produce_planned_group`).
+            let count = manifest.group_size(g);
+            let mut results = match manifest.selections.as_deref() {
+                Some(s) if !s.is_empty() => produce_group(
+                    &s[(g % s.len() as u64) as usize],
                     manifest.seed,
-                    g,
-                    &config.plan_policy(),
+                    g * 4,
+                    count,
+                    catalog,
+                    &config,
                 )
                 .map_err(|e| e.to_string())?,
+                _ => {
+                    produce_planned_group(
+                        catalog,
+                        &manifest.families,
+                        manifest.seed,
+                        g,
+                        count,
+                        &config,
+                    )
+                    .map_err(|e| match e {
+                        GroupError::Input(m) | GroupError::Render(m) => m,
+                    })?
+                    .0
+                }
             };
-            let mut results = produce_group(
-                &selection,
-                manifest.seed,
-                g * 4,
-                manifest.group_size(g),
-                catalog,
-                &config,
-            )
-            .map_err(|e| e.to_string())?;
             let stored = match (&rows, &index) {
                 (Some(rows), Some(index)) => {
                     let picks: Vec<u32> = (0..rows.num_rows() as u32)

@@ -238,6 +238,45 @@ mod tests {
     }
 
     #[test]
+    fn twin_pairs_come_first_whole_and_within_the_no_action_cap() {
+        let cfg = EvalConfig {
+            per_family: 6,
+            catch_share: Some(0.5),
+            no_action_per_family: 1,
+            twin_pairs_per_family: 2,
+        };
+        let paired = |i: u64, twin: u64, action| EvalRow {
+            twin: Some(twin),
+            ..row("a", i, action)
+        };
+        let rows = vec![
+            // Pair 0–4: NO_ACTION / NO_ACTION exceeds the cap of one: left out.
+            paired(0, 4, "NO_ACTION"),
+            paired(4, 0, "NO_ACTION"),
+            // Pair 1–5: CATCH / DODGE, taken.
+            paired(1, 5, "CATCH"),
+            paired(5, 1, "DODGE"),
+            // Pair 2–6: CATCH / NO_ACTION, taken (the one NO_ACTION).
+            paired(2, 6, "CATCH"),
+            paired(6, 2, "NO_ACTION"),
+            // Pair 3–7: the twin is invalid: not a pair.
+            paired(3, 7, "CATCH"),
+            EvalRow {
+                valid: false,
+                ..paired(7, 3, "DODGE")
+            },
+            row("a", 8, "CATCH"),
+            row("a", 9, "DODGE"),
+            row("a", 10, "DODGE"),
+        ];
+        let (chosen, _) = select(&rows, &cfg);
+        let indices: Vec<u64> = chosen.iter().map(|&r| rows[r].scene_index).collect();
+        // Pairs 1–5 and 2–6; CATCH target 3 less the pairs' 2: one more (3); DODGE for
+        // the rest (9); no further NO_ACTION (the pair used the cap).
+        assert_eq!(indices, vec![1, 2, 3, 5, 6, 9]);
+    }
+
+    #[test]
     fn label_blind_subset_prefers_whole_groups_then_fills_by_index() {
         // Family a: groups 0..6 (scenes 0..24); group 1 has an invalid scene.
         let mut rows: Vec<EvalRow> = (0..24)
