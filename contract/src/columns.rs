@@ -53,6 +53,7 @@ pub mod col {
     pub const OBJECT_CATEGORY: &str = "object_category";
     pub const LOOKS_LIKE: &str = "looks_like";
     pub const ADVERSARIAL: &str = "adversarial";
+    pub const TWIN_SCENE_ID: &str = "twin_scene_id";
     pub const OBJECT_MASS_KG: &str = "object_mass_kg";
     pub const HAZARDS: &str = "hazards";
     pub const ROOM: &str = "room";
@@ -254,6 +255,12 @@ pub const COLUMNS: &[Column] = &[
         Bool,
         false,
         "The object looks like another one but has its own physics (e.g. a foam anvil)",
+    ),
+    c(
+        col::TWIN_SCENE_ID,
+        Utf8,
+        true,
+        "Adversarial probe pair (label rule v5): the scene that is this one's spec with only the object replaced by its look-alike (or back); null outside probe pairs",
     ),
     c(
         col::OBJECT_MASS_KG,

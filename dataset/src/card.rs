@@ -92,12 +92,25 @@ pub fn eval_selection(
     let valid = table::bool_column(batch, "valid");
     let index = table::u64_column(batch, "scene_index");
     let action = table::string_column(batch, "gt_action");
+    // Adversarial twin pairs (label rule v5); builds before it have no such column.
+    let ids = table::string_column(batch, "scene_id");
+    let by_id: BTreeMap<&str, u64> = ids
+        .iter()
+        .map(String::as_str)
+        .zip(index.iter().copied())
+        .collect();
+    let twins: Vec<Option<u64>> =
+        table::optional_string_column(batch, rh_contract::columns::col::TWIN_SCENE_ID)
+            .into_iter()
+            .map(|t| t.and_then(|t| by_id.get(t.as_str()).copied()))
+            .collect();
     let rows: Vec<EvalRow> = (0..batch.num_rows())
         .map(|i| EvalRow {
             family: family[i].as_str(),
             scene_index: index[i],
             valid: valid[i],
             action: action[i].as_str(),
+            twin: twins[i],
         })
         .collect();
     let (chosen, counts) = eval_subset::select(&rows, cfg);

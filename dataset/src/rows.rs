@@ -92,6 +92,8 @@ pub fn record_batch(results: &[SceneResult], catalog: &Catalog) -> RecordBatch {
         strings!(|r: &SceneResult| Some(object(r).category.clone())),
         strings!(|r: &SceneResult| object(r).looks_like.clone()),
         bools(&|r| object(r).is_adversarial()),
+        strings!(|r: &SceneResult| rh_scenes::twins::twin_of(&r.spec)
+            .map(|i| rh_physics::seeds::scene_id(r.spec.build_seed, i))),
         prim!(Float64Builder, |r: &SceneResult| Some(
             r.spec.hazard_body().mass
         )),

@@ -94,6 +94,7 @@ fn neutral_scene() -> Scene {
         object_id: String::new(),
         looks_like: None,
         adversarial: false,
+        twin_scene_id: None,
         gt_action: rh_score::Action::NoAction,
         dangerous: false,
         danger_present: false,

@@ -40,6 +40,14 @@ pub struct FamilyBalance {
     pub attempts: u32,
     /// Attempts rejected by each validator (`validate::VALIDATOR_COLUMNS` order).
     pub rejected_by: Vec<u32>,
+    /// Adversarial twin pairs (`twins`) with both scenes in the evaluation subset, and
+    /// how many of them have different labels; the same over the pool (both valid).
+    pub twin_pairs: usize,
+    pub twin_pairs_differing: usize,
+    pub pool_twin_pairs: usize,
+    pub pool_twin_pairs_differing: usize,
+    /// The adversarial objects the pool shows (valid scenes or not).
+    pub adversarial_objects: Vec<String>,
 }
 
 impl FamilyBalance {
@@ -99,13 +107,59 @@ pub struct Balance {
     /// Families with at least 3 CATCH (and 3 DODGE) in the subset.
     pub families_with_3_catch: usize,
     pub families_with_3_dodge: usize,
+    /// Adversarial twin pairs in the subset and in the pool, and their differing labels.
+    pub twins: TwinShares,
+    /// Adversarial catalog objects that no pool scene shows.
+    pub adversarial_missing: Vec<String>,
     pub families: Vec<FamilyBalance>,
 }
 
+/// Twin pairs (both scenes valid) and the share whose two labels differ.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TwinShares {
+    pub eval_pairs: usize,
+    pub eval_differing: usize,
+    pub eval_share_differing: f64,
+    pub pool_pairs: usize,
+    pub pool_differing: usize,
+    pub pool_share_differing: f64,
+}
+
 impl Balance {
-    pub fn of(seed: u64, pool: u64, per_family: usize, families: Vec<FamilyBalance>) -> Balance {
+    /// `catalog`: to name the adversarial objects missing from the pool.
+    pub fn of(
+        catalog: &Catalog,
+        seed: u64,
+        pool: u64,
+        per_family: usize,
+        families: Vec<FamilyBalance>,
+    ) -> Balance {
         let sum = |f: fn(&FamilyBalance) -> usize| families.iter().map(f).sum::<usize>();
+        let share = |n: usize, of: usize| n as f64 / of.max(1) as f64;
+        let (pairs, differing) = (sum(|f| f.twin_pairs), sum(|f| f.twin_pairs_differing));
+        let (pool_pairs, pool_differing) = (
+            sum(|f| f.pool_twin_pairs),
+            sum(|f| f.pool_twin_pairs_differing),
+        );
+        let seen: std::collections::BTreeSet<&String> = families
+            .iter()
+            .flat_map(|f| &f.adversarial_objects)
+            .collect();
         Balance {
+            twins: TwinShares {
+                eval_pairs: pairs,
+                eval_differing: differing,
+                eval_share_differing: share(differing, pairs),
+                pool_pairs,
+                pool_differing,
+                pool_share_differing: share(pool_differing, pool_pairs),
+            },
+            adversarial_missing: catalog
+                .objects
+                .iter()
+                .filter(|o| o.is_adversarial() && !seen.contains(&o.id))
+                .map(|o| o.id.clone())
+                .collect(),
             seed,
             pool,
             per_family,
@@ -173,6 +227,11 @@ pub fn label_balance(
             invalid: 0,
             attempts: 0,
             rejected_by: vec![0; crate::validate::VALIDATOR_COLUMNS.len()],
+            twin_pairs: 0,
+            twin_pairs_differing: 0,
+            pool_twin_pairs: 0,
+            pool_twin_pairs_differing: 0,
+            adversarial_objects: Vec::new(),
         };
         let mut scenes = Vec::new();
         for result in built {
@@ -190,25 +249,57 @@ pub fn label_balance(
                     Action::Dodge => balance.pool_dodge += 1,
                     Action::NoAction => balance.pool_no_action += 1,
                 }
-                scenes.push((r.spec.scene_index, r.verdicts.all(), r.labels.gt_action));
+                let object = &r.spec.selection.object_id;
+                if catalog.object(object).is_some_and(|o| o.is_adversarial())
+                    && !balance.adversarial_objects.contains(object)
+                {
+                    balance.adversarial_objects.push(object.clone());
+                }
+                scenes.push((
+                    r.spec.scene_index,
+                    r.verdicts.all(),
+                    r.labels.gt_action,
+                    crate::twins::twin_of(&r.spec),
+                ));
             }
         }
         let rows: Vec<EvalRow> = scenes
             .iter()
-            .map(|&(scene_index, valid, action)| EvalRow {
+            .map(|&(scene_index, valid, action, twin)| EvalRow {
                 family,
                 scene_index,
                 valid,
                 action: action.as_str(),
+                twin,
             })
             .collect();
-        for i in crate::eval_subset::select(&rows, &eval_cfg).0 {
+        let chosen = crate::eval_subset::select(&rows, &eval_cfg).0;
+        for &i in &chosen {
             match scenes[i].2 {
                 Action::Catch => balance.catch += 1,
                 Action::Dodge => balance.dodge += 1,
                 Action::NoAction => balance.no_action += 1,
             }
         }
+        // Twin pairs, counted once (from the lower index), both scenes valid.
+        let at: std::collections::BTreeMap<u64, usize> =
+            scenes.iter().enumerate().map(|(i, s)| (s.0, i)).collect();
+        for (i, &(index, valid, action, twin)) in scenes.iter().enumerate() {
+            let Some(&j) = twin.filter(|&t| t > index).and_then(|t| at.get(&t)) else {
+                continue;
+            };
+            if !(valid && scenes[j].1) {
+                continue;
+            }
+            let differ = usize::from(action != scenes[j].2);
+            balance.pool_twin_pairs += 1;
+            balance.pool_twin_pairs_differing += differ;
+            if chosen.contains(&i) && chosen.contains(&j) {
+                balance.twin_pairs += 1;
+                balance.twin_pairs_differing += differ;
+            }
+        }
+        balance.adversarial_objects.sort();
         out.push(balance);
     }
     Ok(out)
@@ -246,6 +337,11 @@ pub fn format_table(rows: &[FamilyBalance]) -> String {
         invalid: 0,
         attempts: 0,
         rejected_by: vec![0; crate::validate::VALIDATOR_COLUMNS.len()],
+        twin_pairs: 0,
+        twin_pairs_differing: 0,
+        pool_twin_pairs: 0,
+        pool_twin_pairs_differing: 0,
+        adversarial_objects: Vec::new(),
     };
     let line = |r: &FamilyBalance| {
         let other: u32 = r
@@ -279,6 +375,10 @@ pub fn format_table(rows: &[FamilyBalance]) -> String {
         total.pool_no_action += r.pool_no_action;
         total.invalid += r.invalid;
         total.attempts += r.attempts;
+        total.twin_pairs += r.twin_pairs;
+        total.twin_pairs_differing += r.twin_pairs_differing;
+        total.pool_twin_pairs += r.pool_twin_pairs;
+        total.pool_twin_pairs_differing += r.pool_twin_pairs_differing;
         for (t, n) in total.rejected_by.iter_mut().zip(&r.rejected_by) {
             *t += n;
         }
@@ -298,6 +398,11 @@ pub fn format_table(rows: &[FamilyBalance]) -> String {
         share(total.pool_catch, p),
         share(total.pool_dodge, p),
         share(total.pool_no_action, p)
+    );
+    let _ = writeln!(
+        s,
+        "adversarial twin pairs: {} in the evaluation subset, {} of them with different labels; {} in the pool, {} differing",
+        total.twin_pairs, total.twin_pairs_differing, total.pool_twin_pairs, total.pool_twin_pairs_differing
     );
     s
 }

@@ -233,6 +233,8 @@ struct RawConfig {
     aim: AimConfig,
     #[serde(default)]
     eval: crate::eval_subset::EvalConfig,
+    #[serde(default)]
+    probes: crate::twins::ProbeConfig,
 }
 
 /// The whole, validated build configuration (`Deserialize` reads back the copy a build
@@ -254,6 +256,14 @@ pub struct Config {
     /// label-blind, whole groups first).
     #[serde(default)]
     pub eval: crate::eval_subset::EvalConfig,
+    /// Adversarial probe pairs and their twins (absent in manifests of older builds: none).
+    #[serde(default)]
+    pub probes: crate::twins::ProbeConfig,
+    /// Set by the driver for the groups of an adversarial probe pair (`twins`): their
+    /// intent (`intent::Intent::for_object`) is this catalog object's, the pair's benign
+    /// member, whichever object they show. Not part of any file.
+    #[serde(skip)]
+    pub aimed_as: Option<String>,
     /// Where the configuration came from (for messages; not part of its content).
     #[serde(skip)]
     pub source: String,
@@ -290,6 +300,8 @@ impl Config {
             labels,
             aim: raw.aim,
             eval: raw.eval,
+            probes: raw.probes,
+            aimed_as: None,
             source: name.to_string(),
         };
         config.validate(name)?;

@@ -9,7 +9,8 @@ use crate::config::Config;
 use crate::families;
 use crate::label::{label, Labels};
 use crate::randomize::{randomize, RandomizeError, SceneKey};
-use crate::selection::replan_group;
+use crate::selection::{plan_group_with, replan_group};
+use crate::twins;
 use crate::validate::{validate, Verdicts, VALIDATOR_COLUMNS};
 use rh_catalog::Catalog;
 use rh_physics::simulate::{simulate, SimOptions, Simulation};
@@ -108,12 +109,10 @@ pub fn run_group(
     Ok((results, rejections))
 }
 
-/// Plans group `g` and produces its scenes ([`produce_group_counted`]). Selections
-/// planned from descriptions (`build --descriptions`): group g takes g mod D. Otherwise a
-/// group none of whose attempts passes every validator (a heavy pillow thrown at the
-/// chest that no walk escapes) is planned afresh ([`replan_group`]), up to
-/// `validators.replans` times, and the first plan whose bands all pass is kept (else the
-/// last, marked invalid). The one planning path of builds, `verify` and `balance`.
+/// Plans group `g` and produces its scenes: selections planned from descriptions
+/// (`build --descriptions`, group g takes g mod D) as given, else as the embedded planner
+/// deals the group ([`produce_planned_group`]). The one planning path of builds, `verify`
+/// and `balance`.
 pub fn plan_and_produce(
     catalog: &Catalog,
     families: &[String],
@@ -128,6 +127,110 @@ pub fn plan_and_produce(
         return produce_group_counted(selection, seed, g * 4, count, catalog, config)
             .map_err(|e| e.to_string());
     }
+    produce_planned_group(catalog, families, seed, g, count, config).map_err(|e| match e {
+        GroupError::Input(m) | GroupError::Render(m) => m,
+    })
+}
+
+/// Group `g` of a descriptionless build over `families`, as the embedded planner deals
+/// it: a group of an adversarial probe pair (`twins::slot`, `[probes]`) — the probe shows
+/// the disguised object, never as a near miss; its twin is the probe's final specs with
+/// only the object replaced by its look-alike (`twins::twin_spec`), simulated and
+/// labelled without resampling — else [`replanned_group`].
+pub fn produce_planned_group(
+    catalog: &Catalog,
+    families: &[String],
+    seed: u64,
+    g: u64,
+    count: u64,
+    config: &Config,
+) -> Result<(Vec<SceneResult>, Rejections), GroupError> {
+    let input = |e: &dyn std::fmt::Display| GroupError::Input(e.to_string());
+    let policy = crate::selection::PlanPolicy::of(config);
+    let Some(slot) = twins::slot(&config.probes, families, g) else {
+        return replanned_group(catalog, families, seed, g, count, config).map_err(|e| input(&e));
+    };
+    let (adversarial, genuine) = twins::objects(slot.pair, catalog).map_err(|e| input(&e))?;
+    let mut selection = plan_group_with(catalog, families, seed, slot.probe_group, &policy)
+        .map_err(|e| input(&e))?;
+    selection.object_id = adversarial.id.clone();
+    let mut probe_config = config.clone();
+    probe_config.build.far_observer_share = 0.0;
+    let heavy = config.labels.heavy_mass_kg;
+    let benign = if crate::selection::intrinsically_dangerous(adversarial, heavy) {
+        genuine
+    } else {
+        adversarial
+    };
+    probe_config.aimed_as = Some(benign.id.clone());
+    // A twin group rebuilds its probe group (deterministic) with all four bands.
+    let probe_count = if slot.role == twins::Role::Probe {
+        count
+    } else {
+        4
+    };
+    let (mut probe, rejections) = produce_group_counted(
+        &selection,
+        seed,
+        slot.probe_group * 4,
+        probe_count,
+        catalog,
+        &probe_config,
+    )
+    .map_err(|e| input(&e))?;
+    let mut twin = Vec::new();
+    for (band, r) in probe.iter_mut().enumerate() {
+        if !slot.pair.twin {
+            break;
+        }
+        let index = slot.twin_group * 4 + band as u64;
+        let spec = twins::twin_spec(&mut r.spec, genuine, index, slot.twin_group);
+        if slot.role == twins::Role::Twin && (band as u64) < count {
+            let spec = SceneSpec::from_json(&spec.to_json()).expect("a spec parses back");
+            let sim = simulate(&spec, SimOptions::default());
+            twin.push(label_scene(spec, sim, config));
+        }
+    }
+    if std::env::var_os("RH_TWIN_DEBUG").is_some() && slot.role == twins::Role::Twin {
+        for (p, t) in probe.iter().zip(&twin) {
+            eprintln!(
+                "twin {} {} {:?} {}/{} valid {}/{} {:?}",
+                p.spec.family,
+                p.spec.selection.object_id,
+                crate::intent::Intent::of(&p.spec),
+                p.labels.gt_action.as_str(),
+                t.labels.gt_action.as_str(),
+                p.verdicts.all(),
+                t.verdicts.all(),
+                t.verdicts.as_array()
+            );
+        }
+    }
+    if slot.role == twins::Role::Probe {
+        return Ok((probe, rejections));
+    }
+    let mut rejected = Rejections {
+        attempts: 1,
+        ..Rejections::default()
+    };
+    for (v, n) in rejected.rejected_by.iter_mut().enumerate() {
+        *n = u32::from(twin.iter().any(|r| !r.verdicts.as_array()[v]));
+    }
+    Ok((twin, rejected))
+}
+
+/// A group the planner deals (no probe pair): a group none of whose attempts passes
+/// every validator (a heavy pillow thrown at the chest that no walk escapes) is planned
+/// afresh ([`replan_group`]), up to `validators.replans` times, and the first plan whose
+/// bands all pass is kept (else the last, marked invalid).
+fn replanned_group(
+    catalog: &Catalog,
+    families: &[String],
+    seed: u64,
+    g: u64,
+    count: u64,
+    config: &Config,
+) -> Result<(Vec<SceneResult>, Rejections), String> {
     let policy = crate::selection::PlanPolicy::of(config);
     let mut total = Rejections::default();
     let mut replan = 0;

@@ -27,6 +27,11 @@ pub struct EvalConfig {
     /// At most this many NO_ACTION scenes per family (with `catch_share`).
     #[serde(default)]
     pub no_action_per_family: usize,
+    /// Adversarial twin pairs (`twins`) taken first, whole, per family (with
+    /// `catch_share`): both scenes valid, in the probe's scene-index order. Their labels
+    /// count toward the family's CATCH and NO_ACTION targets.
+    #[serde(default)]
+    pub twin_pairs_per_family: usize,
 }
 
 impl Default for EvalConfig {
@@ -36,6 +41,7 @@ impl Default for EvalConfig {
             per_family: 18,
             catch_share: None,
             no_action_per_family: 0,
+            twin_pairs_per_family: 0,
         }
     }
 }
@@ -48,6 +54,8 @@ pub struct EvalRow<'a> {
     pub valid: bool,
     /// `gt_action` as written in the dataset ("CATCH", "DODGE", "NO_ACTION").
     pub action: &'a str,
+    /// The scene index of its adversarial twin (`twin_scene_id`), if in a probe pair.
+    pub twin: Option<u64>,
 }
 
 /// The chosen rows (indices into `rows`, in scene-index order) and how many scenes
@@ -74,28 +82,56 @@ pub fn select(rows: &[EvalRow], cfg: &EvalConfig) -> (Vec<usize>, BTreeMap<Strin
     (chosen, counts)
 }
 
-/// Per kind, the first scenes in index order: CATCH up to its target, NO_ACTION up to
-/// its cap, DODGE for the rest; then whatever is left of CATCH and DODGE, in that
-/// order, until `per_family`.
+/// Up to `twin_pairs_per_family` probe pairs whose scenes are both valid members, in the
+/// probe's (the lower index's) order, as long as their NO_ACTION scenes stay within
+/// `no_action_per_family`; then per kind, the first remaining scenes in index
+/// order: CATCH up to its target, NO_ACTION up to its cap (both less what the pairs
+/// gave), DODGE for the rest; then whatever is left of CATCH and DODGE, in that order,
+/// until `per_family`.
 fn stratified(rows: &[EvalRow], members: &[usize], cfg: &EvalConfig, share: f64) -> Vec<usize> {
     let n = cfg.per_family;
+    let by_index: BTreeMap<u64, usize> =
+        members.iter().map(|&r| (rows[r].scene_index, r)).collect();
+    let mut taken: Vec<usize> = Vec::new();
+    for &r in members {
+        if taken.len() + 2 > n.min(2 * cfg.twin_pairs_per_family) {
+            break;
+        }
+        let twin = rows[r].twin.filter(|&t| t > rows[r].scene_index);
+        if let Some(&q) = twin.and_then(|t| by_index.get(&t)) {
+            // Within the family's NO_ACTION cap, like every other scene.
+            let none = [r, q]
+                .iter()
+                .chain(&taken)
+                .filter(|&&x| rows[x].action == "NO_ACTION")
+                .count();
+            if none <= cfg.no_action_per_family {
+                taken.extend([r, q]);
+            }
+        }
+    }
+    let count = |action: &str| taken.iter().filter(|&&r| rows[r].action == action).count();
+    let (pair_catch, pair_none) = (count("CATCH"), count("NO_ACTION"));
+    let left = n - taken.len();
     let of = |action: &str| -> Vec<usize> {
         members
             .iter()
             .copied()
-            .filter(|&r| rows[r].action == action)
+            .filter(|&r| rows[r].action == action && !taken.contains(&r))
             .collect()
     };
     let (catch, dodge, none) = (of("CATCH"), of("DODGE"), of("NO_ACTION"));
-    let c = ((n as f64 * share).round() as usize).min(catch.len());
-    let na = cfg.no_action_per_family.min(none.len()).min(n - c);
-    let d = (n - c - na).min(dodge.len());
-    let mut taken: Vec<usize> = catch[..c]
-        .iter()
-        .chain(&dodge[..d])
-        .chain(&none[..na])
-        .copied()
-        .collect();
+    let c = ((n as f64 * share).round() as usize)
+        .saturating_sub(pair_catch)
+        .min(catch.len())
+        .min(left);
+    let na = cfg
+        .no_action_per_family
+        .saturating_sub(pair_none)
+        .min(none.len())
+        .min(left - c);
+    let d = (left - c - na).min(dodge.len());
+    taken.extend(catch[..c].iter().chain(&dodge[..d]).chain(&none[..na]));
     for (kind, from) in [(&catch, c), (&dodge, d)] {
         for &r in &kind[from..] {
             if taken.len() >= n {
@@ -141,6 +177,7 @@ mod tests {
             scene_index: i,
             valid: true,
             action,
+            twin: None,
         }
     }
 
@@ -150,6 +187,7 @@ mod tests {
             per_family: 10,
             catch_share: Some(0.5),
             no_action_per_family: 1,
+            twin_pairs_per_family: 0,
         };
         // Family a: 3 CATCH, 12 DODGE, 4 NO_ACTION: CATCH short, DODGE fills.
         // Family c: 1 CATCH, 1 DODGE, 5 NO_ACTION: short, one NO_ACTION only.
@@ -197,6 +235,45 @@ mod tests {
         assert!(chosen
             .windows(2)
             .all(|w| rows[w[0]].scene_index < rows[w[1]].scene_index));
+    }
+
+    #[test]
+    fn twin_pairs_come_first_whole_and_within_the_no_action_cap() {
+        let cfg = EvalConfig {
+            per_family: 6,
+            catch_share: Some(0.5),
+            no_action_per_family: 1,
+            twin_pairs_per_family: 2,
+        };
+        let paired = |i: u64, twin: u64, action| EvalRow {
+            twin: Some(twin),
+            ..row("a", i, action)
+        };
+        let rows = vec![
+            // Pair 0–4: NO_ACTION / NO_ACTION exceeds the cap of one: left out.
+            paired(0, 4, "NO_ACTION"),
+            paired(4, 0, "NO_ACTION"),
+            // Pair 1–5: CATCH / DODGE, taken.
+            paired(1, 5, "CATCH"),
+            paired(5, 1, "DODGE"),
+            // Pair 2–6: CATCH / NO_ACTION, taken (the one NO_ACTION).
+            paired(2, 6, "CATCH"),
+            paired(6, 2, "NO_ACTION"),
+            // Pair 3–7: the twin is invalid: not a pair.
+            paired(3, 7, "CATCH"),
+            EvalRow {
+                valid: false,
+                ..paired(7, 3, "DODGE")
+            },
+            row("a", 8, "CATCH"),
+            row("a", 9, "DODGE"),
+            row("a", 10, "DODGE"),
+        ];
+        let (chosen, _) = select(&rows, &cfg);
+        let indices: Vec<u64> = chosen.iter().map(|&r| rows[r].scene_index).collect();
+        // Pairs 1–5 and 2–6; CATCH target 3 less the pairs' 2: one more (3); DODGE for
+        // the rest (9); no further NO_ACTION (the pair used the cap).
+        assert_eq!(indices, vec![1, 2, 3, 5, 6, 9]);
     }
 
     #[test]

@@ -93,6 +93,12 @@ pub fn randomize(
     // (which never fail the reaction-time validator).
     let far_observer =
         seeds::stream(seed, 0, "observer").random_bool(config.build.far_observer_share);
+    // An adversarial probe pair's groups are aimed as its benign member would be (`twins`).
+    let aimed_as = config
+        .aimed_as
+        .as_deref()
+        .and_then(|id| catalog.object(id))
+        .unwrap_or(object);
     let input = FamilyInput {
         object,
         room,
@@ -100,7 +106,7 @@ pub fn randomize(
         band_speeds: *bands,
         far_observer,
         observer_height: config.observer.height,
-        intent: Intent::for_object(object, far_observer, &config.labels),
+        intent: Intent::for_object(aimed_as, far_observer, &config.labels),
     };
     let layout = family.sample(&input, &mut seeds::stream(seed, key.attempt, "placement"));
 

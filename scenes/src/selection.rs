@@ -91,7 +91,7 @@ pub fn plan_group(
     plan_group_with(catalog, families, build_seed, group, policy)
 }
 
-/// [`plan_group`] under a build configuration's policy (`Config::plan_policy`).
+/// [`plan_group`] under a build configuration's policy (`PlanPolicy::of`).
 pub fn plan_group_with(
     catalog: &Catalog,
     families: &[String],

@@ -157,6 +157,7 @@ pub(crate) mod tests {
             object_id: "ball".into(),
             looks_like: None,
             adversarial: false,
+            twin_scene_id: None,
             gt_action: Action::Catch,
             dangerous: false,
             danger_present: true,

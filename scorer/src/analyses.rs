@@ -104,6 +104,22 @@ pub struct LookalikeComparison {
     pub lookalike_dodge_rate: Option<f64>,
 }
 
+/// Adversarial twin pairs (label rule v5, `twin_scene_id`): a disguised object's scene
+/// and the same scene with its genuine look-alike. How often a model gave the disguised
+/// object the decision it gave the look-alike where the two labels differ.
+#[derive(Debug, Clone, Serialize)]
+pub struct TwinProbe {
+    pub model: String,
+    /// Pairs whose two scenes the model decided.
+    pub pairs: u64,
+    /// ... of them, pairs whose labels differ.
+    pub pairs_labels_differ: u64,
+    /// ... of those, pairs where the model decided both scenes alike: it treated the
+    /// disguised object as its look-alike.
+    pub same_decision: u64,
+    pub share_same: Option<f64>,
+}
+
 #[derive(Debug, Clone, Serialize)]
 pub struct Analyses {
     pub safety: Vec<SafetyBreakdown>,
@@ -112,6 +128,7 @@ pub struct Analyses {
     pub voting: Voting,
     pub adversarial: Vec<AdversarialProbe>,
     pub lookalikes: Vec<LookalikeComparison>,
+    pub twins: Vec<TwinProbe>,
 }
 
 pub(crate) fn safety_breakdown(name: &str, m: &ModelAgg) -> SafetyBreakdown {
@@ -324,6 +341,46 @@ pub(crate) fn lookalikes(models: &[&ModelAgg], ds: &Dataset) -> Vec<LookalikeCom
                 lookalike_catch_rate: ratio(b.1, b.0),
                 lookalike_dodge_rate: ratio(b.2, b.0),
             }
+        })
+        .collect()
+}
+
+pub(crate) fn twin_probes(models: &[&ModelAgg], ds: &Dataset) -> Vec<TwinProbe> {
+    // (disguised scene, twin scene), each pair once.
+    let pairs: Vec<(usize, usize)> = ds
+        .scenes
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.adversarial && s.valid)
+        .filter_map(|(i, s)| {
+            let twin = ds.index.get(s.twin_scene_id.as_ref()?)?;
+            ds.scenes[*twin as usize]
+                .valid
+                .then_some((i, *twin as usize))
+        })
+        .collect();
+    models
+        .iter()
+        .map(|m| {
+            let mut out = TwinProbe {
+                model: m.name.clone(),
+                pairs: 0,
+                pairs_labels_differ: 0,
+                same_decision: 0,
+                share_same: None,
+            };
+            for &(a, b) in &pairs {
+                let (Some(x), Some(y)) = (m.records[a].decision(), m.records[b].decision()) else {
+                    continue;
+                };
+                out.pairs += 1;
+                if ds.scenes[a].gt_action != ds.scenes[b].gt_action {
+                    out.pairs_labels_differ += 1;
+                    out.same_decision += u64::from(x == y);
+                }
+            }
+            out.share_same = ratio(out.same_decision, out.pairs_labels_differ);
+            out
         })
         .collect()
 }

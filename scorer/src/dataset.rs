@@ -30,6 +30,9 @@ pub struct Scene {
     pub object_id: String,
     pub looks_like: Option<String>,
     pub adversarial: bool,
+    /// The scene that is this one with only the object replaced by its look-alike
+    /// (`twin_scene_id`, label rule v5); `None` outside adversarial twin pairs.
+    pub twin_scene_id: Option<String>,
     pub gt_action: Action,
     pub dangerous: bool,
     pub danger_present: bool,
@@ -103,6 +106,7 @@ impl Dataset {
             object_id: s.object_id,
             looks_like: s.looks_like,
             adversarial: s.adversarial,
+            twin_scene_id: s.twin_scene_id,
             gt_action: s.gt_action,
             dangerous: s.dangerous,
             danger_present: s.danger_present,
@@ -186,6 +190,9 @@ pub struct SceneInput {
     pub object_id: String,
     pub looks_like: Option<String>,
     pub adversarial: bool,
+    /// The scene that is this one with only the object replaced by its look-alike
+    /// (`twin_scene_id`, label rule v5); `None` outside adversarial twin pairs.
+    pub twin_scene_id: Option<String>,
     pub gt_action: Action,
     pub dangerous: bool,
     pub danger_present: bool,
@@ -238,6 +245,11 @@ pub fn scenes_of_batch(batch: &RecordBatch, file: &Path) -> Result<Vec<SceneInpu
     let object_id = required_strings(batch, file, col::OBJECT_ID)?;
     let looks_like = strings(batch, file, col::LOOKS_LIKE)?;
     let adversarial = bools(batch, file, col::ADVERSARIAL)?;
+    // Builds before label rule v5's twins have no such column.
+    let twin_scene_id = match batch.column_by_name(col::TWIN_SCENE_ID) {
+        Some(_) => strings(batch, file, col::TWIN_SCENE_ID)?,
+        None => vec![None; batch.num_rows()],
+    };
     let gt_action = required_strings(batch, file, col::GT_ACTION)?;
     let dangerous = bools(batch, file, col::DANGEROUS)?;
     let danger_present = bools(batch, file, col::DANGER_PRESENT)?;
@@ -295,6 +307,7 @@ pub fn scenes_of_batch(batch: &RecordBatch, file: &Path) -> Result<Vec<SceneInpu
             object_id: object_id[i].clone(),
             looks_like: looks_like[i].clone(),
             adversarial: adversarial[i],
+            twin_scene_id: twin_scene_id[i].clone(),
             gt_action: gt,
             dangerous: dangerous[i],
             danger_present: danger_present[i],

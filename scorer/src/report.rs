@@ -2,7 +2,8 @@
 
 use crate::aggregate::{Acc, ModelAgg, Rec};
 use crate::analyses::{
-    lookalikes, out_of_reach, ratio, safety_breakdown, speed_analysis, speed_groups, voting,
+    lookalikes, out_of_reach, ratio, safety_breakdown, speed_analysis, speed_groups, twin_probes,
+    voting,
 };
 use crate::config::Config;
 use crate::dataset::{Dataset, SPEED_BANDS};
@@ -13,7 +14,7 @@ use std::collections::BTreeMap;
 
 pub use crate::analyses::{
     AdversarialProbe, Analyses, LookalikeComparison, OutOfReach, SafetyBreakdown, SpeedAnalysis,
-    Voting,
+    TwinProbe, Voting,
 };
 pub use crate::metrics_row::{ActionCounts, ClassRecall, Interval, MetricsRow, RuleCounts};
 
@@ -311,6 +312,7 @@ impl Report {
                 })
                 .collect(),
             lookalikes: lookalikes(&owned, ds),
+            twins: twin_probes(&owned, ds),
         };
         if owned.len() > 1 {
             analyses.safety.push(safety_breakdown("ALL", &pooled));

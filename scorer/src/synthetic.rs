@@ -183,6 +183,7 @@ pub fn synth_rows(n: usize, seed: u64) -> Vec<FixtureRow> {
                     object_id: obj.0.to_string(),
                     looks_like: obj.3.map(str::to_string),
                     adversarial: obj.3.is_some(),
+                    twin_scene_id: None,
                     gt_action: gt,
                     dangerous: obj.4,
                     danger_present,

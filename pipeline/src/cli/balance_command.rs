@@ -38,7 +38,7 @@ pub fn run(
             })?;
     if json {
         print_json(&rh_scenes::balance::Balance::of(
-            seed, pool, per_family, rows,
+            catalog, seed, pool, per_family, rows,
         ));
     } else {
         print!("{}", rh_scenes::balance::format_table(&rows));
