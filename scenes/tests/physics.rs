@@ -28,8 +28,10 @@ fn scenes(family: &str, groups: u64, seed: u64) -> Vec<SceneResult> {
         })
         .collect();
     for r in &results {
+        // A scene of an adversarial probe pair (label rule v5) is labelled without
+        // resampling; every other scene passes every validator.
         assert!(
-            r.verdicts.all(),
+            r.verdicts.all() || r.spec.family_params.contains_key("twin_scene_index"),
             "{} invalid: {:?}",
             r.spec.scene_id,
             r.verdicts.failures()
@@ -118,13 +120,14 @@ fn object_drop_falls_ballistically_once_clear_of_the_table() {
             continue;
         }
         // The centre of mass follows z(t) = z_r + v_r t − g t²/2 in flight.
-        let z_r = sim.hazard_position(release)[2];
+        // (The centre of mass, not the body origin: a spinning body's origin circles it.)
+        let z_r = sim.hazard_com(release)[2];
         let v_r = sim.hazard_velocity(release)[2];
-        let drop = z_r - sim.hazard_position(floor - 1)[2];
+        let drop = z_r - sim.hazard_com(floor - 1)[2];
         for k in release..floor {
             let t = (k - release) as f64 * sim.dt;
             let expected = z_r + v_r * t - 0.5 * G * t * t;
-            let z = sim.hazard_position(k)[2];
+            let z = sim.hazard_com(k)[2];
             assert!(
                 (z - expected).abs() < 0.01 * drop.max(0.05),
                 "{}: step {k} z {z:.4} vs {expected:.4}",

@@ -36,8 +36,9 @@ fn a_default_340_scene_build_is_all_valid_and_bands_share_their_cameras() {
         let first = &results[0].spec;
         assert_eq!(first.cameras.len(), 3, "{}", first.scene_id);
         for r in &results {
+            // But a scene of an adversarial probe pair, labelled without resampling.
             assert!(
-                r.verdicts.all(),
+                r.verdicts.all() || r.spec.family_params.contains_key("twin_scene_index"),
                 "{} ({}) fails {:?}",
                 r.spec.scene_id,
                 r.spec.family,

@@ -1,5 +1,5 @@
 //! `rh-score --execute --execute-videos DIR` end to end (issue 14, item 4) and the
-//! outcome figure (item 3): on a label-only build of one throw group, two baselines'
+//! outcome figure (item 3): on a label-only build of one furniture_tip group (a wardrobe tipping: large enough to see moving at the small test size; label rule v5 deals a thrown_object build its steel-apple probe first), two baselines'
 //! executions are drawn at a small size — each decision's outside and ego MP4 (H.264, the
 //! configured size, the dataset's rate, one frame per video time step from t = 0 to the
 //! last executed step), the tiled video two tiles wide, `index.json` — and outcomes and
@@ -152,7 +152,7 @@ fn execution_videos_outside_ego_tiled_and_the_outcome_figure() {
             "--seed",
             "14",
             "--families",
-            "thrown_object",
+            "furniture_tip",
             "--no-render",
             "--quiet",
             "--out",
@@ -254,7 +254,7 @@ fn execution_videos_outside_ego_tiled_and_the_outcome_figure() {
             );
             // A drawn scene, not a blank frame, and a moving one: the middle frame has
             // light and dark parts (a lit room), and differs from the first or the last
-            // frame where something (the thrown object, the humanoid) moved. No count of
+            // frame where something (the tipping furniture, the humanoid) moved. No count of
             // distinct colours: a plain room corner honestly has few (19 under Debian's
             // Mesa 22.3 on an AVX-512 CPU), and that count depends on the adapter.
             let mid = rgb(&vids.join(rel), Some(want / 2));
