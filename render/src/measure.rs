@@ -83,30 +83,26 @@ impl Renderer {
             let dynamic = scene.dynamic_at(sim, steps[k as usize], false);
             let dyn_range = self.gpu.set_dynamic(&dynamic)?;
             let dyn_ids = scene.dynamic_ids(&dyn_range);
-            let views: Vec<IdView> = cams
-                .iter()
-                .enumerate()
-                .map(|(slot, cam)| {
-                    let mut ranges = scene.id_ranges_for(cam);
-                    ranges.extend(dyn_ids.iter().cloned());
-                    let alone = ranges
-                        .iter()
-                        .filter(|(_, id)| *id == hazard)
-                        .map(|(r, _)| r.clone())
-                        .collect();
-                    IdView {
-                        slot,
-                        width: cam.width,
-                        height: cam.height,
-                        view_proj: view_proj(cam),
-                        cam_pos: cam.position.map(|c| c as f32),
-                        ranges,
-                        alone,
-                    }
-                })
-                .collect();
-            let images = self.gpu.draw_ids(pass, &views)?;
-            for (ci, (img, cam)) in images.into_iter().zip(cams).enumerate() {
+            // One camera at a time through one target (per worker, a 720p id target
+            // and its read-backs are about 13 MB).
+            for (ci, cam) in cams.iter().enumerate() {
+                let mut ranges = scene.id_ranges_for(cam);
+                ranges.extend(dyn_ids.iter().cloned());
+                let alone = ranges
+                    .iter()
+                    .filter(|(_, id)| *id == hazard)
+                    .map(|(r, _)| r.clone())
+                    .collect();
+                let view = IdView {
+                    slot: 0,
+                    width: cam.width,
+                    height: cam.height,
+                    view_proj: view_proj(cam),
+                    cam_pos: cam.position.map(|c| c as f32),
+                    ranges,
+                    alone,
+                };
+                let img = self.gpu.draw_ids(pass, &[view])?.remove(0);
                 let visible = img.ids.iter().filter(|&&id| id == hazard).count() as u32;
                 counts[ci].push((visible, img.covered));
                 if let Some(root) = masks_root {

@@ -95,31 +95,8 @@ impl Renderer {
         // the observation videos the plain run (`scene::full_event_simulation`).
         let counterfactual = full_event_simulation(spec, sim);
         let full_sim = counterfactual.as_ref().unwrap_or(sim);
-        // The cameras stand still within a scene: the room, furniture and observer are
-        // drawn once per view and every frame starts from that image.
         let full_cam =
             full_event_camera(spec, full_sim, self.opts.full_width, self.opts.full_height);
-        let mut all_cams = cams.clone();
-        all_cams.push(&full_cam);
-        let static_views: Vec<ViewJob> = all_cams
-            .iter()
-            .enumerate()
-            .map(|(slot, cam)| scene.view_job(slot, cam, Shading::Lit, scene.ranges_for(cam), 0..0))
-            .collect();
-        self.gpu
-            .cache_static(scene.light_vp, &scene.static_casters(), &static_views)?;
-        // What each view needs per frame that does not change within the scene.
-        let mut fixed_views: Vec<FixedView> = all_cams
-            .iter()
-            .enumerate()
-            .map(|(slot, cam)| scene.fixed_view(slot, cam))
-            .collect();
-        for v in &mut fixed_views {
-            if let Some(depth) = self.gpu.cached_depth(v.slot)? {
-                v.set_surface(&depth);
-            }
-        }
-        let (window_views, full_view) = fixed_views.split_at(cams.len());
         // The id pass at the observation frames: measured visibility, and the mask and
         // depth PNGs (written on their own thread while the frames below render).
         let masks_root = self.opts.masks.then_some(out_dir);
@@ -133,37 +110,41 @@ impl Renderer {
             .iter()
             .map(|&t| (((t * fps as f64).round() as u32).min(frames), t))
             .collect();
-
-        let (videos, jobs) = self.spawn_videos(&cams, id, fps, out_dir);
+        let mut videos = BTreeMap::new();
         let mut frame_files = vec![String::new(); cams.len() * FRAME_TIMES.len()];
         let (png_tx, png_thread) = png_writer();
+        let mut errors = Vec::new();
 
         let debug = std::env::var_os("RH_RENDER_DEBUG").is_some();
         let t_start = std::time::Instant::now();
         let mut t_draw = 0.0;
-        let mut result = Ok(());
-        for (k, &step) in frame_steps.iter().enumerate() {
-            let t = std::time::Instant::now();
-            let images = self.draw_overlay_step(&scene, sim, step, window_views)?;
-            t_draw += t.elapsed().as_secs_f64();
-            for (ci, (img, job)) in images.into_iter().zip(&jobs).enumerate() {
+        // One video at a time (memory: a 720p libx264 encoder holds about 50 MB, and a
+        // view's targets about 27 MB): each camera's static image is cached in the same
+        // target slot, its frames drawn and encoded, and its encoder finished before the
+        // next camera starts. The pixels are those of drawing all cameras per frame.
+        for (ci, cam) in cams.iter().enumerate() {
+            let view = self.cache_view(&scene, 0, cam)?;
+            let rel = video_path(&cam.name, id);
+            let job = self.spawn_video(out_dir.join(&rel), cam.width, cam.height, fps);
+            for (k, &step) in frame_steps.iter().enumerate() {
+                let t = std::time::Instant::now();
+                let img = self.draw_view_step(&scene, sim, step, &view)?;
+                t_draw += t.elapsed().as_secs_f64();
                 for (ti, &(pk, t)) in png_frames.iter().enumerate() {
                     if pk as usize == k {
-                        let rel = frame_path(id, &cams[ci].name, t);
-                        let _ = png_tx.send((
-                            out_dir.join(&rel),
-                            cams[ci].width,
-                            cams[ci].height,
-                            img.clone(),
-                        ));
+                        let rel = frame_path(id, &cam.name, t);
+                        let _ =
+                            png_tx.send((out_dir.join(&rel), cam.width, cam.height, img.clone()));
                         frame_files[ci * FRAME_TIMES.len() + ti] = rel;
                     }
                 }
                 if !job.send(img) {
-                    result = Err(());
+                    break;
                 }
             }
-            if result.is_err() {
+            finish_video(job, &cam.name, frame_steps.len(), &mut errors);
+            videos.insert(cam.name.clone(), rel);
+            if !errors.is_empty() {
                 break;
             }
         }
@@ -172,21 +153,21 @@ impl Renderer {
         let full_fps = self.opts.full_fps.max(1);
         let full_event_steps = full_event_steps(full_sim, full_fps);
         let full_rel = video_path(FULL_EVENT, id);
-        let full_job = VideoJob::spawn(
-            out_dir.join(&full_rel),
-            full_cam.width,
-            full_cam.height,
-            full_fps,
-            self.opts.encode.clone(),
-            self.gpu.frames.clone(),
-        );
-        if result.is_ok() {
+        if errors.is_empty() {
+            let view = self.cache_view(&scene, 1, &full_cam)?;
+            let full_job = self.spawn_video(
+                out_dir.join(&full_rel),
+                full_cam.width,
+                full_cam.height,
+                full_fps,
+            );
             for &step in &full_event_steps {
-                let mut images = self.draw_overlay_step(&scene, full_sim, step, full_view)?;
-                if !full_job.send(images.pop().unwrap()) {
+                let img = self.draw_view_step(&scene, full_sim, step, &view)?;
+                if !full_job.send(img) {
                     break;
                 }
             }
+            finish_video(full_job, "full", full_event_steps.len(), &mut errors);
         }
         drop(png_tx);
         if debug {
@@ -198,11 +179,6 @@ impl Renderer {
                 t_start.elapsed().as_secs_f64()
             );
         }
-        let mut errors = Vec::new();
-        for (job, cam) in jobs.into_iter().zip(&cams) {
-            finish_video(job, &cam.name, frame_steps.len(), &mut errors);
-        }
-        finish_video(full_job, "full", full_event_steps.len(), &mut errors);
         for thread in [png_thread, mask_thread] {
             match thread.join() {
                 Ok(Ok(())) => {}
@@ -228,29 +204,37 @@ impl Renderer {
         })
     }
 
-    /// Starts one encoder per observation camera: `videos/<cam>/<scene_id>.mp4`.
-    fn spawn_videos(
-        &self,
-        cams: &[&CameraSpec],
-        id: &str,
-        fps: u32,
-        out_dir: &Path,
-    ) -> (BTreeMap<String, String>, Vec<VideoJob>) {
-        let mut videos = BTreeMap::new();
-        let mut jobs = Vec::new();
-        for cam in cams {
-            let rel = video_path(&cam.name, id);
-            jobs.push(VideoJob::spawn(
-                out_dir.join(&rel),
-                cam.width,
-                cam.height,
-                fps,
-                self.opts.encode.clone(),
-                self.gpu.frames.clone(),
-            ));
-            videos.insert(cam.name.clone(), rel);
+    /// Starts an encoder for one video (`out`, an absolute path).
+    fn spawn_video(&self, out: PathBuf, width: u32, height: u32, fps: u32) -> VideoJob {
+        VideoJob::spawn(
+            out,
+            width,
+            height,
+            fps,
+            self.opts.encode.clone(),
+            self.gpu.frames.clone(),
+        )
+    }
+
+    /// Draws `cam`'s static scene into target `slot` and keeps it as the view's cached
+    /// image (see `Gpu::cache_static`); returns what its frames need per step.
+    fn cache_view<'a>(
+        &mut self,
+        scene: &SceneGeometry,
+        slot: usize,
+        cam: &'a CameraSpec,
+    ) -> Result<FixedView<'a>, RenderError> {
+        let job = scene.view_job(slot, cam, Shading::Lit, scene.ranges_for(cam), 0..0);
+        self.gpu.cache_static(
+            scene.light_vp,
+            &scene.static_casters(),
+            std::slice::from_ref(&job),
+        )?;
+        let mut view = scene.fixed_view(slot, cam);
+        if let Some(depth) = self.gpu.cached_depth(slot)? {
+            view.set_surface(&depth);
         }
-        (videos, jobs)
+        Ok(view)
     }
 
     /// Renders the given cameras at one physics step (RGBA8 sRGB images, no files).
@@ -325,37 +309,34 @@ impl Renderer {
         self.gpu.draw(scene.light_vp, &casters, &views)
     }
 
-    /// The same pixels as `draw_step` with `Shading::Lit`, drawn over the views cached
-    /// in `render_scene`: only the moving bodies and the static surfaces their shadows
-    /// can reach are drawn.
-    fn draw_overlay_step(
+    /// The same pixels as `draw_step` with `Shading::Lit`, drawn over the view cached
+    /// by `cache_view`: only the moving bodies and the static surfaces their shadows can
+    /// reach are drawn.
+    fn draw_view_step(
         &mut self,
         scene: &SceneGeometry,
         sim: &Simulation,
         step: u32,
-        views: &[FixedView],
-    ) -> Result<Vec<Vec<u8>>, RenderError> {
+        view: &FixedView,
+    ) -> Result<Vec<u8>, RenderError> {
         let dynamic = scene.dynamic_at(sim, step, false);
         let dyn_range = self.gpu.set_dynamic(&dynamic)?;
         let moving = bounds(&dynamic);
-        let jobs: Vec<OverlayJob> = views
-            .iter()
-            .map(|v| {
-                let redraw = moving
-                    .map(|m| scene.shadow_redraws(v, m))
-                    .unwrap_or_default();
-                let changed = moving.and_then(|m| scene.changed_rect(v, m, &redraw));
-                OverlayJob {
-                    slot: v.slot,
-                    uniforms: v.uniforms,
-                    redraw,
-                    dynamic: dyn_range.clone(),
-                    changed,
-                }
-            })
-            .collect();
-        self.gpu
-            .draw_overlay(scene.light_vp, std::slice::from_ref(&dyn_range), &jobs)
+        let redraw = moving
+            .map(|m| scene.shadow_redraws(view, m))
+            .unwrap_or_default();
+        let changed = moving.and_then(|m| scene.changed_rect(view, m, &redraw));
+        let job = OverlayJob {
+            slot: view.slot,
+            uniforms: view.uniforms,
+            redraw,
+            dynamic: dyn_range.clone(),
+            changed,
+        };
+        let mut images =
+            self.gpu
+                .draw_overlay(scene.light_vp, std::slice::from_ref(&dyn_range), &[job])?;
+        Ok(images.remove(0))
     }
 }
 

@@ -99,6 +99,9 @@ fn open_device(
         label: Some("rh-render"),
         required_features: wgpu::Features::empty(),
         required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+        // Small memory blocks (wgpu's default reserves 64-256 MB blocks, whose pages its
+        // staging buffers touch one after another: on a CPU adapter all of it resident).
+        memory_hints: wgpu::MemoryHints::MemoryUsage,
         ..Default::default()
     }))
     .map_err(|e| RenderError::NoAdapter(format!("request device on {adapter_name}: {e}")))?;
