@@ -62,6 +62,10 @@ pub struct AimConfig {
     /// The hazard counts as meeting the body when its centre comes within the torso
     /// radius + its bounding radius + this (m) of the torso axis.
     pub touch_slack: f64,
+    /// Before the earliest meeting step the hazard's centre stays farther than this (m)
+    /// from the torso axis (the in-frame check's `frame_check_until_within`).
+    #[serde(default)]
+    pub clear_before: f64,
 }
 
 /// What the aim decided, recorded in the spec's `family_params` (`aim_*`).
@@ -343,6 +347,12 @@ pub fn meets(spec: &SceneSpec, sim: &Simulation, cfg: &AimConfig, intent: Intent
     // no touch of the body, before the earliest step.
     let reached = approach(spec, sim, 0, spec.labels.reach_radius).map(|(k, _)| k);
     if reached.is_some_and(|k| k < from) {
+        return false;
+    }
+    // Nor does its centre come within `clear_before` of the torso axis before then (a
+    // pendulum hanging beside the head at t0 that swings away and back: it has reached
+    // the observer before any decision).
+    if (0..from).any(|k| distance(k) <= cfg.clear_before) {
         return false;
     }
     let closest = (from..=sim.steps())

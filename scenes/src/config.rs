@@ -453,6 +453,7 @@ impl Config {
             ("aim.body_lateral", a.body_lateral),
             ("aim.wall_margin", a.wall_margin),
             ("aim.touch_slack", a.touch_slack),
+            ("aim.clear_before", a.clear_before),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(fail(

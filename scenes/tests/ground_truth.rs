@@ -9,9 +9,7 @@ use rh_physics::simulate::{observer_penetration, simulate, SimOptions};
 use rh_physics::spec::{SceneSpec, Selection};
 use rh_physics::strike::{HarmRule, Region, RegionLimit};
 use rh_scenes::config::Config;
-use rh_scenes::driver::{
-    counterfactual_options, plan_and_produce, produce_group_counted, run_scene,
-};
+use rh_scenes::driver::{counterfactual_options, plan_and_produce, run_scene};
 use rh_scenes::families;
 use rh_scenes::label::{self, ImpactKind};
 use rh_scenes::randomize::{randomize, SceneKey};

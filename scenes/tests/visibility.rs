@@ -6,7 +6,6 @@
 use rh_catalog::Catalog;
 use rh_scenes::config::Config;
 use rh_scenes::driver::plan_and_produce;
-use rh_scenes::selection::plan_group;
 use rh_scenes::validate::VALIDATOR_COLUMNS;
 use rh_scenes::visibility;
 use std::collections::BTreeMap;
