@@ -69,8 +69,8 @@ def executed(work, ds68, oracle_preds) -> dict:
 
 @pytest.fixture(scope="session")
 def rendered(work) -> str:
-    """A small rendered build (frames/ for the canonical prompt): 24 scenes, all in its
-    eval subset, for the inspect task's `--limit 20` (about 250 CPU-seconds to render)."""
+    """A small rendered build (frames/ for the canonical prompt): 24 scenes, 19 of them in
+    its eval subset (label rule v5), for the inspect task's `--limit` (16) (about 250 CPU-seconds to render)."""
     out = work / "rendered"
     run("rh-pipeline", "build", "--n", "24", "--seed", "5", "--quiet", "--out", str(out))
     return str(out)

@@ -28,7 +28,7 @@ from inspect_ai.model import ModelOutput, ModelUsage, get_model  # noqa: E402
 # inspect's CLI takes the task file relative to its working directory (the checkout).
 TASK = "integrations/inspect_ai/reacthuman_task.py"
 OFFLINE = Path(__file__).resolve().parent / "inspect_offline.py"
-LIMIT = 20
+LIMIT = 16
 METRICS = {
     "saa": lambda m: m["overall"]["saa"],
     "safety": lambda m: m["overall"]["safety"],
@@ -80,7 +80,7 @@ class FakeOpenAI:
 
 
 def predict_via(ds: str, out: Path, answer) -> tuple[list[dict], dict]:
-    """`rh-score predict --limit 20` against the fake server: its lines and the messages
+    """`rh-score predict --limit LIMIT` against the fake server: its lines and the messages
     the server received."""
     fake = FakeOpenAI(answer)
     with fake as url:
@@ -113,13 +113,13 @@ def assert_metrics_equal(log, report: dict):
 
 @pytest.fixture(scope="session")
 def answers(rendered) -> dict:
-    """Plans for the first 20 eval scenes, by prompt hash: the oracle's (right), the
+    """Plans for the first LIMIT eval scenes, by prompt hash: the oracle's (right), the
     freeze baseline's and always-catch's (often wrong), and text with no plan (R1)."""
     import reacthuman as rh
 
     ds = rh.Dataset(rendered)
     ids = ds.predict_scenes("eval", LIMIT)
-    assert len(ids) == LIMIT, "the rendered fixture needs 20 valid eval scenes"
+    assert len(ids) == LIMIT, f"the rendered fixture needs {LIMIT} valid eval scenes"
     plans = {}
     for b in ("oracle", "freeze", "always-catch"):
         text = run("rh-score", "baseline", b, "--dataset", rendered)
