@@ -309,17 +309,8 @@ impl Config {
     }
 
     fn validate(&self, name: &str) -> Result<(), ConfigError> {
-        let fail = |field: &str, message: String| ConfigError {
-            location: format!("{name}: field '{field}'"),
-            message,
-        };
-        let positive = |field: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(fail(field, format!("must be a positive number (got {v})")))
-            }
-        };
+        let fail = |field: &str, message: String| field_error(name, field, message);
+        let positive = |field: &str, v: f64| positive_field(name, field, v);
         positive("physics.dt", self.physics.dt)?;
         self.validate_aim(name)?;
         if self.eval.per_family == 0 {
@@ -424,10 +415,7 @@ impl Config {
     }
 
     fn validate_aim(&self, name: &str) -> Result<(), ConfigError> {
-        let fail = |field: &str, message: String| ConfigError {
-            location: format!("{name}: field '{field}'"),
-            message,
-        };
+        let fail = |field: &str, message: String| field_error(name, field, message);
         let a = &self.aim;
         let range = |field: &str, r: [f64; 2]| {
             if r[0].is_finite() && r[1].is_finite() && r[0] <= r[1] {
@@ -466,17 +454,8 @@ impl Config {
     }
 
     fn validate_labels(&self, name: &str) -> Result<(), ConfigError> {
-        let fail = |field: &str, message: String| ConfigError {
-            location: format!("{name}: field '{field}'"),
-            message,
-        };
-        let positive = |field: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(fail(field, format!("must be a positive number (got {v})")))
-            }
-        };
+        let fail = |field: &str, message: String| field_error(name, field, message);
+        let positive = |field: &str, v: f64| positive_field(name, field, v);
         let l = &self.labels;
         for (field, v) in [
             (
@@ -541,6 +520,27 @@ impl Config {
     /// The family's speed parameter in the four bands (slow, normal, fast, very fast).
     pub fn speed_bands(&self, family: &str) -> Option<&[f64; 4]> {
         self.speed_bands.get(family)
+    }
+}
+
+/// A configuration error naming the file and the field.
+fn field_error(name: &str, field: &str, message: String) -> ConfigError {
+    ConfigError {
+        location: format!("{name}: field '{field}'"),
+        message,
+    }
+}
+
+/// `v` must be a finite positive number.
+fn positive_field(name: &str, field: &str, v: f64) -> Result<(), ConfigError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(field_error(
+            name,
+            field,
+            format!("must be a positive number (got {v})"),
+        ))
     }
 }
 
