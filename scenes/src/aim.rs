@@ -30,6 +30,15 @@ pub struct AimConfig {
     /// the validators reject a pose (a camera that cannot see the hazard from there).
     #[serde(default)]
     pub tries: u32,
+    /// A group whose event could not be aimed (the family's own pose stood) is planned
+    /// afresh — another object and room of its family — up to this many times (at most
+    /// `validators.replans`); the last plan stands.
+    #[serde(default)]
+    pub replans: u32,
+    /// ... after this many attempts (new layouts of the same plan) none of which could
+    /// be aimed.
+    #[serde(default)]
+    pub attempts: u32,
     /// Extra time beyond Δ + `reaction_time_min` before the path may meet the observer (s).
     pub reaction_margin_s: f64,
     /// The meeting height band (hazard centre height, m) for every family but those in

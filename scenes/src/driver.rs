@@ -233,22 +233,44 @@ fn replanned_group(
 ) -> Result<(Vec<SceneResult>, Rejections), String> {
     let policy = crate::selection::PlanPolicy::of(config);
     let mut total = Rejections::default();
+    let aim_replans = config.aim.replans.min(config.validators.replans);
     let mut replan = 0;
     loop {
         let selection =
             replan_group(catalog, families, seed, g, &policy, replan).map_err(|e| e.to_string())?;
-        let (results, rejections) =
-            produce_group_counted(&selection, seed, g * 4, count, catalog, config)
+        // While a replan is left for it, a group whose event cannot be aimed is planned
+        // afresh at once, before any band is labelled.
+        let require_aim = replan < aim_replans;
+        let produced =
+            produce_attempts(&selection, seed, g * 4, count, catalog, config, require_aim)
                 .map_err(|e| e.to_string())?;
+        let Some((results, rejections)) = produced else {
+            total.attempts += 1;
+            replan += 1;
+            continue;
+        };
         total.attempts += rejections.attempts;
         for (t, r) in total.rejected_by.iter_mut().zip(rejections.rejected_by) {
             *t += r;
         }
-        if replan >= config.validators.replans || results.iter().all(|r| r.verdicts.all()) {
+        let valid = results.iter().all(|r| r.verdicts.all());
+        let unaimed = require_aim && results.first().is_some_and(|r| needs_aim(&r.spec, config));
+        if replan >= config.validators.replans || (valid && !unaimed) {
             return Ok((results, total));
         }
         replan += 1;
     }
+}
+
+/// Whether a spec's event still waits to be aimed (label rule v5): its intent asks for
+/// the hands or the body, its family does not aim the event itself, events are aimed
+/// (`[aim] candidates`), and no aimed pose (`aim::apply`) stands in it.
+fn needs_aim(spec: &SceneSpec, config: &Config) -> bool {
+    use crate::intent::Intent;
+    config.aim.candidates > 0
+        && matches!(Intent::of(spec), Some(Intent::Hands | Intent::Body))
+        && !families::get(&spec.family).is_some_and(|f| f.self_aimed())
+        && !spec.family_params.contains_key("aim_candidate")
 }
 
 /// Frames one set of cameras for a group's bands and labels and validates each band.
@@ -364,10 +386,14 @@ fn hazard_trajectory(spec: &SceneSpec, sim: &Simulation) -> Vec<[f32; 4]> {
         .collect()
 }
 
-/// Labels a group's simulated bands at the first aimed pose (`aim::aims`) whose bands all
+/// Labels a group's simulated bands at the first of `aims` (`aim::aims`) whose bands all
 /// pass the validators, else at the family's own pose.
-fn label_aimed(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> Vec<SceneResult> {
-    for aim in crate::aim::aims(&runs, &config.aim) {
+fn label_aimed(
+    runs: Vec<(SceneSpec, Simulation)>,
+    aims: Vec<crate::aim::Aim>,
+    config: &Config,
+) -> Vec<SceneResult> {
+    for aim in aims {
         let mut posed = runs.clone();
         crate::aim::apply(&mut posed, &aim);
         let results = label_group(posed, config);
@@ -423,8 +449,33 @@ pub fn produce_group_counted(
     catalog: &Catalog,
     config: &Config,
 ) -> Result<(Vec<SceneResult>, Rejections), RandomizeError> {
+    let produced = produce_attempts(
+        selection,
+        build_seed,
+        first_index,
+        count,
+        catalog,
+        config,
+        false,
+    )?;
+    Ok(produced.unwrap_or_default())
+}
+
+/// [`produce_group_counted`]; with `require_aim`, an attempt whose event cannot be aimed
+/// ([`needs_aim`] after `aim::aims` found no pose) is redrawn unlabelled, and after
+/// `[aim] attempts` such attempts the answer is `None` (the caller replans).
+fn produce_attempts(
+    selection: &Selection,
+    build_seed: u64,
+    first_index: u64,
+    count: u64,
+    catalog: &Catalog,
+    config: &Config,
+    require_aim: bool,
+) -> Result<Option<(Vec<SceneResult>, Rejections)>, RandomizeError> {
     let mut results = Vec::new();
     let mut rejections = Rejections::default();
+    let mut unaimed = 0;
     for attempt in 0..config.validators.max_attempts {
         rejections.attempts += 1;
         let mut runs = Vec::with_capacity(count as usize);
@@ -445,7 +496,16 @@ pub fn produce_group_counted(
         // aimed pose the validators reject (the hazard out of a camera's view, too early
         // to react) gives way to the next aimed pose, then to the family's own pose,
         // before a new attempt is drawn.
-        results = label_aimed(runs, config);
+        let aims = crate::aim::aims(&runs, &config.aim);
+        if require_aim && aims.is_empty() && runs.first().is_some_and(|(s, _)| needs_aim(s, config))
+        {
+            unaimed += 1;
+            if unaimed >= config.aim.attempts.max(1) {
+                return Ok(None);
+            }
+            continue;
+        }
+        results = label_aimed(runs, aims, config);
         if results.iter().all(|r| r.verdicts.all()) {
             break;
         }
@@ -455,5 +515,5 @@ pub fn produce_group_counted(
             }
         }
     }
-    Ok((results, rejections))
+    Ok(Some((results, rejections)))
 }

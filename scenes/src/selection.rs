@@ -103,8 +103,10 @@ pub fn plan_group_with(
 }
 
 /// [`plan_group_with`]'s plan number `replan` (0: the group's plan): the same family, the
-/// object kind, object and room drawn again from the "plan" stream's `replan`-th index.
-/// The driver replans a group none of whose attempts passes the validators.
+/// object and room drawn again from the "plan" stream's `replan`-th index, the object
+/// kind (benign or dangerous) kept from plan 0.
+/// The driver replans a group none of whose attempts passes the validators, or whose
+/// event could not be aimed (`[aim] replans`).
 pub fn replan_group(
     catalog: &Catalog,
     families: &[String],
@@ -124,7 +126,15 @@ pub fn replan_group(
                 .get(family)
                 .copied()
                 .unwrap_or(share);
-            let benign = rng.random_bool(share.clamp(0.0, 1.0));
+            let share = share.clamp(0.0, 1.0);
+            // A replan keeps its group's first draw of the kind (benign or dangerous): it
+            // changes the object and room, never the kind of decision the group asks.
+            let first = rng.random_bool(share);
+            let benign = if replan == 0 {
+                first
+            } else {
+                seeds::stream(seeds::group_seed(build_seed, group), 0, "plan").random_bool(share)
+            };
             let kind: Vec<&Object> = all
                 .iter()
                 .copied()
