@@ -495,6 +495,33 @@ mod tests {
     }
 
     #[test]
+    fn a_replan_keeps_the_groups_object_kind() {
+        let c = catalog();
+        let policy = PlanPolicy {
+            benign_share: Some(0.5),
+            benign_share_by_family: Default::default(),
+            heavy_mass_kg: 2.0,
+        };
+        let families = vec!["multi_object".to_string()];
+        let mut kinds = [0u32; 2];
+        let mut changed = 0;
+        for g in 0..40 {
+            let first = replan_group(&c, &families, 3, g, &policy, 0).unwrap();
+            let kind =
+                |s: &Selection| intrinsically_dangerous(c.object(&s.object_id).unwrap(), 2.0);
+            kinds[kind(&first) as usize] += 1;
+            for replan in 1..4 {
+                let again = replan_group(&c, &families, 3, g, &policy, replan).unwrap();
+                assert_eq!(kind(&again), kind(&first), "group {g} replan {replan}");
+                changed += u32::from(again.object_id != first.object_id);
+            }
+        }
+        // Both kinds occur, and replans do draw other objects.
+        assert!(kinds[0] > 5 && kinds[1] > 5, "{kinds:?}");
+        assert!(changed > 60, "{changed} of 120 replans changed the object");
+    }
+
+    #[test]
     fn lexicon_maps_object_family_and_room() {
         let c = catalog();
         let p = LexiconPlanner::new(&c);

@@ -597,7 +597,7 @@ fn label_balance_covers_every_family() {
     // 42–56%, NO_ACTION 2–8%, and most families give real decisions of both kinds.
     let n: usize = totals.iter().sum();
     let share = |k: usize| totals[k] as f64 / n as f64;
-    assert!(n >= 230, "subset of {n} scenes: {totals:?}");
+    assert!(n >= 280, "subset of {n} scenes: {totals:?}");
     assert!((0.40..=0.52).contains(&share(0)), "CATCH share {totals:?}");
     assert!((0.42..=0.56).contains(&share(1)), "DODGE share {totals:?}");
     assert!(
@@ -607,7 +607,40 @@ fn label_balance_covers_every_family() {
     let with = |f: fn(&rh_scenes::balance::FamilyBalance) -> usize| {
         rows.iter().filter(|r| f(r) >= 3).count()
     };
-    assert!(with(|r| r.catch) >= 11, "families with >= 3 CATCH");
-    assert!(with(|r| r.dodge) >= 12, "families with >= 3 DODGE");
+    assert!(with(|r| r.catch) >= 12, "families with >= 3 CATCH");
+    assert!(with(|r| r.dodge) >= 15, "families with >= 3 DODGE");
     let _ = Action::Catch;
+}
+
+/// `[aim] replans`: a group whose event cannot be aimed at the hands or the body (the
+/// family's own pose would stand, usually out of the hazard's way) is planned afresh.
+/// stair_tumble's heavy objects come to rest before Δ + the reaction time in many
+/// layouts; with replans fewer of its groups end unaimed than without.
+#[test]
+fn a_group_whose_event_cannot_be_aimed_is_planned_afresh() {
+    use rh_scenes::intent::Intent;
+    let (catalog, config) = setup();
+    let names = all_names();
+    let fi = names.iter().position(|n| n == "stair_tumble").unwrap() as u64;
+    let unaimed = |config: &Config| -> usize {
+        (0..8)
+            .map(|i| fi + 17 * i)
+            .filter(|&g| {
+                let (results, _) =
+                    rh_scenes::driver::plan_and_produce(&catalog, &names, None, 7, g, 4, config)
+                        .unwrap();
+                let spec = &results[0].spec;
+                matches!(Intent::of(spec), Some(Intent::Hands | Intent::Body))
+                    && !spec.family_params.contains_key("aim_candidate")
+            })
+            .count()
+    };
+    let mut without = config.clone();
+    without.aim.replans = 0;
+    let (before, after) = (unaimed(&without), unaimed(&config));
+    println!("stair_tumble groups left unaimed: {before} of 8 without replans, {after} with");
+    assert!(
+        after < before,
+        "{after} unaimed with replans, {before} without"
+    );
 }
