@@ -220,9 +220,11 @@ pub fn produce_planned_group(
 }
 
 /// A group the planner deals (no probe pair): a group none of whose attempts passes
-/// every validator (a heavy pillow thrown at the chest that no walk escapes) is planned
-/// afresh ([`replan_group`]), up to `validators.replans` times, and the first plan whose
-/// bands all pass is kept (else the last, marked invalid).
+/// every validator (a heavy pillow thrown at the chest that no walk escapes), or whose
+/// event cannot be aimed (`[aim] replans`), is planned afresh ([`replan_group`]), up to
+/// `validators.replans` times, and the first plan whose bands all pass (aimed, while
+/// aim replans are left) is kept. If the last plan fails, the first earlier plan that
+/// passes at its family's own pose stands instead; else the last, marked invalid.
 fn replanned_group(
     catalog: &Catalog,
     families: &[String],
@@ -234,32 +236,45 @@ fn replanned_group(
     let policy = crate::selection::PlanPolicy::of(config);
     let mut total = Rejections::default();
     let aim_replans = config.aim.replans.min(config.validators.replans);
-    let mut replan = 0;
-    loop {
+    let produce = |replan: u32, require_aim: bool, total: &mut Rejections| {
         let selection =
             replan_group(catalog, families, seed, g, &policy, replan).map_err(|e| e.to_string())?;
-        // While a replan is left for it, a group whose event cannot be aimed is planned
-        // afresh at once, before any band is labelled.
-        let require_aim = replan < aim_replans;
         let produced =
             produce_attempts(&selection, seed, g * 4, count, catalog, config, require_aim)
                 .map_err(|e| e.to_string())?;
-        let Some((results, rejections)) = produced else {
-            total.attempts += 1;
-            replan += 1;
+        match &produced {
+            // Planned afresh at once, before any band is labelled.
+            None => total.attempts += 1,
+            Some((_, rejections)) => {
+                total.attempts += rejections.attempts;
+                for (t, r) in total.rejected_by.iter_mut().zip(rejections.rejected_by) {
+                    *t += r;
+                }
+            }
+        }
+        Ok::<_, String>(produced.map(|(results, _)| results))
+    };
+    let valid = |results: &[SceneResult]| results.iter().all(|r| r.verdicts.all());
+    let mut last = Vec::new();
+    for replan in 0..=config.validators.replans {
+        // While a replan is left for it, a group whose event cannot be aimed is planned
+        // afresh.
+        let require_aim = replan < aim_replans;
+        let Some(results) = produce(replan, require_aim, &mut total)? else {
             continue;
         };
-        total.attempts += rejections.attempts;
-        for (t, r) in total.rejected_by.iter_mut().zip(rejections.rejected_by) {
-            *t += r;
-        }
-        let valid = results.iter().all(|r| r.verdicts.all());
         let unaimed = require_aim && results.first().is_some_and(|r| needs_aim(&r.spec, config));
-        if replan >= config.validators.replans || (valid && !unaimed) {
+        if valid(&results) && !unaimed {
             return Ok((results, total));
         }
-        replan += 1;
+        last = results;
     }
+    for replan in 0..aim_replans {
+        if let Some(results) = produce(replan, false, &mut total)?.filter(|r| valid(r)) {
+            return Ok((results, total));
+        }
+    }
+    Ok((last, total))
 }
 
 /// Whether a spec's event still waits to be aimed (label rule v5): its intent asks for
