@@ -20,6 +20,7 @@ pub mod bouncing_object;
 pub mod ceiling_drop;
 pub mod chain_reaction;
 pub mod door_swing;
+pub mod edge_creep;
 pub mod furniture_tip;
 pub mod hanging_fall;
 pub mod ladder_slip;
