@@ -1,8 +1,8 @@
-//! The one sampler of object_drop and shelf_slide: an object creeps down a tilted board
-//! (a tray propped on a table, a sagging shelf) and tips over its lower edge toward an
-//! observer standing beyond it. The two families differ only in their [`EdgeCreep`]
-//! table: where the board is mounted, the drawn ranges and the names of the recorded
-//! parameters.
+//! The one family behind object_drop and shelf_slide: an object creeps down a tilted
+//! board (a tray propped on a table, a sagging shelf) and tips over its lower edge toward
+//! an observer standing beyond it. The two families are two [`EdgeCreep`] tables (in
+//! their own files): their name, where the board is mounted, the drawn ranges and the
+//! names of the recorded parameters.
 
 use super::launch::*;
 use super::*;
@@ -29,6 +29,8 @@ pub struct UnderTable {
 /// speed, in the order of the fields, so the four bands differ only in the nudge.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EdgeCreep {
+    /// The family's name (its speed is the nudge down the slope, `push_speed_mps`).
+    pub name: &'static str,
     /// Name of the board body ("board", "shelf"); also prefixes the recorded friction and
     /// tilt (`<name>_friction`, `<name>_tilt_rad`).
     pub surface_name: &'static str,
@@ -57,8 +59,21 @@ pub struct EdgeCreep {
     pub observer_near: (f64, f64),
 }
 
-impl EdgeCreep {
-    pub fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
+impl Family for EdgeCreep {
+    fn info(&self) -> FamilyInfo {
+        FamilyInfo {
+            name: self.name,
+            speed_parameter: "push_speed_mps",
+            speed_sweep: true,
+        }
+    }
+
+    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
+        // The object left the board and reached the floor.
+        reached_floor(spec, sim)
+    }
+
+    fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
         let object = input.object;
         let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
         let dir = heading(heading_angle);

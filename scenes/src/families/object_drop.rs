@@ -8,10 +8,10 @@
 //! observer standing beyond the edge after Δ + 0.2 s = 0.8 s.
 
 use super::edge_creep::{EdgeCreep, Mount, UnderTable};
-use super::*;
 
 /// The family's ranges: a board on a table, its lower edge on the table's front edge.
-pub const RANGES: EdgeCreep = EdgeCreep {
+pub static OBJECT_DROP: EdgeCreep = EdgeCreep {
+    name: "object_drop",
     surface_name: "board",
     mount: Mount::Table,
     height_param: "table_height_m",
@@ -32,24 +32,3 @@ pub const RANGES: EdgeCreep = EdgeCreep {
     landing_ahead: 0.15,
     observer_near: (0.35, 0.85),
 };
-
-pub struct ObjectDrop;
-
-impl Family for ObjectDrop {
-    fn info(&self) -> FamilyInfo {
-        FamilyInfo {
-            name: "object_drop",
-            speed_parameter: "push_speed_mps",
-            speed_sweep: true,
-        }
-    }
-
-    fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
-        RANGES.sample(input, rng)
-    }
-
-    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
-        // The object left the table and reached the floor.
-        reached_floor(spec, sim)
-    }
-}

@@ -7,10 +7,10 @@
 //! shelf height, so it reaches the observer in front of the shelf after Δ + 0.2 s = 0.8 s.
 
 use super::edge_creep::{EdgeCreep, Mount};
-use super::*;
 
 /// The family's ranges: a shelf board alone, its lower edge at the event's origin.
-pub const RANGES: EdgeCreep = EdgeCreep {
+pub static SHELF_SLIDE: EdgeCreep = EdgeCreep {
+    name: "shelf_slide",
     surface_name: "shelf",
     mount: Mount::Shelf,
     height_param: "shelf_height_m",
@@ -27,23 +27,3 @@ pub const RANGES: EdgeCreep = EdgeCreep {
     landing_ahead: 0.25,
     observer_near: (0.3, 0.9),
 };
-
-pub struct ShelfSlide;
-
-impl Family for ShelfSlide {
-    fn info(&self) -> FamilyInfo {
-        FamilyInfo {
-            name: "shelf_slide",
-            speed_parameter: "push_speed_mps",
-            speed_sweep: true,
-        }
-    }
-
-    fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
-        RANGES.sample(input, rng)
-    }
-
-    fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
-        reached_floor(spec, sim)
-    }
-}
