@@ -11,10 +11,7 @@ pub type Vec3 = [f64; 3];
 
 /// Hex of the first 16 bytes of a SHA-256 (the executor's hashes).
 pub fn hash_hex(hasher: Sha256) -> String {
-    hasher.finalize()[..16]
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
+    crate::digest::hex(&hasher.finalize()[..16])
 }
 
 /// Version of the executor's code (humanoid, controller, outcome rule); part of the

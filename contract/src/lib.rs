@@ -6,6 +6,7 @@
 //! * [`columns`] — the scene table's columns, their types, nullability and meaning;
 //! * [`action`] — the three action primitives;
 //! * [`layout`] — where files live in a dataset directory (specs, videos, frames, data);
+//! * [`digest`] — SHA-256 and hex, for fingerprints, file sums and cache keys;
 //! * [`fsio`] — atomic file writing; [`progress`] — progress lines for logs (both programs).
 //!
 //! With the `arrow` feature, [`arrow_schema`] gives the Arrow schema of the scene table.
@@ -15,6 +16,7 @@
 pub mod action;
 pub mod adapter;
 pub mod columns;
+pub mod digest;
 pub mod execution;
 pub mod families;
 pub mod fsio;

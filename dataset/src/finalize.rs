@@ -2,7 +2,7 @@
 //! and the finished `build.json` with every file's SHA-256. Shared by `build` (rows from
 //! the group records) and `merge` (rows from the shards).
 
-use crate::integrity::{self, FileSums};
+use crate::integrity::FileSums;
 use crate::manifest::{Manifest, MANIFEST_FILE};
 use crate::{card, frames, stream, table};
 use arrow::array::RecordBatch;
@@ -73,7 +73,8 @@ pub fn finalize(
         Ok(())
     })?;
     data.finish().map_err(BuildError::Internal)?;
-    let data_sum = integrity::sha256_file(&data_path).map_err(|e| internal(&data_path, e))?;
+    let data_sum =
+        rh_contract::digest::sha256_file(&data_path).map_err(|e| internal(&data_path, e))?;
     sums.insert(data_file.clone(), data_sum);
     let summary = compact(&summary)?;
     let eval = if manifest.is_whole() {
@@ -83,7 +84,7 @@ pub fn finalize(
             stream::ParquetStream::create_with(&path, group_rows).map_err(BuildError::Internal)?;
         write_streamed(&rows, &indices, &mut eval)?;
         eval.finish().map_err(BuildError::Internal)?;
-        let sum = integrity::sha256_file(&path).map_err(|e| internal(&path, e))?;
+        let sum = rh_contract::digest::sha256_file(&path).map_err(|e| internal(&path, e))?;
         sums.insert(card::EVAL_FILE.to_string(), sum);
         Some(counts)
     } else {
@@ -99,7 +100,7 @@ pub fn finalize(
     table::write_atomic(&path, readme.as_bytes()).map_err(|e| internal(&path, e))?;
     sums.insert(
         "README.md".to_string(),
-        integrity::sha256_bytes(readme.as_bytes()),
+        rh_contract::digest::sha256_hex(readme.as_bytes()),
     );
     let finished = Manifest {
         files: Some(sums),

@@ -7,40 +7,12 @@
 use crate::table;
 use arrow::array::RecordBatch;
 use rayon::prelude::*;
-use sha2::{Digest, Sha256};
+use rh_contract::digest::sha256_file;
 use std::collections::BTreeMap;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// Relative path → SHA-256 (hex), in path order.
 pub type FileSums = BTreeMap<String, String>;
-
-/// SHA-256 of a file, streamed.
-pub fn sha256_file(path: &Path) -> std::io::Result<String> {
-    let mut file = std::fs::File::open(path)?;
-    let mut hasher = Sha256::new();
-    let mut buf = vec![0u8; 1 << 20];
-    loop {
-        let n = file.read(&mut buf)?;
-        if n == 0 {
-            break;
-        }
-        hasher.update(&buf[..n]);
-    }
-    Ok(hasher
-        .finalize()
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect())
-}
-
-/// SHA-256 of bytes (hex).
-pub fn sha256_bytes(bytes: &[u8]) -> String {
-    Sha256::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
-}
 
 /// The sums of `files` (relative to `root`), hashed in parallel.
 pub fn sums_of(root: &Path, files: &[String]) -> std::io::Result<FileSums> {

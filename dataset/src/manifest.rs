@@ -12,10 +12,10 @@
 #[cfg(feature = "write")]
 use rh_catalog::Catalog;
 #[cfg(feature = "write")]
+use rh_contract::digest::sha256_hex;
+#[cfg(feature = "write")]
 use rh_scenes::config::Config;
 use serde::{Deserialize, Serialize};
-#[cfg(feature = "write")]
-use sha2::{Digest, Sha256};
 use std::path::Path;
 
 /// A planned selection of a build from descriptions: typed with `write`; without it (the
@@ -70,14 +70,6 @@ pub struct Manifest {
     /// different adapters do not merge: their pixels, the models' inputs, may differ.
     #[serde(default)]
     pub render_adapter: Option<rh_contract::adapter::RenderAdapter>,
-}
-
-#[cfg(feature = "write")]
-fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
 }
 
 /// A fingerprint of a configuration (also used to tell the embedded default apart).

@@ -305,16 +305,10 @@ struct ShardCursor {
 
 impl ShardCursor {
     fn open(path: &Path) -> Result<ShardCursor, BuildError> {
-        use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
-        let fail = |e: &dyn std::fmt::Display| input(format!("{}: {e}", path.display()));
-        let file = std::fs::File::open(path).map_err(|e| fail(&e))?;
-        let reader = ParquetRecordBatchReaderBuilder::try_new(file)
-            // Small batches: a rendered shard's rows carry ~1 MB of frame images each.
-            .and_then(|b| {
-                b.with_batch_size(crate::frames::IMAGE_ROW_GROUP_SIZE * 4)
-                    .build()
-            })
-            .map_err(|e| fail(&e))?;
+        // Every column, in small batches: a rendered shard's rows carry ~1 MB of frame
+        // images each.
+        let batch = crate::frames::IMAGE_ROW_GROUP_SIZE * 4;
+        let reader = crate::read::open_columns(path, batch, |_| true).map_err(input)?;
         Ok(ShardCursor {
             path: path.to_path_buf(),
             reader,

@@ -28,6 +28,18 @@ pub fn parquet_files(folder: &Path) -> Result<Vec<PathBuf>, String> {
 /// frames' images (`<cam>_frames`, about 1 MB a row: only `datasets` users and `merge`
 /// read them).
 pub fn open_parquet(file: &Path, batch_size: usize) -> Result<ParquetRecordBatchReader, String> {
+    open_columns(file, batch_size, |name| {
+        !rh_contract::columns::is_frames_column(name)
+    })
+}
+
+/// A record-batch reader over one Parquet file, the columns whose names `keep` accepts
+/// (the others are never decoded): the one place a scene table is opened.
+pub fn open_columns(
+    file: &Path,
+    batch_size: usize,
+    keep: impl Fn(&str) -> bool,
+) -> Result<ParquetRecordBatchReader, String> {
     let f =
         std::fs::File::open(file).map_err(|e| format!("cannot open {}: {e}", file.display()))?;
     ParquetRecordBatchReaderBuilder::try_new(f)
@@ -37,7 +49,7 @@ pub fn open_parquet(file: &Path, batch_size: usize) -> Result<ParquetRecordBatch
                 .fields()
                 .iter()
                 .enumerate()
-                .filter(|(_, f)| !rh_contract::columns::is_frames_column(f.name()))
+                .filter(|(_, f)| keep(f.name()))
                 .map(|(i, _)| i)
                 .collect();
             let mask = parquet::arrow::ProjectionMask::roots(b.parquet_schema(), roots);

@@ -47,7 +47,7 @@ pub fn group_files(
         let rel = table::spec_path(&r.spec.scene_id);
         let path = out.join(&rel);
         let json = r.spec.to_json();
-        spec_sums.insert(rel, integrity::sha256_bytes(json.as_bytes()));
+        spec_sums.insert(rel, rh_contract::digest::sha256_hex(json.as_bytes()));
         files.push(write_unsynced(&path, json.as_bytes()).map_err(|e| internal(&path, e))?);
     }
     let path = record_path(out, g);

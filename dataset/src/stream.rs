@@ -126,28 +126,12 @@ pub fn project(batch: &RecordBatch, names: &[&str]) -> RecordBatch {
 /// The named columns of a scene-table Parquet file (a projection: the other columns are
 /// never decoded).
 pub fn read_columns(path: &Path, names: &[&str]) -> Result<RecordBatch, String> {
-    use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
-    use parquet::arrow::ProjectionMask;
     let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-    let file = fs::File::open(path).map_err(|e| fail(&e))?;
-    let builder = ParquetRecordBatchReaderBuilder::try_new(file)
-        .map_err(|e| format!("{}: not a readable Parquet file: {e}", path.display()))?;
-    let roots: Vec<usize> = names
-        .iter()
-        .map(|n| {
-            builder
-                .schema()
-                .index_of(n)
-                .map_err(|_| format!("{}: no column '{n}'", path.display()))
-        })
-        .collect::<Result<_, _>>()?;
-    let mask = ProjectionMask::roots(builder.parquet_schema(), roots);
-    let reader = builder
-        .with_projection(mask)
-        .with_batch_size(8192)
-        .build()
-        .map_err(|e| fail(&e))?;
+    let reader = crate::read::open_columns(path, 8192, |n| names.contains(&n))?;
     let schema = arrow::array::RecordBatchReader::schema(&reader);
+    if let Some(n) = names.iter().find(|n| schema.index_of(n).is_err()) {
+        return Err(format!("{}: no column '{n}'", path.display()));
+    }
     let batches: Vec<RecordBatch> = reader.collect::<Result<_, _>>().map_err(|e| fail(&e))?;
     let batch = arrow::compute::concat_batches(&schema, &batches).map_err(|e| fail(&e))?;
     // The columns in the order asked for.

@@ -12,10 +12,10 @@
 //! git blob SHA-1 (`sha1("blob <len>\0" + content)`, 40 hex digits) for the others. So any
 //! blob can be checked against its own name, with no other record.
 
+use rh_contract::digest::{hash_reader, hex};
 use serde::{Deserialize, Serialize};
 use sha1::Sha1;
 use sha2::{Digest, Sha256};
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// The cache root: `$HF_HUB_CACHE`, `$HUGGINGFACE_HUB_CACHE`, `$HF_HOME/hub`,
@@ -261,39 +261,19 @@ impl Hasher {
 /// file at `path`, streamed.
 pub fn hash_like(path: &Path, name: &str) -> std::io::Result<String> {
     let len = std::fs::metadata(path)?.len();
-    let mut file = std::fs::File::open(path)?;
-    let mut buf = vec![0u8; 1 << 20];
+    let file = std::fs::File::open(path)?;
     if name.len() == 40 {
         let mut h = Sha1::new();
         h.update(format!("blob {len}\0").as_bytes());
-        loop {
-            let n = file.read(&mut buf)?;
-            if n == 0 {
-                break;
-            }
-            h.update(&buf[..n]);
-        }
-        Ok(hex(&h.finalize()))
+        hash_reader(h, file)
     } else {
-        let mut h = Sha256::new();
-        loop {
-            let n = file.read(&mut buf)?;
-            if n == 0 {
-                break;
-            }
-            h.update(&buf[..n]);
-        }
-        Ok(hex(&h.finalize()))
+        hash_reader(Sha256::new(), file)
     }
 }
 
 /// Whether the file's content has the hash `name`.
 pub fn content_matches(path: &Path, name: &str) -> std::io::Result<bool> {
     Ok(hash_like(path, name)? == name.to_ascii_lowercase())
-}
-
-pub fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 fn file_name(p: &Path) -> String {

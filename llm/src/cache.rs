@@ -4,7 +4,7 @@
 //! sibling and renamed, so a killed run leaves no half-written entry.
 
 use crate::Reply;
-use sha2::{Digest, Sha256};
+use rh_contract::digest::sha256_hex;
 use std::path::{Path, PathBuf};
 
 /// The cache directory: `$RH_LLM_CACHE`, else `$XDG_CACHE_HOME/reacthuman/llm`, else
@@ -19,10 +19,6 @@ pub fn default_dir() -> PathBuf {
         .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
         .unwrap_or_else(std::env::temp_dir);
     base.join("reacthuman").join("llm")
-}
-
-pub fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// The cache key of one request.
@@ -40,7 +36,7 @@ pub fn key(
         "params": params,
         "sample": sample,
     });
-    hex(&Sha256::digest(canonical.to_string().as_bytes()))
+    sha256_hex(canonical.to_string().as_bytes())
 }
 
 #[derive(Debug, Clone)]

@@ -103,7 +103,7 @@ impl ChatRequest {
         params: serde_json::Map<String, Value>,
         sample: u32,
     ) -> ChatRequest {
-        let prompt_hash = cache::hex(&Sha256::digest(messages.to_string().as_bytes()));
+        let prompt_hash = rh_contract::digest::sha256_hex(messages.to_string().as_bytes());
         ChatRequest {
             model: model.to_string(),
             messages,

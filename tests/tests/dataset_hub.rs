@@ -7,8 +7,8 @@
 //! Network rules: loopback only, one server thread that stops when told to (or after two
 //! minutes by itself), bounded request sizes and loops.
 
+use rh_contract::digest::{hex, sha256_hex};
 use rh_e2e::{bin, files_under, run_ok};
-use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::io::{Read, Write};
 use std::net::{TcpListener, TcpStream};
@@ -24,20 +24,13 @@ const COMMIT: &str = "0123456789abcdef0123456789abcdef01234567";
 /// The stand-in Hub answers only requests that carry this token (`HF_TOKEN`).
 const TOKEN: &str = "hf_rh_test_token";
 
-fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
-}
-
 /// The git blob hash the Hub uses for files not stored in LFS.
 fn git_sha1(bytes: &[u8]) -> String {
     use sha1::Digest as _;
     let mut h = sha1::Sha1::new();
     h.update(format!("blob {}\0", bytes.len()).as_bytes());
     h.update(bytes);
-    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    hex(&h.finalize())
 }
 
 /// Files the stand-in stores in LFS (as the real dataset's `.gitattributes` does).

@@ -96,11 +96,7 @@ fn a_clean_build_verifies_and_records_every_file() {
         if name == "build.json" {
             continue;
         }
-        use sha2::Digest;
-        let sha: String = sha2::Sha256::digest(bytes)
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect();
+        let sha = rh_contract::digest::sha256_hex(bytes);
         assert_eq!(files[name].as_str(), Some(sha.as_str()), "{name}");
     }
     let (code, stdout, stderr) = verify(reference, false);

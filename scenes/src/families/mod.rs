@@ -20,6 +20,7 @@ pub mod bouncing_object;
 pub mod ceiling_drop;
 pub mod chain_reaction;
 pub mod door_swing;
+pub mod edge_creep;
 pub mod furniture_tip;
 pub mod hanging_fall;
 pub mod ladder_slip;
@@ -119,8 +120,8 @@ pub trait Family: Sync {
 /// All implemented families, in canonical order.
 pub fn all() -> Vec<&'static dyn Family> {
     vec![
-        &object_drop::ObjectDrop,
-        &shelf_slide::ShelfSlide,
+        &object_drop::OBJECT_DROP,
+        &shelf_slide::SHELF_SLIDE,
         &hanging_fall::HangingFall,
         &ceiling_drop::CeilingDrop,
         &sliding_object::SlidingObject,

@@ -19,10 +19,7 @@ pub fn cache_key(scene_hash: &str, plan: &ExecPlan, cfg: &ExecConfig) -> String 
         h.update(part.as_bytes());
         h.update(b"/");
     }
-    h.finalize()[..16]
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
+    rh_contract::execution::hash_hex(h)
 }
 
 fn cache_path(dir: &Path, key: &str) -> PathBuf {

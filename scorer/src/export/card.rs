@@ -2,16 +2,9 @@
 //! features) and `export.json` (what was exported, from which build, with which prompt).
 
 use super::{ExportOptions, Summary, FILE};
+use rh_contract::digest::sha256_hex;
 use rh_dataset::manifest::Manifest;
 use serde_json::json;
-use sha2::{Digest, Sha256};
-
-fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
-}
 
 /// The columns of the export and what they hold.
 fn columns(summary: &Summary) -> String {

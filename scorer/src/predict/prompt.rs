@@ -394,14 +394,6 @@ mod tests {
         assert!(err.contains("missing observation frame"), "{err}");
     }
 
-    fn sha256_hex(b: &[u8]) -> String {
-        use sha2::Digest;
-        sha2::Sha256::digest(b)
-            .iter()
-            .map(|x| format!("{x:02x}"))
-            .collect()
-    }
-
     /// [`test_frame`] as `frame.png` in a new temporary directory.
     fn test_frame_in_tempdir() -> (tempfile::TempDir, std::path::PathBuf) {
         let d = tempfile::tempdir().unwrap();
@@ -457,7 +449,7 @@ mod tests {
         let back = image::load_from_memory(&jpeg).unwrap();
         assert_eq!((back.width(), back.height()), (768, 432));
         assert_eq!(
-            sha256_hex(&jpeg),
+            rh_contract::digest::sha256_hex(&jpeg),
             "1d1464c2357283ebefd1ee065bc71d26269bee8997e300c8029f14987c480fde",
             "the frame encoder's bytes changed: bump the prompt version in configs/prompt.toml"
         );

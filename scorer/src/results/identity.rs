@@ -7,9 +7,9 @@ use crate::coverage::Expected;
 use crate::dataset::Dataset;
 use crate::error::InputError;
 use anyhow::Result;
+use rh_contract::digest::sha256_hex;
 use rh_dataset::manifest::Manifest;
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
 
 /// The dataset a run was scored on.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -58,13 +58,6 @@ pub struct ScoringIdentity {
     pub config_sha256: String,
     /// Metrics over the answered scenes only (`--answered-only`).
     pub answered_only: bool,
-}
-
-fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
 }
 
 impl DatasetIdentity {
