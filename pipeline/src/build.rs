@@ -372,6 +372,7 @@ fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<RenderChec
     #[cfg(feature = "render")]
     {
         memory::no_huge_pages();
+        memory::large_buffers_mapped();
         let renderer =
             rh_render::Renderer::new(rh_render::RenderOptions::from_config(&config.render))
                 .map_err(|e| {
@@ -612,6 +613,25 @@ mod memory {
         // SAFETY: prctl with integer arguments only; a failure leaves the default.
         unsafe {
             libc::prctl(libc::PR_SET_THP_DISABLE, 1, 0, 0, 0);
+        }
+    }
+
+    /// Allocations from this size up always come from the system (mmap) and go back to
+    /// it when freed: a 720p frame (3.7 MB), its RGB copy for a PNG (2.8 MB), lavapipe's
+    /// memory blocks (4 MB and up). glibc otherwise raises its mmap threshold to the
+    /// largest block freed so far (up to 32 MB), after which such buffers are carved from
+    /// the malloc arenas, whose freed space fragments and stays resident: peak RSS crept
+    /// up scene by scene (docs/benchmarks.md, "Render memory"). Not lower: lavapipe
+    /// allocates and frees about 1.2 MB per frame, which mapped each time cost 5x the
+    /// system time.
+    const MMAP_THRESHOLD: i32 = 2 << 20;
+
+    pub fn large_buffers_mapped() {
+        #[cfg(all(target_os = "linux", target_env = "gnu"))]
+        // SAFETY: mallopt only sets an allocator parameter; M_MMAP_THRESHOLD is valid for
+        // glibc (setting it also turns its adjustment off).
+        unsafe {
+            libc::mallopt(libc::M_MMAP_THRESHOLD, MMAP_THRESHOLD);
         }
     }
 

@@ -32,7 +32,7 @@
 //! | `camera` | view-projection matrices (basis from `view::View`), full-event camera |
 //! | `regions` | shadow-tile rectangle maths: where a moving shadow can change pixels |
 //! | `measure` | the instance-id pass at the observation frames: hazard visibility, masks, depth |
-//! | `gpu` | the wgpu device, pipelines, static cache and overlay drawing |
+//! | `gpu` | the wgpu device and pipelines (one per process, shared by the workers), static cache and overlay drawing |
 //! | `encode` | H.264 encoding through FFmpeg (feature `video`, default; `encode_off` without it) |
 //! | `execution` | execution videos: outside and ego views of executed plans, tiled ([`Renderer::render_executions`]) |
 //! | `ego` | [`EgoCamera`]: the ego view of a closed-loop episode, one step at a time (the Gym env's image) |

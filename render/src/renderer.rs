@@ -16,7 +16,8 @@ use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// The wgpu device and pipelines; create one per worker thread and reuse it.
+/// One worker's renderer (its targets and encoders, on the process's shared wgpu device
+/// and pipelines: see `gpu::Gpu`); create one per worker thread and reuse it.
 pub struct Renderer {
     pub(super) gpu: Gpu,
     opts: RenderOptions,
@@ -29,7 +30,7 @@ thread_local! {
 }
 
 /// Runs `f` with this thread's renderer, creating it on first use (so a rayon worker
-/// keeps one device for all its scenes).
+/// keeps its targets for all its scenes; the device is the process's).
 pub fn with_thread_renderer<R>(
     opts: &RenderOptions,
     f: impl FnOnce(&mut Renderer) -> R,

@@ -60,17 +60,46 @@ struct IdTarget {
     bind: wgpu::BindGroup,
 }
 
-/// The id pass's pipelines and per-slot targets.
+/// The id pass's per-slot targets, and its pipelines (the device's: see `Shared`).
 pub struct IdPass {
+    pipes: IdPipelines,
+    targets: Vec<Option<IdTarget>>,
+}
+
+/// The id and coverage pipelines and their bind group layout, built once per device.
+#[derive(Clone)]
+pub(super) struct IdPipelines {
     ids: wgpu::RenderPipeline,
     cover: wgpu::RenderPipeline,
     bgl: wgpu::BindGroupLayout,
-    targets: Vec<Option<IdTarget>>,
 }
 
 impl IdPass {
     pub fn new(gpu: &Gpu) -> IdPass {
-        let device = &gpu.device;
+        let pipes = gpu
+            .id_pipelines
+            .get_or_init(|| IdPipelines::new(&gpu.device));
+        IdPass {
+            pipes: pipes.clone(),
+            targets: Vec::new(),
+        }
+    }
+
+    fn target(&mut self, device: &wgpu::Device, slot: usize, width: u32, height: u32) {
+        if self.targets.len() <= slot {
+            self.targets.resize_with(slot + 1, || None);
+        }
+        let fits = self.targets[slot]
+            .as_ref()
+            .is_some_and(|t| t.width == width && t.height == height);
+        if !fits {
+            self.targets[slot] = Some(make_target(device, &self.pipes.bgl, width, height));
+        }
+    }
+}
+
+impl IdPipelines {
+    fn new(device: &wgpu::Device) -> IdPipelines {
         let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("ids-bgl"),
             entries: &[wgpu::BindGroupLayoutEntry {
@@ -140,23 +169,10 @@ impl IdPass {
                 cache: None,
             })
         };
-        IdPass {
+        IdPipelines {
             ids: pipeline("ids", "vs_ids", "fs_ids", ID_FORMAT, true),
             cover: pipeline("cover", "vs_cover", "fs_cover", COVER_FORMAT, false),
             bgl,
-            targets: Vec::new(),
-        }
-    }
-
-    fn target(&mut self, device: &wgpu::Device, slot: usize, width: u32, height: u32) {
-        if self.targets.len() <= slot {
-            self.targets.resize_with(slot + 1, || None);
-        }
-        let fits = self.targets[slot]
-            .as_ref()
-            .is_some_and(|t| t.width == width && t.height == height);
-        if !fits {
-            self.targets[slot] = Some(make_target(device, &self.bgl, width, height));
         }
     }
 }
@@ -294,7 +310,7 @@ impl Gpu {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            rp.set_pipeline(&pass.ids);
+            rp.set_pipeline(&pass.pipes.ids);
             rp.set_bind_group(0, &t.bind, &[]);
             rp.set_vertex_buffer(0, self.vbuf.slice(..));
             for (r, id) in v.ranges.iter().filter(|(r, _)| !r.is_empty()) {
@@ -318,7 +334,7 @@ impl Gpu {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        rp.set_pipeline(&pass.cover);
+        rp.set_pipeline(&pass.pipes.cover);
         rp.set_bind_group(0, &t.bind, &[]);
         rp.set_vertex_buffer(0, self.vbuf.slice(..));
         for r in v.alone.iter().filter(|r| !r.is_empty()) {

@@ -83,6 +83,8 @@ struct Target {
     bind: wgpu::BindGroup,
 }
 
+/// One worker's renderer state: its shadow maps, targets and vertex buffer, on the
+/// process's shared device and pipelines (`setup::Shared`).
 pub struct Gpu {
     device: wgpu::Device,
     queue: wgpu::Queue,
@@ -107,6 +109,8 @@ pub struct Gpu {
     shadow_bind: wgpu::BindGroup,
     /// Post-process anti-aliasing (FXAA), where MSAA is off and it is enabled.
     post: Option<post::Post>,
+    /// The id pass's pipelines, built on first use (shared like the device's).
+    id_pipelines: std::sync::Arc<std::sync::OnceLock<ids::IdPipelines>>,
     vbuf: wgpu::Buffer,
     vcap: u64,
     static_len: u32,

@@ -14,6 +14,7 @@ const MASK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth16Unorm;
 /// The FXAA pipelines (`mark`: copy every pixel and mark edges in the depth mask;
 /// `edge`: blend the marked pixels), their bind group layout and the (bilinear,
 /// clamped) sampler.
+#[derive(Clone)]
 pub(super) struct Post {
     mark: wgpu::RenderPipeline,
     edge: wgpu::RenderPipeline,

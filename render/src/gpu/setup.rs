@@ -285,13 +285,46 @@ fn pipelines(
     [main, depth_only, main_over, fill, shadow]
 }
 
-impl Gpu {
-    /// Opens the adapter and builds the pipelines with `samples` MSAA samples on a
-    /// hardware GPU, `cpu_samples` on a CPU rasterizer (4 or 1 each); `fxaa`: a
-    /// post-process anti-aliasing pass on lit frames wherever MSAA is off.
-    pub fn new(samples: u32, cpu_samples: u32, fxaa: bool) -> Result<Gpu, RenderError> {
+/// The device and what is built once for it (pipelines, bind group layouts, the shadow
+/// sampler, the FXAA and id pipelines): one per process and settings, shared by every
+/// [`Gpu`] (each worker thread's), so that the CPU rasterizer compiles and keeps one set
+/// of shaders and one memory allocator instead of one per worker. wgpu's queue orders
+/// the workers' submissions; each worker draws into its own targets, so no frame
+/// depends on another worker's.
+#[derive(Clone)]
+struct Shared {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    adapter: RenderAdapter,
+    samples: u32,
+    /// (main, depth-only, main-over, fill, shadow): see `pipelines`.
+    pipelines: [wgpu::RenderPipeline; 5],
+    main_bgl: wgpu::BindGroupLayout,
+    shadow_bgl: wgpu::BindGroupLayout,
+    shadow_sampler: wgpu::Sampler,
+    post: Option<post::Post>,
+    id_pipelines: std::sync::Arc<std::sync::OnceLock<ids::IdPipelines>>,
+}
+
+/// The process's shared devices, by (samples, cpu_samples, fxaa); kept until it exits.
+type SharedKey = (u32, u32, bool);
+static SHARED: std::sync::Mutex<Vec<(SharedKey, Shared)>> = std::sync::Mutex::new(Vec::new());
+
+impl Shared {
+    /// The shared device for these settings, opened on first use.
+    fn get(samples: u32, cpu_samples: u32, fxaa: bool) -> Result<Shared, RenderError> {
+        let key = (samples, cpu_samples, fxaa);
+        let mut all = SHARED.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, shared)) = all.iter().find(|(k, _)| *k == key) {
+            return Ok(shared.clone());
+        }
+        let shared = Shared::open(samples, cpu_samples, fxaa)?;
+        all.push((key, shared.clone()));
+        Ok(shared)
+    }
+
+    fn open(samples: u32, cpu_samples: u32, fxaa: bool) -> Result<Shared, RenderError> {
         let (device, queue, adapter, samples) = open_device(samples, cpu_samples)?;
-        let adapter_name = adapter.name.clone();
         let post = (fxaa && samples == 1).then(|| post::Post::new(&device));
         let (shadow_bgl, main_bgl) = bind_group_layouts(&device);
         let layout = |bgl: &wgpu::BindGroupLayout| {
@@ -303,8 +336,38 @@ impl Gpu {
         };
         let main_layout = layout(&main_bgl);
         let shadow_layout = layout(&shadow_bgl);
-        let [main, depth_only, main_over, fill, shadow] =
-            pipelines(&device, &main_layout, &shadow_layout, samples);
+        let pipelines = pipelines(&device, &main_layout, &shadow_layout, samples);
+        let shadow_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow-sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        Ok(Shared {
+            device,
+            queue,
+            adapter,
+            samples,
+            pipelines,
+            main_bgl,
+            shadow_bgl,
+            shadow_sampler,
+            post,
+            id_pipelines: Default::default(),
+        })
+    }
+}
+
+impl Gpu {
+    /// A renderer on the process's shared device (opened with its pipelines on first
+    /// use: see `Shared`) with `samples` MSAA samples on a hardware GPU, `cpu_samples` on
+    /// a CPU rasterizer (4 or 1 each); `fxaa`: a post-process anti-aliasing pass on lit
+    /// frames wherever MSAA is off. Its shadow maps, targets and vertex buffer are its own.
+    pub fn new(samples: u32, cpu_samples: u32, fxaa: bool) -> Result<Gpu, RenderError> {
+        let shared = Shared::get(samples, cpu_samples, fxaa)?;
+        let device = shared.device;
+        let [main, depth_only, main_over, fill, shadow] = shared.pipelines;
         let shadow_map = |label| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -323,17 +386,10 @@ impl Gpu {
         let shadow_tex = shadow_map("shadow-map");
         let static_shadow = shadow_map("static-shadow-map");
         let shadow_view = shadow_tex.create_view(&Default::default());
-        let shadow_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("shadow-sampler"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            compare: Some(wgpu::CompareFunction::LessEqual),
-            ..Default::default()
-        });
         let shadow_uniform = uniform_buffer(&device);
         let shadow_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: None,
-            layout: &shadow_bgl,
+            layout: &shared.shadow_bgl,
             entries: &[wgpu::BindGroupEntry {
                 binding: 0,
                 resource: shadow_uniform.as_entire_binding(),
@@ -343,23 +399,24 @@ impl Gpu {
         let vbuf = vertex_buffer(&device, vcap);
         Ok(Gpu {
             device,
-            queue,
-            adapter_name,
-            adapter,
-            samples,
+            queue: shared.queue,
+            adapter_name: shared.adapter.name.clone(),
+            adapter: shared.adapter,
+            samples: shared.samples,
             main,
             depth_only,
             main_over,
             fill,
             shadow,
-            main_bgl,
+            main_bgl: shared.main_bgl,
             shadow_tex,
             shadow_view,
             static_shadow,
-            shadow_sampler,
+            shadow_sampler: shared.shadow_sampler,
             shadow_uniform,
             shadow_bind,
-            post,
+            post: shared.post,
+            id_pipelines: shared.id_pipelines,
             vbuf,
             vcap,
             static_len: 0,
