@@ -169,15 +169,32 @@ pub fn produce_planned_group(
     } else {
         4
     };
-    let (mut probe, rejections) = produce_group_counted(
-        &selection,
-        seed,
-        slot.probe_group * 4,
-        probe_count,
-        catalog,
-        &probe_config,
-    )
-    .map_err(|e| input(&e))?;
+    let produce = || {
+        produce_group_counted(
+            &selection,
+            seed,
+            slot.probe_group * 4,
+            probe_count,
+            catalog,
+            &probe_config,
+        )
+        .map_err(|e| e.to_string())
+    };
+    // The probe group and its twin group both take the probe's four bands: produced once
+    // per process ([`PROBES`]), by whichever of the two comes first.
+    let produced = if slot.pair.twin && probe_count == 4 {
+        let key = ProbeKey {
+            seed,
+            probe_group: slot.probe_group,
+            families: families.to_vec(),
+            config: serde_json::to_string(&probe_config).expect("a config serializes"),
+            catalog: format!("{catalog:?}"),
+        };
+        PROBES.get(key, 2, produce)
+    } else {
+        produce()
+    };
+    let (mut probe, rejections) = produced.map_err(GroupError::Input)?;
     let mut twin = Vec::new();
     for (band, r) in probe.iter_mut().enumerate() {
         if !slot.pair.twin {
@@ -218,6 +235,22 @@ pub fn produce_planned_group(
     }
     Ok((twin, rejected))
 }
+
+/// What a probe group's bands are a function of (with the driver's code): the build's
+/// seed, the group, the families (the planner deals them), the probe's configuration and
+/// the catalog (its `Debug` text: every field).
+#[derive(PartialEq)]
+struct ProbeKey {
+    seed: u64,
+    probe_group: u64,
+    families: Vec<String>,
+    config: String,
+    catalog: String,
+}
+
+/// Probe groups produced for their twin group or by it, until both have taken them.
+static PROBES: crate::shared::Shared<ProbeKey, Result<(Vec<SceneResult>, Rejections), String>> =
+    crate::shared::Shared::new(64);
 
 /// A group the planner deals (no probe pair): a group none of whose attempts passes
 /// every validator (a heavy pillow thrown at the chest that no walk escapes), or whose
@@ -313,13 +346,29 @@ pub fn run_scene(mut spec: SceneSpec, config: &Config) -> SceneResult {
 /// of a simulated spec that carries its cameras.
 pub fn label_scene(spec: SceneSpec, sim: Simulation, config: &Config) -> SceneResult {
     let family = families::get(&spec.family).expect("randomize only emits implemented families");
-    let strike = if may_touch_observer(&spec, &sim) {
-        simulate(&spec, counterfactual_options(&spec)).strike
+    let labels = counterfactual_labels(&spec, &sim);
+    let verdicts = validate(&spec, &sim, family, &config.validators, &labels);
+    scene_result(spec, sim, labels, verdicts)
+}
+
+/// The labels of a simulated spec: the counterfactual run where the hazard may touch
+/// the observer ([`may_touch_observer`]), then the label rule.
+fn counterfactual_labels(spec: &SceneSpec, sim: &Simulation) -> Labels {
+    let strike = if may_touch_observer(spec, sim) {
+        simulate(spec, counterfactual_options(spec)).strike
     } else {
         None
     };
-    let labels = label(&spec, &sim, strike);
-    let verdicts = validate(&spec, &sim, family, &config.validators, &labels);
+    label(spec, sim, strike)
+}
+
+/// A labelled and validated scene as the dataset takes it.
+fn scene_result(
+    spec: SceneSpec,
+    sim: Simulation,
+    labels: Labels,
+    verdicts: Verdicts,
+) -> SceneResult {
     let trajectory = hazard_trajectory(&spec, &sim);
     SceneResult {
         state_hash: sim.state_hash.clone(),
@@ -408,22 +457,72 @@ fn label_aimed(
     aims: Vec<crate::aim::Aim>,
     config: &Config,
 ) -> Vec<SceneResult> {
+    let debug = std::env::var_os("RH_AIM_DEBUG").is_some();
     for aim in aims {
         let mut posed = runs.clone();
         crate::aim::apply(&mut posed, &aim);
+        if !debug {
+            match label_group_if_valid(posed, config) {
+                Some(results) => return results,
+                None => continue,
+            }
+        }
         let results = label_group(posed, config);
         if results.iter().all(|r| r.verdicts.all()) {
             return results;
         }
-        if std::env::var_os("RH_AIM_DEBUG").is_some() {
-            let failed: Vec<Vec<&str>> = results.iter().map(|r| r.verdicts.failures()).collect();
-            eprintln!(
-                "aim {} {} candidate {} rejected: {failed:?}",
-                results[0].spec.family, results[0].spec.selection.object_id, aim.candidate
-            );
-        }
+        let failed: Vec<Vec<&str>> = results.iter().map(|r| r.verdicts.failures()).collect();
+        eprintln!(
+            "aim {} {} candidate {} rejected: {failed:?}",
+            results[0].spec.family, results[0].spec.selection.object_id, aim.candidate
+        );
     }
     label_group(runs, config)
+}
+
+/// [`label_group`] when every band passes every validator, else `None` — found at the
+/// first failing check: the validators that need no labels on every band first
+/// (`validate::unlabelled`), then each band's counterfactual run and the reaction-time
+/// rule, then the escape walks. The results are `label_group`'s (same labels, every
+/// verdict true); only a rejected pose costs less.
+fn label_group_if_valid(
+    runs: Vec<(SceneSpec, Simulation)>,
+    config: &Config,
+) -> Option<Vec<SceneResult>> {
+    let bands: Vec<(&SceneSpec, &Simulation)> = runs.iter().map(|(s, m)| (s, m)).collect();
+    let framed = cameras::frame_group(&bands, &config.validators.framing()).unwrap_or_default();
+    let mut framed_runs = Vec::with_capacity(runs.len());
+    for (mut spec, sim) in runs {
+        spec.cameras = framed.clone();
+        let family =
+            families::get(&spec.family).expect("randomize only emits implemented families");
+        let verdicts = crate::validate::unlabelled(&spec, &sim, family, &config.validators);
+        if !verdicts.all() {
+            return None;
+        }
+        framed_runs.push((spec, sim, verdicts));
+    }
+    let mut labelled = Vec::with_capacity(framed_runs.len());
+    for (spec, sim, mut verdicts) in framed_runs {
+        let labels = counterfactual_labels(&spec, &sim);
+        verdicts.reaction_time = crate::validate::reaction_time_ok(&spec, &labels);
+        if !verdicts.reaction_time {
+            return None;
+        }
+        labelled.push((spec, sim, labels, verdicts));
+    }
+    for (spec, _, labels, verdicts) in labelled.iter_mut() {
+        verdicts.escapable = crate::validate::escapable(spec, labels);
+        if !verdicts.escapable {
+            return None;
+        }
+    }
+    Some(
+        labelled
+            .into_iter()
+            .map(|(spec, sim, labels, verdicts)| scene_result(spec, sim, labels, verdicts))
+            .collect(),
+    )
 }
 
 /// How a group's attempts went: attempts made, and per validator (in

@@ -21,6 +21,7 @@ pub mod intent;
 pub mod label;
 pub mod randomize;
 pub mod selection;
+pub mod shared;
 pub mod twins;
 pub mod validate;
 pub mod view;

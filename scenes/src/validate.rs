@@ -74,6 +74,24 @@ pub fn validate(
     cfg: &ValidatorConfig,
     labels: &Labels,
 ) -> Verdicts {
+    Verdicts {
+        reaction_time: reaction_time_ok(spec, labels),
+        escapable: escapable(spec, labels),
+        ..unlabelled(spec, sim, family, cfg)
+    }
+}
+
+/// The validators that need no labels (nor the counterfactual run behind them), with
+/// `reaction_time` and `escapable` left `true`: [`validate`] sets those
+/// ([`reaction_time_ok`], [`escapable`]). A driver that only needs to know whether a
+/// scene passes everything checks these first, then the cheaper label rule, then the
+/// escape walks.
+pub fn unlabelled(
+    spec: &SceneSpec,
+    sim: &Simulation,
+    family: &dyn Family,
+    cfg: &ValidatorConfig,
+) -> Verdicts {
     let framing = cfg.framing();
     let e0 = sim.energy[0];
     let energy_limit = e0 + (cfg.energy_gain_relative * e0.abs()).max(cfg.energy_gain_absolute);
@@ -87,8 +105,8 @@ pub fn validate(
         in_frame: cameras::hazard_in_frame(spec, sim, &spec.cameras, &framing),
         visible: visibility::assess(spec, sim, &framing).passes(&framing),
         intended_event: family.event_happened(spec, sim),
-        reaction_time: reaction_time_ok(spec, labels),
-        escapable: escapable(spec, labels),
+        reaction_time: true,
+        escapable: true,
     }
 }
 
