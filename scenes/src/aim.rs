@@ -109,15 +109,10 @@ pub fn aim_group(runs: &mut [(SceneSpec, Simulation)], cfg: &AimConfig) -> Optio
 /// or when the spec records no intent. The driver labels them in turn and keeps the first
 /// whose bands all pass the validators (an aimed pose can hide the hazard from a camera).
 pub fn aims(runs: &[(SceneSpec, Simulation)], cfg: &AimConfig) -> Vec<Aim> {
-    if cfg.candidates == 0 || runs.is_empty() {
+    let Some(first) = runs.first().map(|(s, _)| s) else {
         return vec![];
-    }
-    let first = &runs[0].0;
-    // Families that aim their own event (a throw) keep their pose.
-    if crate::families::get(&first.family).is_some_and(|f| f.self_aimed()) {
-        return vec![];
-    }
-    let Some(intent) = Intent::of(first) else {
+    };
+    let Some(intent) = driver_aimed(first, cfg) else {
         return vec![];
     };
     let near_miss = intent == Intent::Miss;
@@ -196,13 +191,31 @@ pub fn aims(runs: &[(SceneSpec, Simulation)], cfg: &AimConfig) -> Vec<Aim> {
     found
 }
 
+/// The intent of a spec whose observer [`aims`] places: events are aimed
+/// (`candidates` > 0), the family does not aim its own event (a throw keeps its pose),
+/// and the spec records an intent. `None` otherwise.
+pub fn driver_aimed(spec: &SceneSpec, cfg: &AimConfig) -> Option<Intent> {
+    let self_aimed = crate::families::get(&spec.family).is_some_and(|f| f.self_aimed());
+    (cfg.candidates > 0 && !self_aimed)
+        .then(|| Intent::of(spec))
+        .flatten()
+}
+
+/// Whether [`apply`] stood the spec's observer at an aimed pose.
+pub fn posed_by_aim(spec: &SceneSpec) -> bool {
+    spec.family_params.contains_key(CANDIDATE_PARAM)
+}
+
+/// The `family_params` key [`apply`] records the winning candidate under.
+const CANDIDATE_PARAM: &str = "aim_candidate";
+
 /// Stands the observer of every band of `runs` at `aim` and records it in the specs'
 /// `family_params` (`aim_candidate`, `aim_meet_height`, `aim_bands_met`).
 pub fn apply(runs: &mut [(SceneSpec, Simulation)], aim: &Aim) {
     for (spec, _) in runs.iter_mut() {
         *spec = posed(spec, aim.x, aim.y, aim.yaw);
         let p = &mut spec.family_params;
-        p.insert("aim_candidate".into(), aim.candidate as f64);
+        p.insert(CANDIDATE_PARAM.into(), aim.candidate as f64);
         p.insert("aim_meet_height".into(), aim.meet_height);
         p.insert("aim_bands_met".into(), aim.bands_met as f64);
     }

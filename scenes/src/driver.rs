@@ -310,15 +310,15 @@ fn replanned_group(
     Ok((last, total))
 }
 
-/// Whether a spec's event still waits to be aimed (label rule v5): its intent asks for
-/// the hands or the body, its family does not aim the event itself, events are aimed
-/// (`[aim] candidates`), and no aimed pose (`aim::apply`) stands in it.
+/// Whether a spec's event still waits to be aimed (label rule v5): the driver aims it
+/// (`aim::driver_aimed`) at the hands or the body, and no aimed pose (`aim::apply`)
+/// stands in it.
 fn needs_aim(spec: &SceneSpec, config: &Config) -> bool {
     use crate::intent::Intent;
-    config.aim.candidates > 0
-        && matches!(Intent::of(spec), Some(Intent::Hands | Intent::Body))
-        && !families::get(&spec.family).is_some_and(|f| f.self_aimed())
-        && !spec.family_params.contains_key("aim_candidate")
+    matches!(
+        crate::aim::driver_aimed(spec, &config.aim),
+        Some(Intent::Hands | Intent::Body)
+    ) && !crate::aim::posed_by_aim(spec)
 }
 
 /// Frames one set of cameras for a group's bands and labels and validates each band.
@@ -614,7 +614,10 @@ fn produce_attempts(
         if require_aim && aims.is_empty() && runs.first().is_some_and(|(s, _)| needs_aim(s, config))
         {
             unaimed += 1;
-            if unaimed >= config.aim.attempts.max(1) {
+            // Also when the attempts run out first: no scene was labelled.
+            if unaimed >= config.aim.attempts.max(1)
+                || attempt + 1 == config.validators.max_attempts
+            {
                 return Ok(None);
             }
             continue;

@@ -631,7 +631,7 @@ fn a_group_whose_event_cannot_be_aimed_is_planned_afresh() {
                         .unwrap();
                 let spec = &results[0].spec;
                 matches!(Intent::of(spec), Some(Intent::Hands | Intent::Body))
-                    && !spec.family_params.contains_key("aim_candidate")
+                    && !rh_scenes::aim::posed_by_aim(spec)
             })
             .count()
     };
