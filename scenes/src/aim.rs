@@ -63,6 +63,10 @@ pub struct AimConfig {
     /// share of its top speed after the earliest step.
     #[serde(default)]
     pub body_speed_share: f64,
+    /// A benign object whose largest half extent exceeds this (m) is aimed at the body,
+    /// not the hands (`intent::Intent::for_object`; 0: no limit).
+    #[serde(default)]
+    pub hands_half_length_max: f64,
     /// A near miss stands this far (m) beyond `reach_radius` + the hazard's bounding
     /// radius, beside the path.
     pub miss_clearance: [f64; 2],

@@ -442,6 +442,7 @@ impl Config {
             ("aim.wall_margin", a.wall_margin),
             ("aim.touch_slack", a.touch_slack),
             ("aim.clear_before", a.clear_before),
+            ("aim.hands_half_length_max", a.hands_half_length_max),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(fail(

@@ -106,7 +106,12 @@ pub fn randomize(
         band_speeds: *bands,
         far_observer,
         observer_height: config.observer.height,
-        intent: Intent::for_object(aimed_as, far_observer, &config.labels),
+        intent: Intent::for_object(
+            aimed_as,
+            far_observer,
+            &config.labels,
+            config.aim.hands_half_length_max,
+        ),
     };
     let layout = family.sample(&input, &mut seeds::stream(seed, key.attempt, "placement"));
 
