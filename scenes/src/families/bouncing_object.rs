@@ -220,3 +220,52 @@ impl Family for BouncingObject {
         (k..=sim.steps()).any(|j| sim.hazard_velocity(j)[2] > 0.1)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A tennis ball (restitution 0.75) on a 0.25 floor, launched at 1.2 m: its slam's one
+    /// bounce comes back down through the hands' heights after Δ (0.6 s) + the reaction
+    /// minimum (0.2 s) + the aim's margin (0.1 s), at the drawn time, below the ceiling.
+    #[test]
+    fn a_slam_comes_down_through_the_hands_after_the_reaction_time() {
+        let (e, r, h0, ceiling) = (0.5, 0.0335, 1.2, 2.6);
+        let s = slam(e, r, h0, 1.15, ceiling).expect("a tennis ball can be slammed");
+        assert!(s.down > 0.0 && s.down <= SLAM_MAX_MPS);
+        assert!(s.low_s >= 1.15 && s.low_s < 1.16, "{s:?}");
+        assert!(
+            s.apex > 1.25 && s.apex + r <= ceiling - CEILING_GAP_M,
+            "{s:?}"
+        );
+        // Closed form: the centre's height after the bounce, at the stated time.
+        let u = (s.down * s.down + 2.0 * GRAVITY * (h0 - r)).sqrt();
+        assert!(((u - s.down) / GRAVITY - s.bounce_s).abs() < 1e-9);
+        let z = |t: f64| {
+            let tb = t - s.bounce_s;
+            r + e * u * tb - 0.5 * GRAVITY * tb * tb
+        };
+        assert!((z(s.low_s) - SLAM_LOW_M).abs() < 1e-6);
+        // At hand height (0.6-1.25 m) and coming down at some time after 0.9 s.
+        let in_band: Vec<f64> = (90..=120)
+            .map(|k| k as f64 / 100.0)
+            .filter(|&t| (0.6..=1.25).contains(&z(t)))
+            .collect();
+        assert!(in_band.len() >= 10, "{in_band:?}");
+        // Every band comes down at the same point: a band's start is set back by its
+        // own travel, so start + travel is the fastest band's travel.
+        let fastest = s.distance(4.6);
+        for v in [1.5, 2.4, 3.4, 4.6] {
+            let start = fastest - s.distance(v);
+            assert!((start + s.distance(v) - fastest).abs() < 1e-12);
+            assert!(s.distance(v) < s.distance(4.6) + 1e-12);
+        }
+    }
+
+    /// A ball that bounces too little (an apple, 0.3, on a 0.2 floor) cannot reach the
+    /// hands from a slam under the ceiling: it is thrown pitched instead.
+    #[test]
+    fn a_dead_ball_is_not_slammed() {
+        assert_eq!(slam(0.25, 0.04, 1.2, 1.1, 2.6), None);
+    }
+}

@@ -240,3 +240,37 @@ impl Family for DoorSwing {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 0.9 m door, observer 0.8 m from the hinge: every band's face reaches the torso
+    /// at the same time, after Δ (0.6 s) + the reaction minimum (0.2 s), still swinging at
+    /// its band's speed (no damping on the hinge) — at least 1 m/s where it meets the
+    /// body's near side even in the slowest band; the fastest starts no farther back
+    /// than the swing door allows.
+    #[test]
+    fn every_band_meets_the_observer_at_the_same_time_after_the_reaction_time() {
+        let bands = [1.5, 1.7, 1.85, 2.0];
+        let (w, radius) = (0.9, 0.8);
+        for (share, meet) in [(0.0, 1.0), (0.5, 1.1), (0.99, 1.15)] {
+            let t = DoorTiming::new(w, 0.05, radius, &bands, share, meet);
+            assert!(t.in_reach, "{t:?}");
+            assert!(t.meet_time >= 0.95 && t.meet_time > 0.6 + 0.2);
+            assert!(t.bearing <= MAX_BEARING);
+            for v in bands {
+                let start = t.start_angle(v);
+                assert!(start >= -MAX_BACK_SWING - 1e-9, "{v}: {start}");
+                let omega = v / w;
+                let reached = start + omega * t.meet_time + t.half_width;
+                assert!((reached - t.bearing).abs() < 1e-9);
+                assert!(omega * (radius - TORSO_RADIUS) >= 1.0);
+            }
+        }
+        // A cabinet door at these speeds would have to start beyond the doorway: its
+        // observer stands out of reach.
+        let t = DoorTiming::new(0.4, 0.018, 0.45, &bands, 0.5, 1.1);
+        assert!(!t.in_reach);
+    }
+}
