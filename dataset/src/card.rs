@@ -138,11 +138,13 @@ fn eval_rule_text(cfg: &EvalConfig) -> String {
         Some(share) => format!(
             "evaluation subset, stratified by label (label rule v5): up to {} valid scenes per \
              family, {:.0}% of them CATCH where the family has them, at most {} NO_ACTION, the \
-             rest DODGE; a family short of CATCH gives more DODGE and the other way round, but \
-             never more NO_ACTION (it stays short)",
+             rest DODGE; a family short of CATCH gives more DODGE and the other way round; a \
+             family short of real decisions takes more NO_ACTION only while the subset's \
+             NO_ACTION scenes stay within {:.0}% of it",
             cfg.per_family,
             100.0 * share,
-            cfg.no_action_per_family
+            cfg.no_action_per_family,
+            100.0 * cfg.no_action_fill_share
         ),
         None => format!(
             "balanced evaluation subset: up to {} valid scenes per family (whole speed-band groups first)",
@@ -358,9 +360,11 @@ fn eval_short_note(
     }
     format!(
         "\n\n**Note:** the `eval` config takes up to {per_family} valid scenes per family, at \
-         most {} NO_ACTION; this build has fewer real decisions in {} of its {} families, so \
-         the subset holds fewer scenes of: {}.",
+         most {} NO_ACTION (more only while the subset's NO_ACTION scenes stay within {:.0}% \
+         of it); this build has fewer real decisions in {} of its {} families, so the subset \
+         holds fewer scenes of: {}.",
         eval_cfg.no_action_per_family,
+        100.0 * eval_cfg.no_action_fill_share,
         short.len(),
         counts.len(),
         short.join(", ")

@@ -323,6 +323,12 @@ impl Config {
         {
             return Err(fail("eval.catch_share", "must be within [0, 1]".into()));
         }
+        if !(0.0..=1.0).contains(&self.eval.no_action_fill_share) {
+            return Err(fail(
+                "eval.no_action_fill_share",
+                "must be within [0, 1]".into(),
+            ));
+        }
         positive("physics.horizon_s", self.physics.horizon_s)?;
         positive("physics.min_duration_s", self.physics.min_duration_s)?;
         positive("observation.window_s", self.observation.window_s)?;

@@ -32,6 +32,16 @@ pub struct EvalConfig {
     /// count toward the family's CATCH and NO_ACTION targets.
     #[serde(default)]
     pub twin_pairs_per_family: usize,
+    /// With `catch_share`: families still short of `per_family` take further NO_ACTION
+    /// scenes of their own, one family at a time in name order, while the subset's
+    /// NO_ACTION scenes stay within this share of `per_family` × families (0: never —
+    /// builds before the fill).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub no_action_fill_share: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 impl Default for EvalConfig {
@@ -42,6 +52,7 @@ impl Default for EvalConfig {
             catch_share: None,
             no_action_per_family: 0,
             twin_pairs_per_family: 0,
+            no_action_fill_share: 0.0,
         }
     }
 }
@@ -67,19 +78,60 @@ pub fn select(rows: &[EvalRow], cfg: &EvalConfig) -> (Vec<usize>, BTreeMap<Strin
             by_family.entry(r.family).or_default().push(i);
         }
     }
-    let mut chosen = Vec::new();
-    let mut counts = BTreeMap::new();
+    let mut picked: Vec<(&str, Vec<usize>, Vec<usize>)> = Vec::new();
     for (family, mut members) in by_family {
         members.sort_by_key(|&r| rows[r].scene_index);
         let taken = match cfg.catch_share {
             Some(share) => stratified(rows, &members, cfg, share),
             None => whole_groups_first(rows, &members, cfg.per_family),
         };
+        picked.push((family, members, taken));
+    }
+    if cfg.catch_share.is_some() && cfg.no_action_fill_share > 0.0 {
+        fill_with_no_action(rows, &mut picked, cfg);
+    }
+    let mut chosen = Vec::new();
+    let mut counts = BTreeMap::new();
+    for (family, _, taken) in picked {
         counts.insert(family.to_string(), taken.len());
         chosen.extend(taken);
     }
     chosen.sort_by_key(|&r| rows[r].scene_index);
     (chosen, counts)
+}
+
+/// Families short of `per_family` take their next NO_ACTION scene (scene-index order),
+/// one family at a time in name order, round after round, while the subset's NO_ACTION
+/// scenes stay within `no_action_fill_share` of `per_family` × families.
+fn fill_with_no_action(
+    rows: &[EvalRow],
+    picked: &mut [(&str, Vec<usize>, Vec<usize>)],
+    cfg: &EvalConfig,
+) {
+    let cap = (cfg.no_action_fill_share * (cfg.per_family * picked.len()) as f64).floor() as usize;
+    let mut none = picked
+        .iter()
+        .flat_map(|(_, _, taken)| taken)
+        .filter(|&&r| rows[r].action == "NO_ACTION")
+        .count();
+    let mut progress = true;
+    while progress && none < cap {
+        progress = false;
+        for (_, members, taken) in picked.iter_mut() {
+            if none >= cap || taken.len() >= cfg.per_family {
+                continue;
+            }
+            let next = members
+                .iter()
+                .copied()
+                .find(|&r| rows[r].action == "NO_ACTION" && !taken.contains(&r));
+            if let Some(r) = next {
+                taken.push(r);
+                none += 1;
+                progress = true;
+            }
+        }
+    }
 }
 
 /// Up to `twin_pairs_per_family` probe pairs whose scenes are both valid members, in the
@@ -188,6 +240,7 @@ mod tests {
             catch_share: Some(0.5),
             no_action_per_family: 1,
             twin_pairs_per_family: 0,
+            no_action_fill_share: 0.0,
         };
         // Family a: 3 CATCH, 12 DODGE, 4 NO_ACTION: CATCH short, DODGE fills.
         // Family c: 1 CATCH, 1 DODGE, 5 NO_ACTION: short, one NO_ACTION only.
@@ -238,12 +291,56 @@ mod tests {
     }
 
     #[test]
+    fn short_families_fill_with_no_action_within_the_subset_share() {
+        let cfg = EvalConfig {
+            per_family: 4,
+            catch_share: Some(0.5),
+            no_action_per_family: 1,
+            twin_pairs_per_family: 0,
+            // 3 families × 4 = 12 scenes: at most floor(0.34 × 12) = 4 NO_ACTION.
+            no_action_fill_share: 0.34,
+        };
+        let mut rows = Vec::new();
+        // a: 2 CATCH, 2 DODGE: full, no NO_ACTION. b: 1 DODGE, 5 NO_ACTION: short by 2
+        // after its one NO_ACTION. c: 1 CATCH, 4 NO_ACTION: short by 2 too.
+        for (i, k) in ["CATCH", "CATCH", "DODGE", "DODGE"].iter().enumerate() {
+            rows.push(row("a", i as u64, k));
+        }
+        rows.push(row("b", 10, "DODGE"));
+        for i in 11..16u64 {
+            rows.push(row("b", i, "NO_ACTION"));
+        }
+        rows.push(row("c", 20, "CATCH"));
+        for i in 21..25u64 {
+            rows.push(row("c", i, "NO_ACTION"));
+        }
+        let (chosen, counts) = select(&rows, &cfg);
+        // Before the fill: b and c one NO_ACTION each (2 of 4 allowed); the fill gives b
+        // one more (its next by index, 12), then c one more (22), and stops at the cap.
+        assert_eq!((counts["a"], counts["b"], counts["c"]), (4, 3, 3));
+        let none: Vec<u64> = chosen
+            .iter()
+            .filter(|&&r| rows[r].action == "NO_ACTION")
+            .map(|&r| rows[r].scene_index)
+            .collect();
+        assert_eq!(none, vec![11, 12, 21, 22]);
+        // Without the fill the short families stay short.
+        let off = EvalConfig {
+            no_action_fill_share: 0.0,
+            ..cfg.clone()
+        };
+        let (_, counts) = select(&rows, &off);
+        assert_eq!((counts["b"], counts["c"]), (2, 2));
+    }
+
+    #[test]
     fn twin_pairs_come_first_whole_and_within_the_no_action_cap() {
         let cfg = EvalConfig {
             per_family: 6,
             catch_share: Some(0.5),
             no_action_per_family: 1,
             twin_pairs_per_family: 2,
+            no_action_fill_share: 0.0,
         };
         let paired = |i: u64, twin: u64, action| EvalRow {
             twin: Some(twin),

@@ -583,12 +583,9 @@ fn label_balance_covers_every_family() {
     assert_eq!(rows.len(), 17);
     let mut totals = [0usize; 3];
     for r in &rows {
-        // A family short of real decisions stays short (never padded with NO_ACTION).
-        assert!(
-            (1..=18).contains(&r.total()) && r.no_action <= 1,
-            "{}",
-            r.family
-        );
+        // A family short of real decisions takes more NO_ACTION only within the
+        // subset's `no_action_fill_share` (checked on the totals below).
+        assert!((1..=18).contains(&r.total()), "{}", r.family);
         totals[0] += r.catch;
         totals[1] += r.dodge;
         totals[2] += r.no_action;
@@ -598,6 +595,11 @@ fn label_balance_covers_every_family() {
     let n: usize = totals.iter().sum();
     let share = |k: usize| totals[k] as f64 / n as f64;
     assert!(n >= 280, "subset of {n} scenes: {totals:?}");
+    // One NO_ACTION per family, more only within the subset's fill share.
+    assert!(
+        totals[2] <= 17.max((config.eval.no_action_fill_share * 306.0).floor() as usize),
+        "NO_ACTION {totals:?}"
+    );
     assert!((0.40..=0.52).contains(&share(0)), "CATCH share {totals:?}");
     assert!((0.42..=0.56).contains(&share(1)), "DODGE share {totals:?}");
     assert!(
