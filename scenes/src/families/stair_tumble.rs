@@ -142,7 +142,13 @@ impl Family for StairTumble {
         let observer = ObserverPose {
             x: obs[0],
             y: obs[1],
-            yaw: (start[1] - obs[1]).atan2(start[0] - obs[0]),
+            // Facing the hazard's start; a timed ball's start follows from the speed, so
+            // facing the top edge.
+            yaw: if timed {
+                (edge[1] - obs[1]).atan2(edge[0] - obs[0])
+            } else {
+                (start[1] - obs[1]).atan2(start[0] - obs[0])
+            },
         };
         Layout {
             bodies,
