@@ -493,6 +493,50 @@ fn stair_tumble_descends_monotonically_between_steps() {
     );
 }
 
+/// Label rule v5's timed stair_tumble (closed form): a ball aimed at the hands rolls
+/// without losing speed, starts `v·t` behind the landing's top edge, and so crosses it at
+/// the drawn time `t` in every band — no earlier than Δ plus the reaction time, the
+/// time from which `aim` may let the hazard meet the observer.
+#[test]
+fn stair_tumble_times_a_ball_over_the_top_edge_after_the_reaction_time() {
+    let bands = [1.0, 1.5, 2.1, 2.8];
+    let scene = |index| custom_scene("stair_tumble", "tennis_ball", "living_room", bands, index);
+    // A group drawn as a near miss is not timed: the first of the others.
+    let group = (0..8)
+        .find(|&g| scene(4 * g).family_params["edge_time_s"] > 0.0)
+        .expect("a timed group among 8");
+    let mut crossings = Vec::new();
+    for band in 0..4 {
+        let spec = scene(4 * group + band);
+        let p = &spec.family_params;
+        let t = p["edge_time_s"];
+        let earliest = spec.observation_window_s + spec.labels.reaction_time_min;
+        assert!(t >= earliest, "edge time {t} before {earliest}");
+        assert!((p["com_behind_edge_m"] - spec.speed_value * t).abs() < 1e-12);
+        let dir = families::heading(p["heading_rad"]);
+        let landing = &spec.bodies[0];
+        let edge = families::ahead(
+            [landing.position[0], landing.position[1]],
+            dir,
+            p["landing_half_m"],
+        );
+        let along = |q: [f64; 3]| (q[0] - edge[0]) * dir[0] + (q[1] - edge[1]) * dir[1];
+        let sim = plain(&spec);
+        let k = (0..=sim.steps())
+            .find(|&k| along(sim.hazard_com(k)) >= 0.0)
+            .expect("the ball goes over the top edge");
+        let crossed = k as f64 * sim.dt;
+        assert!(
+            (crossed - t).abs() <= 0.02,
+            "{} m/s: crossed at {crossed} s, timed for {t} s",
+            spec.speed_value
+        );
+        assert!(crossed >= earliest - 0.02);
+        crossings.push(crossed);
+    }
+    println!("stair_tumble ball crosses the top edge at {crossings:?} s");
+}
+
 #[test]
 fn chain_reaction_target_rests_until_struck_then_moves() {
     for r in scenes("chain_reaction", 4) {

@@ -9,6 +9,13 @@
 //! stands `OBSERVER_GAP_M` or more beyond the bottom step, outside the reach of anything
 //! still on the stairs: what reaches them rolls or slides that gap across the floor after
 //! Δ + 0.2 s, and what the floor's friction stops first never does.
+//!
+//! Timed (label rule v5): a ball aimed at the hands rolls over a longer landing, starting
+//! `v·t` behind its top edge, so every band goes over the edge after the same drawn time
+//! `t` (`EDGE_S`, 0.85–1.0 s): even the fastest band then bounds over the lower steps,
+//! within the hands' reach, after Δ plus the reaction time. `aim` stands the observer
+//! where it comes off the bottom step (`[aim.meet_height_by_family]`), and the label
+//! rule's interception finds where the hands take it.
 
 use super::launch::*;
 use super::*;
@@ -17,6 +24,10 @@ pub struct StairTumble;
 
 /// The slowest band still moves this fast as it goes over the top edge (m/s).
 const LEAVE_SPEED: f64 = 0.8;
+/// Timed groups: when every band's ball goes over the top edge (s after t0): late enough
+/// that even the fastest band, flying over the flight, is still above the lower steps
+/// within the hands' reach after Δ plus the reaction time.
+pub const EDGE_S: [f64; 2] = [0.85, 1.0];
 /// Least floor distance between the bottom step and the observer (m).
 pub const OBSERVER_GAP_M: f64 = 2.1;
 
@@ -27,6 +38,10 @@ impl Family for StairTumble {
             speed_parameter: "push_speed_mps",
             speed_sweep: true,
         }
+    }
+
+    fn timed(&self) -> bool {
+        true
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
@@ -43,18 +58,18 @@ impl Family for StairTumble {
         let relative_yaw = uniform(rng, -0.2, 0.2);
         let rolling = is_single_sphere(object);
         let overshoot = uniform(rng, 0.8, 1.2);
-        let com_to_edge = if rolling {
+        let mu = combined_friction(object.friction, friction);
+        let slowest = input
+            .band_speeds
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        let half_len = footprint_half_length(object, 0.0);
+        let untimed_com_to_edge = if rolling {
             0.05 + 0.15 * (overshoot - 0.8) / 0.4
         } else {
             // Where the slowest band, sliding, would still move at LEAVE_SPEED with its
             // centre `overshoot` half-lengths past the edge: it goes over with momentum.
-            let mu = combined_friction(object.friction, friction);
-            let slowest = input
-                .band_speeds
-                .iter()
-                .copied()
-                .fold(f64::INFINITY, f64::min);
-            let half_len = footprint_half_length(object, 0.0);
             let run_up =
                 (slowest * slowest - LEAVE_SPEED * LEAVE_SPEED).max(0.0) / (2.0 * mu * GRAVITY);
             (run_up - overshoot * half_len).clamp(-0.4 * half_len, 0.25)
@@ -63,19 +78,35 @@ impl Family for StairTumble {
         let gap_near = uniform(rng, OBSERVER_GAP_M, OBSERVER_GAP_M + 0.4);
         let gap_far = uniform(rng, OBSERVER_GAP_M + 1.4, OBSERVER_GAP_M + 1.8);
         let side = uniform(rng, -0.3, 0.3);
+        let t_edge = uniform(rng, EDGE_S[0], EDGE_S[1]);
+        // Timed (label rule v5, see the module doc): a ball aimed at the hands keeps its
+        // push over the landing (it rolls), so it starts `v·t_edge` back from the top
+        // edge and every band goes over it at the drawn time.
+        let timed = rolling && input.intent == crate::intent::Intent::Hands && !input.far_observer;
+        let com_to_edge = if timed {
+            input.speed * t_edge
+        } else {
+            untimed_com_to_edge
+        };
+        let longest_run_up = if timed {
+            input.band_speeds.iter().copied().fold(0.0, f64::max) * t_edge
+        } else {
+            0.0
+        };
+        let landing_half = (0.5 * (longest_run_up + half_len + 0.05)).max(0.35);
         let gap = if input.far_observer {
             gap_far
         } else {
             gap_near
         };
-        let length = (0.7 + flight + gap).min(room_span(room, dir, 0.55));
-        let origin = ahead(span_start(rng, room, dir, length, 0.55), dir, 0.35);
+        let length = (2.0 * landing_half + flight + gap).min(room_span(room, dir, 0.55));
+        let origin = ahead(span_start(rng, room, dir, length, 0.55), dir, landing_half);
 
         let top_height = steps as f64 * rise;
         let landing = EdgeLaunch {
             surface_name: "landing",
             surface_height: top_height,
-            surface_half: [0.35, half_width],
+            surface_half: [landing_half, half_width],
             surface_friction: friction,
             heading_angle,
             com_to_edge,
@@ -103,11 +134,21 @@ impl Family for StairTumble {
         }
         let hazard = bodies.len() - 1;
         let foot = ahead(edge, dir, flight);
-        let obs = ahead(ahead(foot, dir, length - 0.7 - flight), left_of(dir), side);
+        let obs = ahead(
+            ahead(foot, dir, length - 2.0 * landing_half - flight),
+            left_of(dir),
+            side,
+        );
         let observer = ObserverPose {
             x: obs[0],
             y: obs[1],
-            yaw: (start[1] - obs[1]).atan2(start[0] - obs[0]),
+            // Facing the hazard's start; a timed ball's start follows from the speed, so
+            // facing the top edge.
+            yaw: if timed {
+                (edge[1] - obs[1]).atan2(edge[0] - obs[0])
+            } else {
+                (start[1] - obs[1]).atan2(start[0] - obs[0])
+            },
         };
         Layout {
             bodies,
@@ -122,6 +163,8 @@ impl Family for StairTumble {
                 ("top_height_m".into(), top_height),
                 ("com_behind_edge_m".into(), com_to_edge),
                 ("heading_rad".into(), heading_angle),
+                ("landing_half_m".into(), landing_half),
+                ("edge_time_s".into(), if timed { t_edge } else { 0.0 }),
             ]),
         }
     }
@@ -141,7 +184,8 @@ pub fn step_crossing_heights(spec: &SceneSpec, sim: &Simulation) -> Vec<f64> {
     let p = &spec.family_params;
     let dir = heading(p["heading_rad"]);
     let landing = &spec.bodies[0];
-    let edge = ahead([landing.position[0], landing.position[1]], dir, 0.35);
+    let half = p.get("landing_half_m").copied().unwrap_or(0.35);
+    let edge = ahead([landing.position[0], landing.position[1]], dir, half);
     let along = |q: [f64; 3]| (q[0] - edge[0]) * dir[0] + (q[1] - edge[1]) * dir[1];
     let mut out = Vec::new();
     let steps = p["steps"] as usize;
