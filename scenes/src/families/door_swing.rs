@@ -7,18 +7,18 @@
 //! edge does: `J·w = I_hinge·ω`, `ω = v/w`, with `I_hinge = m(w² + t²)/12 + m(w/2)²`; the
 //! spec records `I_hinge` and the impulse. The observer stands inside the swing.
 //!
-//! Timing (label rule v5, self-aimed and timed): the observer stands within the door's
-//! width (its torso axis 0.75–0.92 w + 0.1 m from the hinge, so the fast outer part of the
-//! face strikes), at a bearing where every band's door face reaches the torso at the same
-//! drawn time after Δ + the reaction minimum (`MEET_S`): a band's door starts `ω·t` before
-//! that bearing, so a faster band starts farther back — through the doorway on the jamb's
-//! side when it must (a swing door, up to `MAX_BACK_SWING`). The aim's meeting point of
+//! Timing (label rule v5, self-aimed): the observer stands within the door's width (its
+//! torso axis 0.75–0.92 w + 0.1 m from the hinge, so the fast outer part of the face
+//! strikes), at a bearing the fastest band's door face reaches at a drawn time after
+//! Δ + the reaction minimum (`MEET_S`), slower bands later: the door starts `ω·t` before
+//! that bearing — through the doorway on the jamb's side when it must (a swing door, up
+//! to `MAX_BACK_SWING`). The aim's meeting point of
 //! the door's centre would stand the observer at half the width, where the face moves at
 //! half the edge speed and touches the hand below the harm limits. A door too narrow to
 //! reach the torso (a cabinet door) or too fast to time has its observer out of reach.
 //!
 //! Labels (rule v5): DODGE when the face's strike harms the standing body (the hand it
-//! meets first, mostly: ≥ ~1.8 m/s at the contact for a 4 kg screen door, less for heavy
+//! meets first, mostly: ≥ ~1.8 m/s at the edge for a 4 kg screen door, less for heavy
 //! doors), else NO_ACTION; never CATCH (no door fits in the arms).
 
 use super::*;
@@ -36,18 +36,19 @@ pub const MAX_BEARING: f64 = 2.75;
 /// The door may start at most this far (rad) through the doorway on the other side of
 /// its closed position (a double-acting door), clear of the jamb post.
 pub const MAX_BACK_SWING: f64 = 1.5;
-/// When every band's door face meets the torso (s after t0): after Δ + the reaction
-/// minimum (0.8 s) with a margin.
+/// When the fastest band's door face meets the torso (s after t0): after Δ + the
+/// reaction minimum (0.8 s) with a margin; slower bands meet later.
 pub const MEET_S: [f64; 2] = [1.0, 1.15];
 /// A door too fast to meet the observer this late (s) is not timed.
 pub const EARLIEST_MEET_S: f64 = 0.95;
 /// The observer's torso radius (m).
 const TORSO_RADIUS: f64 = 0.18;
 
-/// Where a group's door meets its observer (label rule v5, timed): the observer's
-/// bearing from the closed position and the time every band's door face reaches the
-/// torso; a band's door starts `ω·t` before that bearing (`ω = v/w`), so a faster band
-/// starts farther back — on the far side of the doorway when it has to (a swing door).
+/// Where a group's door meets its observer (label rule v5): the observer's bearing from
+/// the closed position and the time the fastest band's door face reaches the torso; the
+/// door starts `ω·t` before that bearing (`ω = v/w` of the fastest band, the same start in
+/// every band, so slower bands meet later) — on the far side of the doorway when it has
+/// to (a swing door).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DoorTiming {
     pub width: f64,
@@ -55,6 +56,8 @@ pub struct DoorTiming {
     pub half_width: f64,
     pub bearing: f64,
     pub meet_time: f64,
+    /// The fastest band's angular speed (rad/s).
+    pub fastest: f64,
     /// Whether the fastest band can be timed (else the observer stands out of reach).
     pub in_reach: bool,
 }
@@ -78,9 +81,10 @@ impl DoorTiming {
             .iter()
             .fold(f64::INFINITY, |a: f64, &b| a.min(b))
             / width;
-        // The fastest band must start no farther back than MAX_BACK_SWING (sooner, when
-        // the drawn time is too long for that); the slowest at least a little open past
-        // its closed position (so it swings through).
+        // The door must start no farther back than MAX_BACK_SWING (the fastest band
+        // meeting sooner, when the drawn time is too long for that); the bearing is at
+        // least what keeps the start on the opening side when the slowest band's sweep
+        // allows (fewer starts through the doorway).
         let meet_time = meet_time
             .min((MAX_BEARING + MAX_BACK_SWING - half_width) / fastest)
             .max(EARLIEST_MEET_S);
@@ -94,15 +98,17 @@ impl DoorTiming {
             half_width,
             bearing,
             meet_time,
+            fastest,
             in_reach: radius < width + TORSO_RADIUS && least <= most && half_width < 1.2,
         }
     }
 
-    /// A band's starting angle from the closed position (rad; negative: through the
-    /// doorway on the other side).
-    pub fn start_angle(&self, speed: f64) -> f64 {
+    /// The door's starting angle from the closed position, the same in every band (rad;
+    /// negative: through the doorway on the other side): the fastest band's face reaches
+    /// the torso at `meet_time`, slower ones later.
+    pub fn start_angle(&self) -> f64 {
         if self.in_reach {
-            self.bearing - self.half_width - speed / self.width * self.meet_time
+            self.bearing - self.half_width - self.fastest * self.meet_time
         } else {
             0.2
         }
@@ -120,6 +126,11 @@ impl Family for DoorSwing {
 
     fn self_aimed(&self) -> bool {
         true
+    }
+
+    /// The door starts at the same angle in every band (only its speed differs).
+    fn timed(&self) -> bool {
+        false
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
@@ -150,7 +161,7 @@ impl Family for DoorSwing {
             width / 2.0 + 1.35
         };
         let obs_angle = timing.bearing;
-        let open0 = timing.start_angle(input.speed);
+        let open0 = timing.start_angle();
         let obs_dir = heading(closed_angle + sign * obs_angle);
         let hinge = event_origin(rng, input.room, obs_dir, 0.6 + far_shift(input));
 
@@ -246,12 +257,12 @@ mod tests {
     use super::*;
 
     /// A 0.9 m door, observer 0.8 m from the hinge: every band's face reaches the torso
-    /// at the same time, after Δ (0.6 s) + the reaction minimum (0.2 s), still swinging at
-    /// its band's speed (no damping on the hinge) — at least 1 m/s where it meets the
-    /// body's near side even in the slowest band; the fastest starts no farther back
-    /// than the swing door allows.
+    /// after Δ (0.6 s) + the reaction minimum (0.2 s), the fastest at the drawn time,
+    /// still swinging at its band's speed (no damping on the hinge) — at least 1 m/s where
+    /// it meets the body's near side even in the slowest band; the door starts no farther
+    /// back than the swing door allows.
     #[test]
-    fn every_band_meets_the_observer_at_the_same_time_after_the_reaction_time() {
+    fn every_band_meets_the_observer_after_the_reaction_time() {
         let bands = [1.5, 1.7, 1.85, 2.0];
         let (w, radius) = (0.9, 0.8);
         for (share, meet) in [(0.0, 1.0), (0.5, 1.1), (0.99, 1.15)] {
@@ -259,14 +270,20 @@ mod tests {
             assert!(t.in_reach, "{t:?}");
             assert!(t.meet_time >= 0.95 && t.meet_time > 0.6 + 0.2);
             assert!(t.bearing <= MAX_BEARING);
+            let start = t.start_angle();
+            assert!(start >= -MAX_BACK_SWING - 1e-9, "{start}");
             for v in bands {
-                let start = t.start_angle(v);
-                assert!(start >= -MAX_BACK_SWING - 1e-9, "{v}: {start}");
                 let omega = v / w;
-                let reached = start + omega * t.meet_time + t.half_width;
-                assert!((reached - t.bearing).abs() < 1e-9);
+                // When the face reaches the torso's angular edge.
+                let meets = (t.bearing - t.half_width - start) / omega;
+                assert!(
+                    meets >= t.meet_time - 1e-9 && meets > 0.6 + 0.2,
+                    "{v}: {meets}"
+                );
                 assert!(omega * (radius - TORSO_RADIUS) >= 1.0);
             }
+            let fastest = (t.bearing - t.half_width - start) / (2.0 / w);
+            assert!((fastest - t.meet_time).abs() < 1e-9);
         }
         // A cabinet door at these speeds would have to start beyond the doorway: its
         // observer stands out of reach.
