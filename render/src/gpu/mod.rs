@@ -44,6 +44,9 @@ pub struct ViewJob {
     pub dynamic: Range<u32>,
 }
 
+/// How far (pixels) the post-process pass reads around an output pixel.
+pub const POST_REACH: u32 = post::REACH;
+
 /// Most rectangles one overlay view redraws (more are merged by the caller).
 pub const MAX_REDRAW_RECTS: usize = 32;
 
@@ -56,9 +59,10 @@ pub struct OverlayJob {
     pub uniforms: Uniforms,
     pub redraw: Vec<([u32; 4], Vec<Range<u32>>)>,
     pub dynamic: Range<u32>,
-    /// A rectangle (x, y, width, height) holding every pixel that may differ from the
-    /// static image (the redraws and the moving bodies); `None`: none.
-    pub changed: Option<[u32; 4]>,
+    /// Rectangles (x, y, width, height) holding every pixel within `POST_REACH` of one
+    /// that may differ from the static image (the redraws and the moving bodies): where
+    /// the post-process pass is redone. Empty: nothing changed.
+    pub post_rects: Vec<[u32; 4]>,
 }
 
 struct Target {
@@ -421,9 +425,8 @@ impl Gpu {
                 // Anti-aliased: the static image's, redone around what changed.
                 (Some(post), Some(pt)) if lit(&v.uniforms) => {
                     copy_whole(&mut enc, &pt.cache, &pt.out);
-                    let grown = v.changed.and_then(|r| grow(r, post::REACH, t));
-                    if let Some(r) = grown {
-                        post.encode(&mut enc, pt, Some(r));
+                    if !v.post_rects.is_empty() {
+                        post.encode(&mut enc, pt, Some(&v.post_rects));
                     }
                     Self::copy_texture_to_readback(&mut enc, t, &pt.out);
                 }
@@ -680,14 +683,6 @@ fn union(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
         (a[1] + a[3]).max(b[1] + b[3]),
     );
     [x0, y0, x1 - x0, y1 - y0]
-}
-
-/// `r` grown by `by` pixels on every side, clamped to the target (`None` if empty).
-fn grow([x, y, w, h]: [u32; 4], by: u32, t: &Target) -> Option<[u32; 4]> {
-    let (x0, y0) = (x.saturating_sub(by), y.saturating_sub(by));
-    let x1 = (x + w + by).min(t.width);
-    let y1 = (y + h + by).min(t.height);
-    (x1 > x0 && y1 > y0).then_some([x0, y0, x1 - x0, y1 - y0])
 }
 
 /// Whether a view is shaded for the dataset (not an unlit diagnostic: `ambient.w`).
