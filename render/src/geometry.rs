@@ -8,7 +8,7 @@ use super::lighting::Lighting;
 use super::mesh::*;
 use super::observer::observer_mesh;
 use super::recipes;
-use super::regions::{bounds, rects_meet, screen_rect, shadow_regions};
+use super::regions::{bounds, cover, rects_meet, screen_rect, shadow_regions};
 use super::tiles::SurfaceTiles;
 use super::Shading;
 use rh_catalog::Catalog;
@@ -342,25 +342,28 @@ impl SceneGeometry {
         .collect()
     }
 
-    /// One rectangle (x, y, width, height) holding every pixel of view `v` that may
-    /// differ from its static image: the moving bodies' screen bounds (`moving`) and
-    /// the `redraw` rectangles. `None` when nothing can differ.
-    pub(super) fn changed_rect(
+    /// Rectangles (x, y, width, height; at most `MAX_REDRAW_RECTS`) where view `v`'s
+    /// post-process pass must be redone: every pixel within `gpu::POST_REACH` of one
+    /// that may differ from the static image (the moving bodies' screen bounds, `moving`,
+    /// and the `redraw` rectangles), on a 16-pixel grid. Empty when nothing can differ.
+    pub(super) fn post_rects(
         &self,
         v: &FixedView,
         moving: [Vec3; 2],
         redraw: &[([u32; 4], Vec<Range<u32>>)],
-    ) -> Option<[u32; 4]> {
-        screen_rect(v.cam, v.view.as_ref(), moving)
+    ) -> Vec<[u32; 4]> {
+        let changed: Vec<[u32; 4]> = screen_rect(v.cam, v.view.as_ref(), moving)
             .into_iter()
             .chain(redraw.iter().map(|(r, _)| *r))
-            .filter(|r| r[2] > 0 && r[3] > 0)
-            .reduce(|a, b| {
-                let (x0, y0) = (a[0].min(b[0]), a[1].min(b[1]));
-                let x1 = (a[0] + a[2]).max(b[0] + b[2]);
-                let y1 = (a[1] + a[3]).max(b[1] + b[3]);
-                [x0, y0, x1 - x0, y1 - y0]
-            })
+            .collect();
+        cover(
+            &changed,
+            gpu::POST_REACH,
+            16,
+            v.cam.width,
+            v.cam.height,
+            gpu::MAX_REDRAW_RECTS,
+        )
     }
 
     /// Fixed bodies and the observer: the shadow casters that never move.

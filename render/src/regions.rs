@@ -183,6 +183,36 @@ fn cover_with_tiles(rects: &[[u32; 4]], width: u32, height: u32) -> Vec<[u32; 4]
     runs_to_rects(&marked, cols, rows, REDRAW_TILE, width, height)
 }
 
+/// Rectangles (pixels; at most `max`, possibly overlapping) covering every `cell`-pixel
+/// grid cell that meets one of `rects` (x, y, width, height) grown by `grow` pixels on
+/// each side, in a `width` × `height` frame: where a pass that reads `grow` pixels
+/// around each output pixel must be redone when `rects` changed. Much less than their
+/// bounding rectangle when they are scattered (a falling body and its shadow).
+pub(super) fn cover(
+    rects: &[[u32; 4]],
+    grow: u32,
+    cell: u32,
+    width: u32,
+    height: u32,
+    max: usize,
+) -> Vec<[u32; 4]> {
+    let (cols, rows) = (width.div_ceil(cell), height.div_ceil(cell));
+    let mut marked = vec![false; (cols * rows) as usize];
+    for &[x, y, w, h] in rects.iter().filter(|r| r[2] > 0 && r[3] > 0) {
+        let (c0, r0) = (x.saturating_sub(grow) / cell, y.saturating_sub(grow) / cell);
+        let c1 = (x + w + grow).min(width).div_ceil(cell);
+        let r1 = (y + h + grow).min(height).div_ceil(cell);
+        for ty in r0..r1 {
+            for tx in c0..c1 {
+                marked[(ty * cols + tx) as usize] = true;
+            }
+        }
+    }
+    let mut out = runs_to_rects(&marked, cols, rows, cell, width, height);
+    merge_rects(&mut out, max);
+    out
+}
+
 /// Rectangles (pixels) covering the marked tiles (`cols` × `rows`, row-major, side
 /// `tile`): each tile row's runs, runs with the same span in consecutive rows stacked
 /// into one rectangle.

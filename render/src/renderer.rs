@@ -326,13 +326,15 @@ impl Renderer {
         let redraw = moving
             .map(|m| scene.shadow_redraws(view, m))
             .unwrap_or_default();
-        let changed = moving.and_then(|m| scene.changed_rect(view, m, &redraw));
+        let post_rects = moving
+            .map(|m| scene.post_rects(view, m, &redraw))
+            .unwrap_or_default();
         let job = OverlayJob {
             slot: view.slot,
             uniforms: view.uniforms,
             redraw,
             dynamic: dyn_range.clone(),
-            changed,
+            post_rects,
         };
         let mut images =
             self.gpu

@@ -44,6 +44,9 @@ pub struct ViewJob {
     pub dynamic: Range<u32>,
 }
 
+/// How far (pixels) the post-process pass reads around an output pixel.
+pub const POST_REACH: u32 = post::REACH;
+
 /// Most rectangles one overlay view redraws (more are merged by the caller).
 pub const MAX_REDRAW_RECTS: usize = 32;
 
@@ -56,9 +59,10 @@ pub struct OverlayJob {
     pub uniforms: Uniforms,
     pub redraw: Vec<([u32; 4], Vec<Range<u32>>)>,
     pub dynamic: Range<u32>,
-    /// A rectangle (x, y, width, height) holding every pixel that may differ from the
-    /// static image (the redraws and the moving bodies); `None`: none.
-    pub changed: Option<[u32; 4]>,
+    /// Rectangles (x, y, width, height) holding every pixel within `POST_REACH` of one
+    /// that may differ from the static image (the redraws and the moving bodies): where
+    /// the post-process pass is redone. Empty: nothing changed.
+    pub post_rects: Vec<[u32; 4]>,
 }
 
 struct Target {
@@ -421,9 +425,8 @@ impl Gpu {
                 // Anti-aliased: the static image's, redone around what changed.
                 (Some(post), Some(pt)) if lit(&v.uniforms) => {
                     copy_whole(&mut enc, &pt.cache, &pt.out);
-                    let grown = v.changed.and_then(|r| grow(r, post::REACH, t));
-                    if let Some(r) = grown {
-                        post.encode(&mut enc, pt, Some(r));
+                    if !v.post_rects.is_empty() {
+                        post.encode(&mut enc, pt, Some(&v.post_rects));
                     }
                     Self::copy_texture_to_readback(&mut enc, t, &pt.out);
                 }
@@ -572,14 +575,21 @@ impl Gpu {
             pass.set_scissor_rect(x, y, w, h);
             pass.draw(0..6, i as u32..i as u32 + 1);
         }
-        // Then every static piece any rectangle needs, once, in draw order, over their
-        // bounding rectangle: outside the re-cleared pixels the copied-in depth equals
-        // the static surface's, which `Less` rejects, so those pixels keep their image
-        // (drawing per rectangle ran the vertex work of a piece once per rectangle).
-        let mut statics: Vec<&Range<u32>> = rects.iter().flat_map(|(_, s)| s.iter()).collect();
-        statics.sort_by_key(|r| (r.start, r.end));
-        statics.dedup();
-        if let Some([x, y, w, h]) = rects.iter().map(|(r, _)| *r).reduce(union) {
+        // Then every static piece a group of nearby rectangles needs, once per group, in
+        // draw order, over the group's bounding rectangle: outside the re-cleared pixels
+        // the copied-in depth equals the static surface's, which `Less` rejects, so those
+        // pixels keep their image (drawing per rectangle ran the vertex work of a piece
+        // once per rectangle; one bounding rectangle for all made lavapipe depth-test
+        // every pixel between scattered rectangles). The groups' rectangles are
+        // disjoint, so each pixel sees its pieces in the whole frame's order.
+        for group in redraw_groups(rects, MAX_REDRAW_GROUPS) {
+            let mut statics: Vec<&Range<u32>> =
+                group.iter().flat_map(|&i| rects[i].1.iter()).collect();
+            statics.sort_by_key(|r| (r.start, r.end));
+            statics.dedup();
+            let Some([x, y, w, h]) = group.iter().map(|&i| rects[i].0).reduce(union) else {
+                continue;
+            };
             pass.set_scissor_rect(x, y, w, h);
             pass.set_pipeline(&self.main);
             for r in statics.into_iter().filter(|r| !r.is_empty()) {
@@ -672,6 +682,47 @@ impl Target {
     }
 }
 
+/// Most groups of redraw rectangles whose static pieces are drawn together.
+const MAX_REDRAW_GROUPS: usize = 4;
+
+/// Groups of `rects` (indices) with disjoint bounding rectangles, at most `max` (unless
+/// overlaps force fewer): starting from one group per rectangle, overlapping groups are
+/// merged, then the pair whose merge adds the least area while more than `max` remain
+/// or a merge adds none.
+fn redraw_groups(rects: &[([u32; 4], &[Range<u32>])], max: usize) -> Vec<Vec<usize>> {
+    let mut groups: Vec<(Vec<usize>, [u32; 4])> = rects
+        .iter()
+        .enumerate()
+        .map(|(i, (r, _))| (vec![i], *r))
+        .collect();
+    let area = |r: [u32; 4]| r[2] as u64 * r[3] as u64;
+    let meet = |a: [u32; 4], b: [u32; 4]| {
+        a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3]
+    };
+    loop {
+        // (overlapping first, then least added area, i, j)
+        let mut best: Option<(bool, i64, usize, usize)> = None;
+        for i in 0..groups.len() {
+            for j in i + 1..groups.len() {
+                let (a, b) = (groups[i].1, groups[j].1);
+                let added = area(union(a, b)) as i64 - area(a) as i64 - area(b) as i64;
+                let key = (!meet(a, b), added);
+                if best.is_none_or(|(o, d, _, _)| key < (o, d)) {
+                    best = Some((key.0, added, i, j));
+                }
+            }
+        }
+        match best {
+            Some((disjoint, added, i, j)) if !disjoint || added <= 0 || groups.len() > max => {
+                let (members, r) = groups.swap_remove(j);
+                groups[i].0.extend(members);
+                groups[i].1 = union(groups[i].1, r);
+            }
+            _ => return groups.into_iter().map(|(g, _)| g).collect(),
+        }
+    }
+}
+
 /// The bounding rectangle of two (x, y, width, height).
 fn union(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
     let (x0, y0) = (a[0].min(b[0]), a[1].min(b[1]));
@@ -680,14 +731,6 @@ fn union(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
         (a[1] + a[3]).max(b[1] + b[3]),
     );
     [x0, y0, x1 - x0, y1 - y0]
-}
-
-/// `r` grown by `by` pixels on every side, clamped to the target (`None` if empty).
-fn grow([x, y, w, h]: [u32; 4], by: u32, t: &Target) -> Option<[u32; 4]> {
-    let (x0, y0) = (x.saturating_sub(by), y.saturating_sub(by));
-    let x1 = (x + w + by).min(t.width);
-    let y1 = (y + h + by).min(t.height);
-    (x1 > x0 && y1 > y0).then_some([x0, y0, x1 - x0, y1 - y0])
 }
 
 /// Whether a view is shaded for the dataset (not an unlit diagnostic: `ambient.w`).

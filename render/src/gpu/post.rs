@@ -190,13 +190,13 @@ impl Post {
     }
 
     /// Encodes the pass: the target's resolved frame, anti-aliased, into `t.out` —
-    /// everywhere, or only inside `rect` (x, y, width, height; the rest of `t.out` is
-    /// kept).
+    /// everywhere, or only inside `rects` (x, y, width, height; they may overlap; the
+    /// rest of `t.out` is kept).
     pub(super) fn encode(
         &self,
         enc: &mut wgpu::CommandEncoder,
         t: &PostTarget,
-        rect: Option<[u32; 4]>,
+        rects: Option<&[[u32; 4]]>,
     ) {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("fxaa"),
@@ -205,7 +205,7 @@ impl Post {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: if rect.is_some() {
+                    load: if rects.is_some() {
                         wgpu::LoadOp::Load
                     } else {
                         wgpu::LoadOp::Clear(wgpu::Color::BLACK)
@@ -227,12 +227,21 @@ impl Post {
             multiview_mask: None,
         });
         pass.set_bind_group(0, &t.bind, &[]);
-        if let Some([x, y, w, h]) = rect {
-            pass.set_scissor_rect(x, y, w, h);
-        }
+        let size = t.out.size();
+        let whole = [[0, 0, size.width, size.height]];
+        let rects = rects.unwrap_or(&whole);
+        // Every mark before any blend: a rectangle's mark pass would otherwise copy over
+        // blended edges of an overlapping one. Both passes read only the source, so
+        // overlapping rectangles write the same values twice.
         pass.set_pipeline(&self.mark);
-        pass.draw(0..3, 0..1);
+        for &[x, y, w, h] in rects {
+            pass.set_scissor_rect(x, y, w, h);
+            pass.draw(0..3, 0..1);
+        }
         pass.set_pipeline(&self.edge);
-        pass.draw(0..3, 0..1);
+        for &[x, y, w, h] in rects {
+            pass.set_scissor_rect(x, y, w, h);
+            pass.draw(0..3, 0..1);
+        }
     }
 }
