@@ -203,6 +203,7 @@ pub fn label_balance(
         ..config.eval.clone()
     };
     let mut out = Vec::new();
+    let mut built_families: Vec<(FamilyBalance, Vec<PoolScene>)> = Vec::new();
     for family in &wanted {
         let index = all
             .iter()
@@ -233,7 +234,7 @@ pub fn label_balance(
             pool_twin_pairs_differing: 0,
             adversarial_objects: Vec::new(),
         };
-        let mut scenes = Vec::new();
+        let mut scenes: Vec<PoolScene> = Vec::new();
         for result in built {
             let (results, rejections) = result?;
             balance.attempts += rejections.attempts;
@@ -263,46 +264,71 @@ pub fn label_balance(
                 ));
             }
         }
-        let rows: Vec<EvalRow> = scenes
-            .iter()
-            .map(|&(scene_index, valid, action, twin)| EvalRow {
-                family,
-                scene_index,
-                valid,
-                action: action.as_str(),
-                twin,
-            })
-            .collect();
-        let chosen = crate::eval_subset::select(&rows, &eval_cfg).0;
-        for &i in &chosen {
-            match scenes[i].2 {
-                Action::Catch => balance.catch += 1,
-                Action::Dodge => balance.dodge += 1,
-                Action::NoAction => balance.no_action += 1,
-            }
-        }
-        // Twin pairs, counted once (from the lower index), both scenes valid.
-        let at: std::collections::BTreeMap<u64, usize> =
-            scenes.iter().enumerate().map(|(i, s)| (s.0, i)).collect();
-        for (i, &(index, valid, action, twin)) in scenes.iter().enumerate() {
-            let Some(&j) = twin.filter(|&t| t > index).and_then(|t| at.get(&t)) else {
-                continue;
-            };
-            if !(valid && scenes[j].1) {
-                continue;
-            }
-            let differ = usize::from(action != scenes[j].2);
-            balance.pool_twin_pairs += 1;
-            balance.pool_twin_pairs_differing += differ;
-            if chosen.contains(&i) && chosen.contains(&j) {
-                balance.twin_pairs += 1;
-                balance.twin_pairs_differing += differ;
-            }
-        }
         balance.adversarial_objects.sort();
+        built_families.push((balance, scenes));
+    }
+    // One subset over every family (the NO_ACTION fill is a share of the whole subset),
+    // exactly as the dataset's `eval` config chooses it.
+    let rows: Vec<EvalRow> = built_families
+        .iter()
+        .flat_map(|(balance, scenes)| {
+            scenes
+                .iter()
+                .map(|&(scene_index, valid, action, twin)| EvalRow {
+                    family: balance.family.as_str(),
+                    scene_index,
+                    valid,
+                    action: action.as_str(),
+                    twin,
+                })
+        })
+        .collect();
+    let chosen_rows = crate::eval_subset::select(&rows, &eval_cfg).0;
+    let mut start = 0;
+    for (mut balance, scenes) in built_families {
+        let end = start + scenes.len();
+        let chosen: Vec<usize> = chosen_rows
+            .iter()
+            .filter(|&&r| (start..end).contains(&r))
+            .map(|&r| r - start)
+            .collect();
+        start = end;
+        count_subset(&mut balance, &scenes, &chosen);
         out.push(balance);
     }
     Ok(out)
+}
+
+/// A family's pool scenes: (scene index, valid, label, twin's scene index).
+type PoolScene = (u64, bool, Action, Option<u64>);
+
+/// Counts the labels and twin pairs of a family's chosen scenes (indices into `scenes`).
+fn count_subset(balance: &mut FamilyBalance, scenes: &[PoolScene], chosen: &[usize]) {
+    for &i in chosen {
+        match scenes[i].2 {
+            Action::Catch => balance.catch += 1,
+            Action::Dodge => balance.dodge += 1,
+            Action::NoAction => balance.no_action += 1,
+        }
+    }
+    // Twin pairs, counted once (from the lower index), both scenes valid.
+    let at: std::collections::BTreeMap<u64, usize> =
+        scenes.iter().enumerate().map(|(i, s)| (s.0, i)).collect();
+    for (i, &(index, valid, action, twin)) in scenes.iter().enumerate() {
+        let Some(&j) = twin.filter(|&t| t > index).and_then(|t| at.get(&t)) else {
+            continue;
+        };
+        if !(valid && scenes[j].1) {
+            continue;
+        }
+        let differ = usize::from(action != scenes[j].2);
+        balance.pool_twin_pairs += 1;
+        balance.pool_twin_pairs_differing += differ;
+        if chosen.contains(&i) && chosen.contains(&j) {
+            balance.twin_pairs += 1;
+            balance.twin_pairs_differing += differ;
+        }
+    }
 }
 
 /// The balance as a plain-text table: label counts, then the group attempts made and
