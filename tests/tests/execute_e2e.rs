@@ -143,8 +143,9 @@ fn oracle_plans_catch_and_never_get_struck_dodging() {
         catch >= 20,
         "too few CATCH scenes ({catch}) for the test to mean anything"
     );
+    // Issue #23's target on an unseen seed: >= 95% (measured: 124 of 128).
     assert!(
-        caught as f64 >= 0.9 * catch as f64,
+        caught as f64 >= 0.95 * catch as f64,
         "oracle caught only {caught}/{catch}"
     );
     assert_eq!(
@@ -204,14 +205,13 @@ fn freeze_is_struck_exactly_where_the_label_says_danger() {
         "freeze: struck {danger_struck}/{danger} danger_present, {safe_struck}/{safe} others"
     );
     assert!(danger >= 20 && safe >= 20, "{danger} / {safe} scenes");
+    // Issue #23: harmed on >= 95% of danger_present scenes and on none of the others
+    // (measured: 150 of 151, 0 of 186).
     assert!(
-        danger_struck as f64 >= 0.9 * danger as f64,
+        danger_struck as f64 >= 0.95 * danger as f64,
         "struck {danger_struck}/{danger}"
     );
-    assert!(
-        (safe - safe_struck) as f64 >= 0.9 * safe as f64,
-        "struck {safe_struck}/{safe} safe"
-    );
+    assert_eq!(safe_struck, 0, "struck {safe_struck}/{safe} safe");
     let a = &report["execution"]["agreement"];
     assert_eq!(a["standing_danger"].as_u64().unwrap(), danger as u64);
     assert_eq!(
