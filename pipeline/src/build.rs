@@ -626,21 +626,12 @@ mod memory {
     /// system time.
     const MMAP_THRESHOLD: i32 = 2 << 20;
 
-    /// Free space at the top of the main heap kept instead of being returned at each
-    /// `free`: with the default (128 KiB, fixed once the mmap threshold is set) lavapipe's
-    /// per-frame memory was given back and faulted in again every frame (issue 27,
-    /// docs/benchmarks.md, "Render speed": ≈ 0.6 million minor faults and 2–5 system CPU-s
-    /// per 4-scene build, about half that with 64 MiB). `release_free_pages` still
-    /// returns it after each scene.
-    const TRIM_THRESHOLD: i32 = 64 << 20;
-
     pub fn large_buffers_mapped() {
         #[cfg(all(target_os = "linux", target_env = "gnu"))]
-        // SAFETY: mallopt only sets allocator parameters; M_MMAP_THRESHOLD and
-        // M_TRIM_THRESHOLD are valid for glibc (setting them turns its adjustment off).
+        // SAFETY: mallopt only sets an allocator parameter; M_MMAP_THRESHOLD is valid for
+        // glibc (setting it also turns its adjustment off).
         unsafe {
             libc::mallopt(libc::M_MMAP_THRESHOLD, MMAP_THRESHOLD);
-            libc::mallopt(libc::M_TRIM_THRESHOLD, TRIM_THRESHOLD);
         }
     }
 
