@@ -78,11 +78,12 @@ pub(super) fn merge_rects(rects: &mut Vec<[u32; 4]>, max: usize) {
     }
 }
 
-fn rect_area(r: [u32; 4]) -> u64 {
+pub(super) fn rect_area(r: [u32; 4]) -> u64 {
     r[2] as u64 * r[3] as u64
 }
 
-fn rect_union(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
+/// The bounding rectangle of two (x, y, width, height).
+pub(super) fn rect_union(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
     let (x0, y0) = (a[0].min(b[0]), a[1].min(b[1]));
     let (x1, y1) = (
         (a[0] + a[2]).max(b[0] + b[2]),
@@ -171,16 +172,32 @@ const REDRAW_TILE: u32 = 16;
 /// rectangle touches, take each tile row's runs, and stack runs with the same span in
 /// consecutive rows into one rectangle.
 fn cover_with_tiles(rects: &[[u32; 4]], width: u32, height: u32) -> Vec<[u32; 4]> {
-    let (cols, rows) = (width.div_ceil(REDRAW_TILE), height.div_ceil(REDRAW_TILE));
+    let (marked, cols, rows) = mark_cells(rects, 0, REDRAW_TILE, width, height);
+    runs_to_rects(&marked, cols, rows, REDRAW_TILE, width, height)
+}
+
+/// The `cell`-pixel grid cells (row-major, with the grid's columns and rows) of a
+/// `width` × `height` frame that meet one of `rects` grown by `grow` pixels on each side.
+fn mark_cells(
+    rects: &[[u32; 4]],
+    grow: u32,
+    cell: u32,
+    width: u32,
+    height: u32,
+) -> (Vec<bool>, u32, u32) {
+    let (cols, rows) = (width.div_ceil(cell), height.div_ceil(cell));
     let mut marked = vec![false; (cols * rows) as usize];
     for &[x, y, w, h] in rects {
-        for ty in y / REDRAW_TILE..(y + h).div_ceil(REDRAW_TILE).min(rows) {
-            for tx in x / REDRAW_TILE..(x + w).div_ceil(REDRAW_TILE).min(cols) {
+        let (c0, r0) = (x.saturating_sub(grow) / cell, y.saturating_sub(grow) / cell);
+        let c1 = (x + w + grow).min(width).div_ceil(cell);
+        let r1 = (y + h + grow).min(height).div_ceil(cell);
+        for ty in r0..r1 {
+            for tx in c0..c1 {
                 marked[(ty * cols + tx) as usize] = true;
             }
         }
     }
-    runs_to_rects(&marked, cols, rows, REDRAW_TILE, width, height)
+    (marked, cols, rows)
 }
 
 /// Rectangles (pixels; at most `max`, possibly overlapping) covering every `cell`-pixel
@@ -196,18 +213,12 @@ pub(super) fn cover(
     height: u32,
     max: usize,
 ) -> Vec<[u32; 4]> {
-    let (cols, rows) = (width.div_ceil(cell), height.div_ceil(cell));
-    let mut marked = vec![false; (cols * rows) as usize];
-    for &[x, y, w, h] in rects.iter().filter(|r| r[2] > 0 && r[3] > 0) {
-        let (c0, r0) = (x.saturating_sub(grow) / cell, y.saturating_sub(grow) / cell);
-        let c1 = (x + w + grow).min(width).div_ceil(cell);
-        let r1 = (y + h + grow).min(height).div_ceil(cell);
-        for ty in r0..r1 {
-            for tx in c0..c1 {
-                marked[(ty * cols + tx) as usize] = true;
-            }
-        }
-    }
+    let changed: Vec<[u32; 4]> = rects
+        .iter()
+        .copied()
+        .filter(|r| r[2] > 0 && r[3] > 0)
+        .collect();
+    let (marked, cols, rows) = mark_cells(&changed, grow, cell, width, height);
     let mut out = runs_to_rects(&marked, cols, rows, cell, width, height);
     merge_rects(&mut out, max);
     out

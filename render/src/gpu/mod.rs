@@ -8,6 +8,7 @@ mod ids;
 mod moving;
 
 use super::mesh::Vertex;
+use super::regions::{rect_area, rect_union, rects_meet};
 use super::RenderError;
 pub use ids::{IdImage, IdPass, IdView};
 pub use setup::probe_adapter;
@@ -587,7 +588,7 @@ impl Gpu {
                 group.iter().flat_map(|&i| rects[i].1.iter()).collect();
             statics.sort_by_key(|r| (r.start, r.end));
             statics.dedup();
-            let Some([x, y, w, h]) = group.iter().map(|&i| rects[i].0).reduce(union) else {
+            let Some([x, y, w, h]) = group.iter().map(|&i| rects[i].0).reduce(rect_union) else {
                 continue;
             };
             pass.set_scissor_rect(x, y, w, h);
@@ -695,18 +696,15 @@ fn redraw_groups(rects: &[([u32; 4], &[Range<u32>])], max: usize) -> Vec<Vec<usi
         .enumerate()
         .map(|(i, (r, _))| (vec![i], *r))
         .collect();
-    let area = |r: [u32; 4]| r[2] as u64 * r[3] as u64;
-    let meet = |a: [u32; 4], b: [u32; 4]| {
-        a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3]
-    };
     loop {
         // (overlapping first, then least added area, i, j)
         let mut best: Option<(bool, i64, usize, usize)> = None;
         for i in 0..groups.len() {
             for j in i + 1..groups.len() {
                 let (a, b) = (groups[i].1, groups[j].1);
-                let added = area(union(a, b)) as i64 - area(a) as i64 - area(b) as i64;
-                let key = (!meet(a, b), added);
+                let added =
+                    rect_area(rect_union(a, b)) as i64 - rect_area(a) as i64 - rect_area(b) as i64;
+                let key = (!rects_meet(a, b), added);
                 if best.is_none_or(|(o, d, _, _)| key < (o, d)) {
                     best = Some((key.0, added, i, j));
                 }
@@ -716,21 +714,11 @@ fn redraw_groups(rects: &[([u32; 4], &[Range<u32>])], max: usize) -> Vec<Vec<usi
             Some((disjoint, added, i, j)) if !disjoint || added <= 0 || groups.len() > max => {
                 let (members, r) = groups.swap_remove(j);
                 groups[i].0.extend(members);
-                groups[i].1 = union(groups[i].1, r);
+                groups[i].1 = rect_union(groups[i].1, r);
             }
             _ => return groups.into_iter().map(|(g, _)| g).collect(),
         }
     }
-}
-
-/// The bounding rectangle of two (x, y, width, height).
-fn union(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
-    let (x0, y0) = (a[0].min(b[0]), a[1].min(b[1]));
-    let (x1, y1) = (
-        (a[0] + a[2]).max(b[0] + b[2]),
-        (a[1] + a[3]).max(b[1] + b[3]),
-    );
-    [x0, y0, x1 - x0, y1 - y0]
 }
 
 /// Whether a view is shaded for the dataset (not an unlit diagnostic: `ambient.w`).

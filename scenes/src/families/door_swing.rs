@@ -51,7 +51,6 @@ const TORSO_RADIUS: f64 = 0.18;
 /// to (a swing door).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DoorTiming {
-    pub width: f64,
     /// The torso's angular half-width seen from the hinge (rad).
     pub half_width: f64,
     pub bearing: f64,
@@ -94,7 +93,6 @@ impl DoorTiming {
         let lo = least.max(lowest.min(most));
         let bearing = lo + bearing_share * (most - lo).max(0.0) * 0.5;
         DoorTiming {
-            width,
             half_width,
             bearing,
             meet_time,
