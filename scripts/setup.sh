@@ -15,8 +15,8 @@ apt_packages=(
 )
 # Import names. The Python package's build and tests (scripts/test_python.sh) need
 # maturin, numpy, gymnasium and pytest; its wheel's own dependencies are numpy, pyarrow
-# and gymnasium.
-python_packages=(pyarrow datasets maturin numpy gymnasium pytest)
+# and gymnasium. jsonschema validates results files in tests/tests/results_leaderboard.rs.
+python_packages=(pyarrow datasets maturin numpy gymnasium pytest jsonschema)
 # Modules whose pip package has another name (module:package): Pillow decodes the
 # `datasets` Image columns of rendered builds (`<cam>_frames`).
 python_renamed=(PIL:pillow)

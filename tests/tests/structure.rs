@@ -3,7 +3,10 @@
 //!
 //! * no import circle between the files of a crate, nor between its top-level modules
 //!   (a folder counts as one module): `crate::…` and `super::…` paths are the edges;
-//! * the crate graph that ARCHITECTURE.md draws is the one `cargo metadata` reports.
+//! * the crate graph that ARCHITECTURE.md draws is the one `cargo metadata` reports;
+//! * dev-dependencies change no feature of a dependency the build already has, so the test
+//!   build reuses what `cargo build --bins` compiled (docs/benchmarks.md, "The test
+//!   suite's build").
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -317,4 +320,60 @@ fn the_documented_crate_graph_is_cargos() {
         "ARCHITECTURE.md's crate graph (left) differs from cargo metadata (right)"
     );
     assert!(find_cycle(&cargo).is_none());
+}
+
+/// `package → its enabled features` of the workspace's resolution, from `cargo tree`
+/// (`kinds`: "normal,build" or "normal,build,dev").
+fn resolved_features(kinds: &str) -> BTreeMap<String, BTreeSet<String>> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = std::process::Command::new(cargo)
+        .args(["tree", "--workspace", "--offline", "--prefix", "none", "-e", kinds])
+        .args(["-f", "{p}|{f}"])
+        .current_dir(root())
+        .output()
+        .expect("cargo tree runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut map: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for line in String::from_utf8_lossy(&out.stdout).lines() {
+        let Some((package, features)) = line.split_once('|') else {
+            continue;
+        };
+        let features = features.trim_end_matches(" (*)").trim();
+        let set: BTreeSet<String> = features
+            .split(',')
+            .filter(|f| !f.is_empty())
+            .map(str::to_string)
+            .collect();
+        map.entry(package.trim().to_string()).or_default().extend(set);
+    }
+    map
+}
+
+#[test]
+fn dev_dependencies_change_no_feature_of_the_built_dependencies() {
+    let built = resolved_features("normal,build");
+    let tested = resolved_features("normal,build,dev");
+    assert!(built.len() > 100, "cargo tree listed {} packages", built.len());
+    let changed: Vec<String> = built
+        .iter()
+        .filter_map(|(package, features)| {
+            let in_tests = tested.get(package)?;
+            (in_tests != features).then(|| {
+                let added: Vec<&String> = in_tests.difference(features).collect();
+                format!("{package}: the test build adds {added:?}")
+            })
+        })
+        .collect();
+    assert!(
+        changed.is_empty(),
+        "a dev-dependency changes the features of built dependencies, so `cargo test` would \
+         compile them (and everything above them) again; give them these features in a \
+         normal dependency too (as contract/Cargo.toml does for bitflags) or drop the \
+         dev-dependency:\n{}",
+        changed.join("\n")
+    );
 }
