@@ -180,6 +180,13 @@ impl Gpu {
         self.ensure_capacity(vertices as u64 * std::mem::size_of::<Vertex>() as u64);
     }
 
+    /// Frees a slot's target (made again by the next draw into it).
+    pub fn release_target(&mut self, slot: usize) {
+        if let Some(t) = self.targets.get_mut(slot) {
+            *t = None;
+        }
+    }
+
     fn target(&mut self, slot: usize, width: u32, height: u32) -> &Target {
         if self.targets.len() <= slot {
             self.targets.resize_with(slot + 1, || None);
