@@ -248,9 +248,9 @@ impl Drop for Mp4Writer {
 pub struct FramePool(std::sync::Arc<std::sync::Mutex<Vec<Vec<u8>>>>);
 
 impl FramePool {
-    /// Most buffers kept: what is in flight (per video `QUEUED` + one being encoded, three
-    /// cameras) with a few to spare. Each kept 720p buffer is 3.7 MB of resident memory
-    /// per worker (48 of them were 177 MB).
+    /// Most buffers kept (a cap: the pool holds what was in flight at once, per video
+    /// `QUEUED` + one being encoded + one being drawn). Each kept 720p buffer is 3.7 MB of
+    /// resident memory per worker (48 of them were 177 MB).
     const KEEP: usize = 16;
 
     /// A buffer of `len` bytes (contents unspecified: the caller overwrites all of it).
