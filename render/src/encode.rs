@@ -248,18 +248,29 @@ impl Drop for Mp4Writer {
 pub struct FramePool(std::sync::Arc<std::sync::Mutex<Vec<Vec<u8>>>>);
 
 impl FramePool {
-    /// Most buffers kept: what is in flight (per video `QUEUED` + one being encoded, three
-    /// cameras) with a few to spare. Each kept 720p buffer is 3.7 MB of resident memory
-    /// per worker (48 of them were 177 MB).
+    /// Most buffers kept (a cap: the pool holds what was in flight at once, per video
+    /// `QUEUED` + one being encoded + one being drawn). Each kept 720p buffer is 3.7 MB of
+    /// resident memory per worker (48 of them were 177 MB).
     const KEEP: usize = 16;
 
     /// A buffer of `len` bytes (contents unspecified: the caller overwrites all of it).
+    /// Kept buffers of another size (an earlier video's) are freed first when none of
+    /// this size is left: the videos of a scene run one after the other, so they would
+    /// only sit idle while this one's are in use.
     pub fn take(&self, len: usize) -> Vec<u8> {
         let mut free = self.0.lock().unwrap_or_else(|e| e.into_inner());
         match free.iter().position(|b| b.len() == len) {
             Some(i) => free.swap_remove(i),
-            None => vec![0; len],
+            None => {
+                free.clear();
+                vec![0; len]
+            }
         }
+    }
+
+    /// Frees every kept buffer (at the end of a scene).
+    pub fn clear(&self) {
+        self.0.lock().unwrap_or_else(|e| e.into_inner()).clear();
     }
 
     pub fn give(&self, buffer: Vec<u8>) {
@@ -293,8 +304,8 @@ fn thread_cpu_seconds() -> f64 {
 }
 
 /// Frames queued per video beyond the one being encoded: enough to keep the encoder
-/// busy while the next frames are drawn; each is 3.7 MB at 720p.
-const QUEUED: usize = 2;
+/// busy while the next frame is drawn; each is 3.7 MB at 720p.
+const QUEUED: usize = 1;
 
 /// A video encoded on its own thread: frames are sent through a bounded channel, so
 /// rendering (this thread) overlaps with encoding (that one).

@@ -103,6 +103,13 @@ impl Renderer {
         let masks_root = self.opts.masks.then_some(out_dir);
         let (observed, pngs) = self.observe(spec, sim, &scene, &cams, masks_root)?;
         let mask_thread = super::measure::write_pngs(pngs);
+        // Memory: only what the current phase draws into stays allocated (the id pass's
+        // target, the observation slot, the full-event slot are each made again per
+        // scene), so the other worker's peak does not meet idle targets of this one.
+        if let Some(ids) = &mut self.ids {
+            ids.release();
+        }
+        self.gpu.release_target(1);
 
         let fps = spec.video.fps;
         let frame_steps = spec.observation_frame_steps(sim.steps());
@@ -134,8 +141,7 @@ impl Renderer {
                 for (ti, &(pk, t)) in png_frames.iter().enumerate() {
                     if pk as usize == k {
                         let rel = frame_path(id, &cam.name, t);
-                        let _ =
-                            png_tx.send((out_dir.join(&rel), cam.width, cam.height, img.clone()));
+                        let _ = png_tx.send((out_dir.join(&rel), cam.width, cam.height, rgb(&img)));
                         frame_files[ci * FRAME_TIMES.len() + ti] = rel;
                     }
                 }
@@ -154,6 +160,7 @@ impl Renderer {
         let full_fps = self.opts.full_fps.max(1);
         let full_event_steps = full_event_steps(full_sim, full_fps);
         let full_rel = video_path(FULL_EVENT, id);
+        self.gpu.release_target(0);
         if errors.is_empty() {
             let view = self.cache_view(&scene, 1, &full_cam)?;
             let full_job = self.spawn_video(
@@ -171,6 +178,7 @@ impl Renderer {
             finish_video(full_job, "full", full_event_steps.len(), &mut errors);
         }
         drop(png_tx);
+        self.gpu.frames.clear();
         if debug {
             eprintln!(
                 "render {id}: {} static + {} dynamic vertices; window draw {:.2} s, all frames {:.2} s",
@@ -406,8 +414,16 @@ fn finish_video(job: VideoJob, name: &str, frames: usize, errors: &mut Vec<Strin
     }
 }
 
-/// A PNG frame to write: (path, width, height, RGBA).
+/// A PNG frame to write: (path, width, height, RGB).
 type PngJob = (PathBuf, u32, u32, Vec<u8>);
+
+/// The RGB bytes of an RGBA image (what the PNG frames hold), made here rather than on
+/// the writer's thread so that no copy of the RGBA frame waits there.
+fn rgb(rgba: &[u8]) -> Vec<u8> {
+    rgba.chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect()
+}
 
 /// A thread that writes the PNG frames sent to it (join it for the first error).
 fn png_writer() -> (
@@ -416,18 +432,10 @@ fn png_writer() -> (
 ) {
     let (tx, rx) = std::sync::mpsc::channel::<PngJob>();
     let thread = std::thread::spawn(move || -> Result<(), String> {
-        for (path, w, h, rgba) in rx {
-            write_png(&path, w, h, &rgba)?;
+        for (path, w, h, rgb) in rx {
+            rh_contract::png::write_png(&path, &rgb, w, h, rh_contract::png::PngColor::Rgb8)?;
         }
         Ok(())
     });
     (tx, thread)
-}
-
-fn write_png(path: &Path, w: u32, h: u32, rgba: &[u8]) -> Result<(), String> {
-    let rgb: Vec<u8> = rgba
-        .chunks_exact(4)
-        .flat_map(|p| [p[0], p[1], p[2]])
-        .collect();
-    rh_contract::png::write_png(path, &rgb, w, h, rh_contract::png::PngColor::Rgb8)
 }

@@ -85,6 +85,11 @@ impl IdPass {
         }
     }
 
+    /// Frees the targets (made again by the next `draw_ids`).
+    pub fn release(&mut self) {
+        self.targets.clear();
+    }
+
     fn target(&mut self, device: &wgpu::Device, slot: usize, width: u32, height: u32) {
         if self.targets.len() <= slot {
             self.targets.resize_with(slot + 1, || None);

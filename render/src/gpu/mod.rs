@@ -1,6 +1,7 @@
 //! The wgpu side: device, pipelines (shadow + lit MSAA), render targets per output slot,
 //! and one call that draws a set of views of the current geometry and reads them back.
 
+mod copy;
 mod post;
 mod setup;
 
@@ -86,6 +87,11 @@ struct Target {
     padded_row: u32,
     uniform: wgpu::Buffer,
     bind: wgpu::BindGroup,
+    /// Where the colour attachment and the FXAA output may differ from their cached
+    /// static images (the last overlay frame's `post_rects`: every pixel it changed, and
+    /// every pixel FXAA redid); the next overlay frame restores only these from the
+    /// caches. `None`: unknown (a whole frame was drawn, or no cache yet), restore all.
+    dirty: Option<Vec<[u32; 4]>>,
 }
 
 /// One worker's renderer state: its shadow maps, targets and vertex buffer, on the
@@ -178,6 +184,13 @@ impl Gpu {
     /// Reserves room for `static_len + dynamic` vertices (call before `set_static`).
     pub fn reserve(&mut self, vertices: usize) {
         self.ensure_capacity(vertices as u64 * std::mem::size_of::<Vertex>() as u64);
+    }
+
+    /// Frees a slot's target (made again by the next draw into it).
+    pub fn release_target(&mut self, slot: usize) {
+        if let Some(t) = self.targets.get_mut(slot) {
+            *t = None;
+        }
     }
 
     fn target(&mut self, slot: usize, width: u32, height: u32) -> &Target {
@@ -279,6 +292,7 @@ impl Gpu {
             padded_row,
             uniform,
             bind,
+            dirty: None,
         }
     }
 
@@ -376,6 +390,10 @@ impl Gpu {
                 self.copy_to_readback(&mut enc, t, lit(&v.uniforms));
             }
         }
+        // A cached view's attachment and FXAA output now equal their caches.
+        for v in views {
+            self.targets[v.slot].as_mut().unwrap().dirty = cache.then(Vec::new);
+        }
         enc
     }
 
@@ -418,14 +436,17 @@ impl Gpu {
         self.shadow_pass(&mut enc, casters, false);
         for (v, rects) in views.iter().zip(&redraws) {
             let t = self.targets[v.slot].as_ref().unwrap();
-            copy_whole(&mut enc, &t.cache_color, t.color());
+            // Colour: only what the last frame changed (multisampled textures and depth
+            // are copied whole: wgpu allows no partial copies of them).
+            let dirty = t.dirty.as_deref().filter(|_| self.samples == 1);
+            copy::restore(&mut enc, &t.cache_color, t.color(), dirty);
             copy_whole(&mut enc, &t.cache_depth, &t.depth);
             let redraw = Redraw::Regions(rects);
             self.main_pass(&mut enc, t, redraw, &v.dynamic);
             match (&self.post, &t.post) {
                 // Anti-aliased: the static image's, redone around what changed.
                 (Some(post), Some(pt)) if lit(&v.uniforms) => {
-                    copy_whole(&mut enc, &pt.cache, &pt.out);
+                    copy::restore(&mut enc, &pt.cache, &pt.out, dirty);
                     if !v.post_rects.is_empty() {
                         post.encode(&mut enc, pt, Some(&v.post_rects));
                     }
@@ -435,6 +456,9 @@ impl Gpu {
             }
         }
         self.queue.submit([enc.finish()]);
+        for v in views {
+            self.targets[v.slot].as_mut().unwrap().dirty = Some(v.post_rects.clone());
+        }
         self.read_back(views.iter().map(|v| v.slot))
     }
 
