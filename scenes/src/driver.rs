@@ -269,12 +269,21 @@ fn replanned_group(
     let policy = crate::selection::PlanPolicy::of(config);
     let mut total = Rejections::default();
     let aim_replans = config.aim.replans.min(config.validators.replans);
-    let produce = |replan: u32, require_aim: bool, total: &mut Rejections| {
+    // The plans tried for an aim are produced again at their own pose if every plan fails
+    // (below): their plain runs are kept, not simulated twice.
+    let mut memo = SimMemo::default();
+    let mut produce = |replan: u32, require_aim: bool, total: &mut Rejections| {
         let selection =
             replan_group(catalog, families, seed, g, &policy, replan).map_err(|e| e.to_string())?;
-        let produced =
-            produce_attempts(&selection, seed, g * 4, count, catalog, config, require_aim)
-                .map_err(|e| e.to_string())?;
+        let memo = (replan < aim_replans).then_some(&mut memo);
+        let attempts = Attempts {
+            build_seed: seed,
+            first_index: g * 4,
+            count,
+            require_aim,
+        };
+        let produced = produce_attempts(&selection, &attempts, catalog, config, memo)
+            .map_err(|e| e.to_string())?;
         match &produced {
             // Planned afresh at once, before any band is labelled.
             None => total.attempts += 1,
@@ -563,16 +572,47 @@ pub fn produce_group_counted(
     catalog: &Catalog,
     config: &Config,
 ) -> Result<(Vec<SceneResult>, Rejections), RandomizeError> {
-    let produced = produce_attempts(
-        selection,
+    let attempts = Attempts {
         build_seed,
         first_index,
         count,
-        catalog,
-        config,
-        false,
-    )?;
+        require_aim: false,
+    };
+    let produced = produce_attempts(selection, &attempts, catalog, config, None)?;
     Ok(produced.unwrap_or_default())
+}
+
+/// Which scenes [`produce_attempts`] produces: `first_index .. first_index + count` of
+/// build `build_seed`; with `require_aim`, unaimed attempts are redrawn unlabelled.
+struct Attempts {
+    build_seed: u64,
+    first_index: u64,
+    count: u64,
+    require_aim: bool,
+}
+
+/// Plain runs kept by spec (its JSON text), so that a plan produced again simulates
+/// nothing twice (`simulate` is pure in the spec, so a kept run is the run). Holds at most
+/// [`SimMemo::KEPT`] runs; later ones are simulated and not kept.
+#[derive(Default)]
+struct SimMemo {
+    runs: std::collections::BTreeMap<String, Simulation>,
+}
+
+impl SimMemo {
+    const KEPT: usize = 64;
+
+    /// The plain run of `spec` (`json` is its JSON text).
+    fn simulate(&mut self, json: &str, spec: &SceneSpec) -> Simulation {
+        if let Some(sim) = self.runs.get(json) {
+            return sim.clone();
+        }
+        let sim = simulate(spec, SimOptions::default());
+        if self.runs.len() < Self::KEPT {
+            self.runs.insert(json.to_string(), sim.clone());
+        }
+        sim
+    }
 }
 
 /// [`produce_group_counted`]; with `require_aim`, an attempt whose event cannot be aimed
@@ -580,13 +620,17 @@ pub fn produce_group_counted(
 /// `[aim] attempts` such attempts the answer is `None` (the caller replans).
 fn produce_attempts(
     selection: &Selection,
-    build_seed: u64,
-    first_index: u64,
-    count: u64,
+    attempts: &Attempts,
     catalog: &Catalog,
     config: &Config,
-    require_aim: bool,
+    mut memo: Option<&mut SimMemo>,
 ) -> Result<Option<(Vec<SceneResult>, Rejections)>, RandomizeError> {
+    let &Attempts {
+        build_seed,
+        first_index,
+        count,
+        require_aim,
+    } = attempts;
     let mut results = Vec::new();
     let mut rejections = Rejections::default();
     let mut unaimed = 0;
@@ -602,8 +646,12 @@ fn produce_attempts(
             )?;
             // Simulate what the file will say: a JSON round trip is exact (serde_json
             // float_roundtrip), and this makes "replay equals build" hold by construction.
-            let spec = SceneSpec::from_json(&spec.to_json()).expect("a spec parses back");
-            let sim = simulate(&spec, SimOptions::default());
+            let json = spec.to_json();
+            let spec = SceneSpec::from_json(&json).expect("a spec parses back");
+            let sim = match memo.as_deref_mut() {
+                Some(memo) => memo.simulate(&json, &spec),
+                None => simulate(&spec, SimOptions::default()),
+            };
             runs.push((spec, sim));
         }
         // Label rule v5: the observer stands on the bands' hazard paths (one pose). An
