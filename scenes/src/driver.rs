@@ -460,11 +460,13 @@ fn hazard_trajectory(spec: &SceneSpec, sim: &Simulation) -> Vec<[f32; 4]> {
 }
 
 /// Labels a group's simulated bands at the first of `aims` (`aim::aims`) whose bands all
-/// pass the validators, else at the family's own pose.
+/// pass the validators, else at the family's own pose — there, unless the attempt is the
+/// `last` (whose verdicts are kept whatever they are), with [`label_group_counting`].
 fn label_aimed(
     runs: Vec<(SceneSpec, Simulation)>,
     aims: Vec<crate::aim::Aim>,
     config: &Config,
+    last: bool,
 ) -> Vec<SceneResult> {
     let debug = std::env::var_os("RH_AIM_DEBUG").is_some();
     for aim in aims {
@@ -486,7 +488,44 @@ fn label_aimed(
             results[0].spec.family, results[0].spec.selection.object_id, aim.candidate
         );
     }
-    label_group(runs, config)
+    if last {
+        label_group(runs, config)
+    } else {
+        label_group_counting(runs, config)
+    }
+}
+
+/// [`label_group`] for an attempt that is not the last: the same labels and verdicts,
+/// but the escape walks (`validate::escapable`, the costliest check) run only when every
+/// other check passes on every band, and stop at the first band they reject. An attempt
+/// another check rejects is discarded whatever its walks say, so its `escapable`
+/// verdicts stay `true` and `Rejections` does not count them; an attempt that the walks
+/// decide gets `label_group`'s results.
+fn label_group_counting(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> Vec<SceneResult> {
+    let bands: Vec<(&SceneSpec, &Simulation)> = runs.iter().map(|(s, m)| (s, m)).collect();
+    let framed = cameras::frame_group(&bands, &config.validators.framing()).unwrap_or_default();
+    let mut labelled = Vec::with_capacity(runs.len());
+    for (mut spec, sim) in runs {
+        spec.cameras = framed.clone();
+        let family =
+            families::get(&spec.family).expect("randomize only emits implemented families");
+        let labels = counterfactual_labels(&spec, &sim);
+        let mut verdicts = crate::validate::unlabelled(&spec, &sim, family, &config.validators);
+        verdicts.reaction_time = crate::validate::reaction_time_ok(&spec, &labels);
+        labelled.push((spec, sim, labels, verdicts));
+    }
+    if labelled.iter().all(|(_, _, _, v)| v.all()) {
+        for (spec, _, labels, verdicts) in labelled.iter_mut() {
+            verdicts.escapable = crate::validate::escapable(spec, labels);
+            if !verdicts.escapable {
+                break;
+            }
+        }
+    }
+    labelled
+        .into_iter()
+        .map(|(spec, sim, labels, verdicts)| scene_result(spec, sim, labels, verdicts))
+        .collect()
 }
 
 /// [`label_group`] when every band passes every validator, else `None` — found at the
@@ -536,7 +575,10 @@ fn label_group_if_valid(
 
 /// How a group's attempts went: attempts made, and per validator (in
 /// `validate::VALIDATOR_COLUMNS` order) how many attempts it rejected (an attempt is
-/// rejected when any band fails; it counts once for each validator that failed).
+/// rejected when any band fails; it counts once for each validator that failed — but the
+/// escape walks of an attempt at the family's pose run only when every other validator
+/// passes or it is the last attempt, [`label_group_counting`], so `valid_escapable`
+/// counts the attempts it alone rejected).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Rejections {
     pub attempts: u32,
@@ -670,7 +712,8 @@ fn produce_attempts(
             }
             continue;
         }
-        results = label_aimed(runs, aims, config);
+        let last = attempt + 1 == config.validators.max_attempts;
+        results = label_aimed(runs, aims, config, last);
         if results.iter().all(|r| r.verdicts.all()) {
             break;
         }
