@@ -298,6 +298,8 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
     };
     let mut hasher = Sha256::new();
     let mut calm_steps = 0u32;
+    // A plain run keeps its world at Δ for this thread's escape walks (`decision_world`).
+    let keep_at = (!options.observer_collider).then(|| spec.decision_step());
 
     for step in 0..=spec.physics.max_steps {
         if step > 0 {
@@ -323,6 +325,15 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         let flags =
             hazard_contact_flags(&world, hazard_collider, floor, source_collider, &observer);
         sim.hazard_contacts.push(flags);
+        if keep_at == Some(step) {
+            let handles = Handles {
+                floor,
+                bodies: &body_handles,
+                colliders: &collider_handles,
+                dynamic: &dynamic_bodies,
+            };
+            keep_decision_world(spec, &world, handles, &hasher);
+        }
 
         if step == 0 {
             continue;
@@ -368,6 +379,97 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         }
     });
     sim
+}
+
+/// A world ready to step from: `sw`'s state (bodies, colliders, joints, broad and
+/// narrow phase, islands, CCD) cloned into a fresh solver workspace, as `execute` forks
+/// the world at Δ for every plan.
+pub fn fork_world(sw: &SceneWorld) -> SceneWorld {
+    SceneWorld {
+        world: fork_physics(&sw.world),
+        floor: sw.floor,
+        body_handles: sw.body_handles.clone(),
+        collider_handles: sw.collider_handles.clone(),
+        dynamic_bodies: sw.dynamic_bodies.clone(),
+    }
+}
+
+fn fork_physics(w: &PhysicsWorld) -> PhysicsWorld {
+    let mut world = PhysicsWorld::new();
+    world.gravity = w.gravity;
+    world.integration_parameters = w.integration_parameters;
+    world.islands = w.islands.clone();
+    world.broad_phase = w.broad_phase.clone();
+    world.narrow_phase = w.narrow_phase.clone();
+    world.bodies = w.bodies.clone();
+    world.colliders = w.colliders.clone();
+    world.impulse_joints = w.impulse_joints.clone();
+    world.multibody_joints = w.multibody_joints.clone();
+    world.soft_bodies = w.soft_bodies.clone();
+    world.ccd_solver = w.ccd_solver.clone();
+    world
+}
+
+/// How many worlds at Δ a thread keeps (a group's four bands, with room to spare).
+const DECISION_WORLDS_KEPT: usize = 16;
+
+thread_local! {
+    /// The worlds at Δ of this thread's latest plain runs, newest last, each under
+    /// [`decision_key`] with the state hash of steps `0..=Δ`.
+    static DECISION_WORLDS: std::cell::RefCell<Vec<(String, SceneWorld, String)>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// What the world at Δ is a function of: the spec without what a plain run never reads
+/// (the observer's place, the cameras, `family_params`), which is all an aimed or framed
+/// copy of a simulated spec changes. Any other difference misses the cache.
+fn decision_key(spec: &SceneSpec) -> String {
+    let mut s = spec.clone();
+    (s.observer.x, s.observer.y, s.observer.yaw) = (0.0, 0.0, 0.0);
+    s.cameras.clear();
+    s.family_params.clear();
+    serde_json::to_string(&s).expect("a spec serializes")
+}
+
+/// The handles of a world that `simulate` holds apart from its physics world.
+struct Handles<'a> {
+    floor: ColliderHandle,
+    bodies: &'a [RigidBodyHandle],
+    colliders: &'a [ColliderHandle],
+    dynamic: &'a [usize],
+}
+
+/// Keeps the world of a plain run at Δ (see [`decision_world`]).
+fn keep_decision_world(spec: &SceneSpec, world: &PhysicsWorld, h: Handles, hasher: &Sha256) {
+    let kept = SceneWorld {
+        world: fork_physics(world),
+        floor: h.floor,
+        body_handles: h.bodies.to_vec(),
+        collider_handles: h.colliders.to_vec(),
+        dynamic_bodies: h.dynamic.to_vec(),
+    };
+    let entry = (decision_key(spec), kept, hash_hex(hasher.clone()));
+    DECISION_WORLDS.with_borrow_mut(|kept| {
+        kept.retain(|(k, _, _)| *k != entry.0);
+        if kept.len() >= DECISION_WORLDS_KEPT {
+            kept.remove(0);
+        }
+        kept.push(entry);
+    });
+}
+
+/// The world at `spec`'s decision moment Δ and the state hash of steps `0..=Δ`, if a plain
+/// run of this thread simulated it lately: bit for bit what stepping `build_world(spec)`
+/// Δ times gives (the same world, stepped the same way), so an escape walk started from
+/// it is the walk started from a fresh replay. `None`: replay it.
+pub fn decision_world(spec: &SceneSpec) -> Option<(SceneWorld, String)> {
+    let key = decision_key(spec);
+    DECISION_WORLDS.with_borrow(|kept| {
+        kept.iter()
+            .rev()
+            .find(|(k, _, _)| *k == key)
+            .map(|(_, w, h)| (fork_world(w), h.clone()))
+    })
 }
 
 /// The observer's body as the counterfactual of SPEC §6 strikes it: the humanoid

@@ -147,9 +147,12 @@ pub fn aims(runs: &[(SceneSpec, Simulation)], cfg: &AimConfig) -> Vec<Aim> {
     let wanted = cfg.tries.max(1) as usize;
     let mut found = Vec::new();
     let mut best_met = None;
+    let at_rest: Vec<Obstacles> = runs.iter().map(|(s, _)| bodies_at_rest(s)).collect();
     for (c, d) in draws.iter().enumerate() {
         let (spec, sim) = &runs[c % runs.len()];
-        let Some((x, y, yaw, meet_height)) = clear_candidate(spec, sim, cfg, band, intent, d)
+        let bodies = &at_rest[c % runs.len()];
+        let Some((x, y, yaw, meet_height)) =
+            clear_candidate(spec, sim, bodies, cfg, band, intent, d)
         else {
             continue;
         };
@@ -180,7 +183,8 @@ pub fn aims(runs: &[(SceneSpec, Simulation)], cfg: &AimConfig) -> Vec<Aim> {
         let clear = (0..draws.len())
             .filter(|&c| {
                 let (spec, sim) = &runs[c % runs.len()];
-                clear_candidate(spec, sim, cfg, band, intent, &draws[c]).is_some()
+                let bodies = &at_rest[c % runs.len()];
+                clear_candidate(spec, sim, bodies, cfg, band, intent, &draws[c]).is_some()
             })
             .count();
         eprintln!(
@@ -243,9 +247,11 @@ fn earliest_step(spec: &SceneSpec, cfg: &AimConfig) -> u32 {
 /// The first of draw `d`'s candidate poses (the offset along the hazard's motion, then
 /// turned to its left, its right and back) that stands clear ([`stands_clear`]): a fall
 /// beside a wall or a cabinet is met from the open side.
+/// `bodies` is [`bodies_at_rest`] of `spec`.
 fn clear_candidate(
     spec: &SceneSpec,
     sim: &Simulation,
+    bodies: &Obstacles,
     cfg: &AimConfig,
     band: [f64; 2],
     intent: Intent,
@@ -253,7 +259,7 @@ fn clear_candidate(
 ) -> Option<(f64, f64, f64, f64)> {
     (0..4)
         .filter_map(|turn| candidate(spec, sim, cfg, band, intent, d, turn))
-        .find(|&(x, y, _, _)| stands_clear(spec, cfg, x, y))
+        .find(|&(x, y, _, _)| stands_clear(spec, bodies, cfg, x, y))
 }
 
 /// A candidate pose from draw `d` = [time fraction, ahead, lateral, miss clearance] on
@@ -335,20 +341,25 @@ fn candidate(
     Some((x, y, yaw, p[2]))
 }
 
-/// Whether an observer at (x, y) stands inside the room, clear of every body as it
-/// stands at t0 (furniture, props and the hazard itself).
-fn stands_clear(spec: &SceneSpec, cfg: &AimConfig, x: f64, y: f64) -> bool {
+/// Every body of `spec` as it stands at t0 (furniture, props and the hazard itself), as
+/// obstacles.
+fn bodies_at_rest(spec: &SceneSpec) -> Obstacles {
+    let mut at_rest = spec.clone();
+    for b in at_rest.bodies.iter_mut() {
+        b.kind = BodyKind::Fixed;
+    }
+    Obstacles::of(&at_rest)
+}
+
+/// Whether an observer at (x, y) stands inside the room, clear of `bodies`
+/// ([`bodies_at_rest`] of `spec`).
+fn stands_clear(spec: &SceneSpec, bodies: &Obstacles, cfg: &AimConfig, x: f64, y: f64) -> bool {
     let [w, d] = [spec.room.size[0], spec.room.size[1]];
     if x.abs() > w / 2.0 - cfg.wall_margin || y.abs() > d / 2.0 - cfg.wall_margin {
         return false;
     }
     let o = &spec.observer;
     let r = o.torso_radius + 0.05;
-    let mut at_rest = spec.clone();
-    for b in at_rest.bodies.iter_mut() {
-        b.kind = BodyKind::Fixed;
-    }
-    let bodies = Obstacles::of(&at_rest);
     let ring = [[0.0, 0.0], [r, 0.0], [-r, 0.0], [0.0, r], [0.0, -r]];
     [0.05, 0.4, 0.8, 1.1, o.height].iter().all(|&z| {
         !ring

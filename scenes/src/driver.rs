@@ -269,12 +269,21 @@ fn replanned_group(
     let policy = crate::selection::PlanPolicy::of(config);
     let mut total = Rejections::default();
     let aim_replans = config.aim.replans.min(config.validators.replans);
-    let produce = |replan: u32, require_aim: bool, total: &mut Rejections| {
+    // The plans tried for an aim are produced again at their own pose if every plan fails
+    // (below): their plain runs are kept, not simulated twice.
+    let mut memo = SimMemo::default();
+    let mut produce = |replan: u32, require_aim: bool, total: &mut Rejections| {
         let selection =
             replan_group(catalog, families, seed, g, &policy, replan).map_err(|e| e.to_string())?;
-        let produced =
-            produce_attempts(&selection, seed, g * 4, count, catalog, config, require_aim)
-                .map_err(|e| e.to_string())?;
+        let memo = (replan < aim_replans).then_some(&mut memo);
+        let attempts = Attempts {
+            build_seed: seed,
+            first_index: g * 4,
+            count,
+            require_aim,
+        };
+        let produced = produce_attempts(&selection, &attempts, catalog, config, memo)
+            .map_err(|e| e.to_string())?;
         match &produced {
             // Planned afresh at once, before any band is labelled.
             None => total.attempts += 1,
@@ -451,11 +460,13 @@ fn hazard_trajectory(spec: &SceneSpec, sim: &Simulation) -> Vec<[f32; 4]> {
 }
 
 /// Labels a group's simulated bands at the first of `aims` (`aim::aims`) whose bands all
-/// pass the validators, else at the family's own pose.
+/// pass the validators, else at the family's own pose — there, unless the attempt is the
+/// `last` (whose verdicts are kept whatever they are), with [`label_group_counting`].
 fn label_aimed(
     runs: Vec<(SceneSpec, Simulation)>,
     aims: Vec<crate::aim::Aim>,
     config: &Config,
+    last: bool,
 ) -> Vec<SceneResult> {
     let debug = std::env::var_os("RH_AIM_DEBUG").is_some();
     for aim in aims {
@@ -477,7 +488,44 @@ fn label_aimed(
             results[0].spec.family, results[0].spec.selection.object_id, aim.candidate
         );
     }
-    label_group(runs, config)
+    if last {
+        label_group(runs, config)
+    } else {
+        label_group_counting(runs, config)
+    }
+}
+
+/// [`label_group`] for an attempt that is not the last: the same labels and verdicts,
+/// but the escape walks (`validate::escapable`, the costliest check) run only when every
+/// other check passes on every band, and stop at the first band they reject. An attempt
+/// another check rejects is discarded whatever its walks say, so its `escapable`
+/// verdicts stay `true` and `Rejections` does not count them; an attempt that the walks
+/// decide gets `label_group`'s results.
+fn label_group_counting(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> Vec<SceneResult> {
+    let bands: Vec<(&SceneSpec, &Simulation)> = runs.iter().map(|(s, m)| (s, m)).collect();
+    let framed = cameras::frame_group(&bands, &config.validators.framing()).unwrap_or_default();
+    let mut labelled = Vec::with_capacity(runs.len());
+    for (mut spec, sim) in runs {
+        spec.cameras = framed.clone();
+        let family =
+            families::get(&spec.family).expect("randomize only emits implemented families");
+        let labels = counterfactual_labels(&spec, &sim);
+        let mut verdicts = crate::validate::unlabelled(&spec, &sim, family, &config.validators);
+        verdicts.reaction_time = crate::validate::reaction_time_ok(&spec, &labels);
+        labelled.push((spec, sim, labels, verdicts));
+    }
+    if labelled.iter().all(|(_, _, _, v)| v.all()) {
+        for (spec, _, labels, verdicts) in labelled.iter_mut() {
+            verdicts.escapable = crate::validate::escapable(spec, labels);
+            if !verdicts.escapable {
+                break;
+            }
+        }
+    }
+    labelled
+        .into_iter()
+        .map(|(spec, sim, labels, verdicts)| scene_result(spec, sim, labels, verdicts))
+        .collect()
 }
 
 /// [`label_group`] when every band passes every validator, else `None` — found at the
@@ -527,7 +575,10 @@ fn label_group_if_valid(
 
 /// How a group's attempts went: attempts made, and per validator (in
 /// `validate::VALIDATOR_COLUMNS` order) how many attempts it rejected (an attempt is
-/// rejected when any band fails; it counts once for each validator that failed).
+/// rejected when any band fails; it counts once for each validator that failed — but the
+/// escape walks of an attempt at the family's pose run only when every other validator
+/// passes or it is the last attempt, [`label_group_counting`], so `valid_escapable`
+/// counts the attempts it alone rejected).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Rejections {
     pub attempts: u32,
@@ -563,16 +614,47 @@ pub fn produce_group_counted(
     catalog: &Catalog,
     config: &Config,
 ) -> Result<(Vec<SceneResult>, Rejections), RandomizeError> {
-    let produced = produce_attempts(
-        selection,
+    let attempts = Attempts {
         build_seed,
         first_index,
         count,
-        catalog,
-        config,
-        false,
-    )?;
+        require_aim: false,
+    };
+    let produced = produce_attempts(selection, &attempts, catalog, config, None)?;
     Ok(produced.unwrap_or_default())
+}
+
+/// Which scenes [`produce_attempts`] produces: `first_index .. first_index + count` of
+/// build `build_seed`; with `require_aim`, unaimed attempts are redrawn unlabelled.
+struct Attempts {
+    build_seed: u64,
+    first_index: u64,
+    count: u64,
+    require_aim: bool,
+}
+
+/// Plain runs kept by spec (its JSON text), so that a plan produced again simulates
+/// nothing twice (`simulate` is pure in the spec, so a kept run is the run). Holds at most
+/// [`SimMemo::KEPT`] runs; later ones are simulated and not kept.
+#[derive(Default)]
+struct SimMemo {
+    runs: std::collections::BTreeMap<String, Simulation>,
+}
+
+impl SimMemo {
+    const KEPT: usize = 64;
+
+    /// The plain run of `spec` (`json` is its JSON text).
+    fn simulate(&mut self, json: &str, spec: &SceneSpec) -> Simulation {
+        if let Some(sim) = self.runs.get(json) {
+            return sim.clone();
+        }
+        let sim = simulate(spec, SimOptions::default());
+        if self.runs.len() < Self::KEPT {
+            self.runs.insert(json.to_string(), sim.clone());
+        }
+        sim
+    }
 }
 
 /// [`produce_group_counted`]; with `require_aim`, an attempt whose event cannot be aimed
@@ -580,13 +662,17 @@ pub fn produce_group_counted(
 /// `[aim] attempts` such attempts the answer is `None` (the caller replans).
 fn produce_attempts(
     selection: &Selection,
-    build_seed: u64,
-    first_index: u64,
-    count: u64,
+    attempts: &Attempts,
     catalog: &Catalog,
     config: &Config,
-    require_aim: bool,
+    mut memo: Option<&mut SimMemo>,
 ) -> Result<Option<(Vec<SceneResult>, Rejections)>, RandomizeError> {
+    let &Attempts {
+        build_seed,
+        first_index,
+        count,
+        require_aim,
+    } = attempts;
     let mut results = Vec::new();
     let mut rejections = Rejections::default();
     let mut unaimed = 0;
@@ -602,8 +688,12 @@ fn produce_attempts(
             )?;
             // Simulate what the file will say: a JSON round trip is exact (serde_json
             // float_roundtrip), and this makes "replay equals build" hold by construction.
-            let spec = SceneSpec::from_json(&spec.to_json()).expect("a spec parses back");
-            let sim = simulate(&spec, SimOptions::default());
+            let json = spec.to_json();
+            let spec = SceneSpec::from_json(&json).expect("a spec parses back");
+            let sim = match memo.as_deref_mut() {
+                Some(memo) => memo.simulate(&json, &spec),
+                None => simulate(&spec, SimOptions::default()),
+            };
             runs.push((spec, sim));
         }
         // Label rule v5: the observer stands on the bands' hazard paths (one pose). An
@@ -622,7 +712,8 @@ fn produce_attempts(
             }
             continue;
         }
-        results = label_aimed(runs, aims, config);
+        let last = attempt + 1 == config.validators.max_attempts;
+        results = label_aimed(runs, aims, config, last);
         if results.iter().all(|r| r.verdicts.all()) {
             break;
         }

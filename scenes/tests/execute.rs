@@ -327,6 +327,41 @@ fn slab_at_the_torso(after: f64) -> rh_physics::spec::SceneSpec {
     })
 }
 
+/// The escape walks start from the world at Δ that the plain run kept
+/// (`simulate::decision_world`, `execute::replay_reusing`): the same world as a fresh
+/// replay — same hash at Δ, same outcomes and per-step hashes of every plan — also for
+/// a copy of the spec with the observer moved (what an aimed pose changes), and a spec
+/// that changes the world misses it.
+#[test]
+fn the_kept_world_at_decision_is_the_replay() {
+    use rh_physics::execute::replay_reusing;
+    use rh_physics::simulate::decision_world;
+    let cfg = ExecConfig::embedded_default();
+    for family in ["thrown_object", "shelf_slide", "door_swing"] {
+        for r in scenes(family, 1).iter().take(2) {
+            let mut moved = r.spec.clone();
+            moved.observer.x += 0.4;
+            moved.observer.yaw += 0.3;
+            moved.cameras.clear();
+            let sim = simulate(&r.spec, SimOptions::default());
+            assert_eq!(sim.state_hash, r.state_hash);
+            assert!(decision_world(&moved).is_some(), "{family}: not kept");
+            let mut heavier = r.spec.clone();
+            heavier.bodies[heavier.hazard].mass *= 2.0;
+            assert!(decision_world(&heavier).is_none(), "{family}");
+            let kept = replay_reusing(&moved);
+            let fresh = replay(&moved);
+            assert_eq!(kept.decision_hash, fresh.decision_hash, "{family}");
+            assert_eq!(kept.decision_hash, r.decision_state_hash, "{family}");
+            for plan in plans() {
+                let (a, b) = (kept.execute(&plan, &cfg), fresh.execute(&plan, &cfg));
+                assert_eq!(a.state_hash, b.state_hash, "{family}");
+                assert_eq!(a.outcome, b.outcome, "{family}");
+            }
+        }
+    }
+}
+
 #[test]
 fn a_strike_is_escapable_only_when_some_walk_clears_it_in_time() {
     use rh_physics::execute::escape::{escapable, escape_plans, first_unstruck};

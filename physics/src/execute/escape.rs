@@ -62,5 +62,5 @@ pub fn escapable(spec: &SceneSpec) -> bool {
     }
     static CFG: OnceLock<ExecConfig> = OnceLock::new();
     let cfg = CFG.get_or_init(ExecConfig::embedded_default);
-    first_unstruck(&super::replay(spec), &plans, cfg).is_some()
+    first_unstruck(&super::replay_reusing(spec), &plans, cfg).is_some()
 }

@@ -24,7 +24,6 @@ pub mod outcome;
 use crate::body::{BodyPose, LinkPose};
 use crate::simulate::{build_world, hash_hex, simulate, BodyState, SceneWorld, SimOptions};
 use crate::spec::{SceneSpec, Vec3};
-use rapier3d::prelude::*;
 
 use sha2::{Digest, Sha256};
 
@@ -117,6 +116,21 @@ pub fn replay(spec: &SceneSpec) -> Replay {
     }
 }
 
+/// [`replay`], taken from the world at Δ that a plain run of `spec` on this thread kept
+/// (`simulate::decision_world`) when there is one: the same world and hash without
+/// stepping again.
+pub fn replay_reusing(spec: &SceneSpec) -> Replay {
+    match crate::simulate::decision_world(spec) {
+        Some((world, decision_hash)) => Replay {
+            spec: spec.clone(),
+            world,
+            decision_step: spec.decision_step(),
+            decision_hash,
+        },
+        None => replay(spec),
+    }
+}
+
 impl Replay {
     pub fn spec(&self) -> &SceneSpec {
         &self.spec
@@ -150,26 +164,7 @@ impl Replay {
 
     /// A copy of the world at Δ to step on (fresh solver workspace; the state is cloned).
     fn fork(&self) -> SceneWorld {
-        let w = &self.world.world;
-        let mut world = PhysicsWorld::new();
-        world.gravity = w.gravity;
-        world.integration_parameters = w.integration_parameters;
-        world.islands = w.islands.clone();
-        world.broad_phase = w.broad_phase.clone();
-        world.narrow_phase = w.narrow_phase.clone();
-        world.bodies = w.bodies.clone();
-        world.colliders = w.colliders.clone();
-        world.impulse_joints = w.impulse_joints.clone();
-        world.multibody_joints = w.multibody_joints.clone();
-        world.soft_bodies = w.soft_bodies.clone();
-        world.ccd_solver = w.ccd_solver.clone();
-        SceneWorld {
-            world,
-            floor: self.world.floor,
-            body_handles: self.world.body_handles.clone(),
-            collider_handles: self.world.collider_handles.clone(),
-            dynamic_bodies: self.world.dynamic_bodies.clone(),
-        }
+        crate::simulate::fork_world(&self.world)
     }
 
     /// A fresh execution from Δ (the world forked, the humanoid standing at rest) to step
