@@ -585,6 +585,61 @@ fn multi_object_momentum_reaches_the_last_item() {
     }
 }
 
+/// Label rule v5's timed multi_object (closed form): the row's first object slides on the
+/// table at the pair's combined friction μ (deceleration a = μ·g); shoved at `u + a·t`
+/// from `u·t + ½·a·t²` behind the next object, it strikes the row at the band's speed `u`
+/// after the drawn time `t` in every band, a rough sponge (μ = 0.9) as well as a
+/// smooth tray — and the row's last object goes over the edge no earlier than Δ plus the
+/// reaction time, the time from which `aim` may let it meet the observer.
+#[test]
+fn multi_object_strikes_the_row_at_the_band_speed_after_the_drawn_time() {
+    let bands = setup().1.speed_bands["multi_object"];
+    let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let norm32 = |v: [f32; 3]| norm(v.map(f64::from));
+    for object in ["sponge", "serving_tray"] {
+        for band in 0..4 {
+            let spec = custom_scene("multi_object", object, "workshop", bands, band);
+            let p = &spec.family_params;
+            let (u, t) = (spec.speed_value, p["hit_time_s"]);
+            assert_eq!(u, bands[band as usize]);
+            let (table, first) = (&spec.bodies[0], &spec.bodies[1]);
+            let a = 0.5 * (first.friction + table.friction) * GRAVITY;
+            assert!(
+                (norm(first.linvel) - (u + a * t)).abs() < 1e-9,
+                "{object}: shove"
+            );
+            assert!((p["run_up_m"] - (u * t + 0.5 * a * t * t)).abs() < 1e-9);
+            let earliest = spec.observation_window_s + spec.labels.reaction_time_min;
+            let sim = plain(&spec);
+            // Slots 0 and 1: the shoved object and the next one, at rest until struck.
+            assert_eq!(sim.dynamic_bodies[..2], [1, 2]);
+            let struck = (0..=sim.steps())
+                .find(|&k| norm32(sim.state(k, 1).linvel) > 0.05)
+                .expect("the row is struck");
+            let hit = struck as f64 * sim.dt;
+            let speed = norm32(sim.state(struck - 1, 0).linvel);
+            // Later by the row's own few-millimetre gap at most.
+            assert!(
+                (t - 0.02..=t + 0.03).contains(&hit),
+                "{object} {u} m/s: struck at {hit} s, timed for {t} s"
+            );
+            assert!(
+                (speed - u).abs() <= 0.05 * u,
+                "{object}: strikes at {speed} m/s, band {u} m/s"
+            );
+            let h = p["table_height_m"];
+            let over = (0..=sim.steps())
+                .find(|&k| sim.hazard_lowest_z[k as usize] < h - 0.01)
+                .expect("the last object goes over the edge") as f64
+                * sim.dt;
+            assert!(
+                over >= earliest,
+                "{object} {u} m/s: over the edge at {over} s"
+            );
+        }
+    }
+}
+
 #[test]
 fn surface_cascade_touches_the_stool_between_table_and_floor() {
     use rh_physics::simulate::{TOUCH_FLOOR, TOUCH_OTHER, TOUCH_SOURCE};
