@@ -11,9 +11,9 @@
 //! polished table at the pair's combined friction μ; 0 for an object that rolls), so it
 //! slides into the row at the band's speed `u` whatever its friction: a faster band or a
 //! rougher object starts farther back and is shoved harder. The row's last object then
-//! leaves the edge of a counter (at least `TABLE_MIN_M` high) after Δ plus the reaction
-//! time, and `aim` stands the observer where it falls: at the hands (a benign object), or
-//! where it lands on the feet (a dangerous one). The counter runs along one of the room's
+//! goes over the edge of a counter (at least `TABLE_MIN_M` high) and falls, and `aim`
+//! stands the observer where it passes after Δ plus the reaction time and margin: at the
+//! hands (a benign object), or where it lands on the feet (a dangerous one). The counter runs along one of the room's
 //! diagonals; where even that is too short for the fastest band's run-up, every band
 //! strikes sooner (`fit_time`). (Until label rule v5 the band's speed was the shove, and
 //! only objects that kept 30% of it over the run-up were timed: 4 of 40 scenes a real
@@ -26,9 +26,9 @@ use super::*;
 
 pub struct MultiObject;
 
-/// When every band's shoved object strikes the row (s after t0): the last object leaves
-/// the edge soon after, and falls through the hands' heights, or onto the feet, after Δ
-/// plus the reaction time and `[aim] reaction_margin_s`.
+/// When every band's shoved object strikes the row (s after t0): the last object goes
+/// over the edge soon after and falls through the hands' heights, or onto the feet, after
+/// Δ plus the reaction time and `[aim] reaction_margin_s` (`aim` checks every band).
 pub const HIT_S: [f64; 2] = [0.75, 0.9];
 
 /// The room keeps this margin (m) from the walls to the table's back and to `BEYOND_M`
