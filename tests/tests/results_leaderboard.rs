@@ -110,7 +110,10 @@ fn results_validate_and_leaderboard_merges_or_refuses() {
         assert!(e.is_empty(), "{}: {e:?}", f.display());
     }
     assert!(!errors[3].is_empty(), "a string SAA value validated");
-    assert!(!errors[4].is_empty(), "an unknown top-level field validated");
+    assert!(
+        !errors[4].is_empty(),
+        "an unknown top-level field validated"
+    );
 
     // The file carries the report's numbers and the dataset's identity.
     let o = read(&oracle);

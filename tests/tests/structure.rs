@@ -327,7 +327,15 @@ fn the_documented_crate_graph_is_cargos() {
 fn resolved_features(kinds: &str) -> BTreeMap<String, BTreeSet<String>> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let out = std::process::Command::new(cargo)
-        .args(["tree", "--workspace", "--offline", "--prefix", "none", "-e", kinds])
+        .args([
+            "tree",
+            "--workspace",
+            "--offline",
+            "--prefix",
+            "none",
+            "-e",
+            kinds,
+        ])
         .args(["-f", "{p}|{f}"])
         .current_dir(root())
         .output()
@@ -348,7 +356,9 @@ fn resolved_features(kinds: &str) -> BTreeMap<String, BTreeSet<String>> {
             .filter(|f| !f.is_empty())
             .map(str::to_string)
             .collect();
-        map.entry(package.trim().to_string()).or_default().extend(set);
+        map.entry(package.trim().to_string())
+            .or_default()
+            .extend(set);
     }
     map
 }
@@ -357,7 +367,11 @@ fn resolved_features(kinds: &str) -> BTreeMap<String, BTreeSet<String>> {
 fn dev_dependencies_change_no_feature_of_the_built_dependencies() {
     let built = resolved_features("normal,build");
     let tested = resolved_features("normal,build,dev");
-    assert!(built.len() > 100, "cargo tree listed {} packages", built.len());
+    assert!(
+        built.len() > 100,
+        "cargo tree listed {} packages",
+        built.len()
+    );
     let changed: Vec<String> = built
         .iter()
         .filter_map(|(package, features)| {
