@@ -244,27 +244,33 @@ fn the_circle_check_finds_a_circle() {
     assert!(find_cycle(&file_graph(src)).is_some());
 }
 
+/// Runs cargo (the one running the tests) in the workspace root; its stdout.
+fn cargo(args: &[&str]) -> String {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = std::process::Command::new(cargo)
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("cargo runs");
+    assert!(
+        out.status.success(),
+        "cargo {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("utf-8 output")
+}
+
 /// `crate → dependencies` among the workspace's crates, from `cargo metadata` (normal
 /// dependencies, optional ones included; dev-dependencies left out).
 fn metadata_graph() -> BTreeMap<String, BTreeSet<String>> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let out = std::process::Command::new(cargo)
-        .args([
-            "metadata",
-            "--format-version",
-            "1",
-            "--no-deps",
-            "--offline",
-        ])
-        .current_dir(root())
-        .output()
-        .expect("cargo metadata runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let out = cargo(&[
+        "metadata",
+        "--format-version",
+        "1",
+        "--no-deps",
+        "--offline",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let packages = v["packages"].as_array().unwrap();
     let ours: BTreeSet<String> = packages
         .iter()
@@ -325,28 +331,19 @@ fn the_documented_crate_graph_is_cargos() {
 /// `package → its enabled features` of the workspace's resolution, from `cargo tree`
 /// (`kinds`: "normal,build" or "normal,build,dev").
 fn resolved_features(kinds: &str) -> BTreeMap<String, BTreeSet<String>> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let out = std::process::Command::new(cargo)
-        .args([
-            "tree",
-            "--workspace",
-            "--offline",
-            "--prefix",
-            "none",
-            "-e",
-            kinds,
-        ])
-        .args(["-f", "{p}|{f}"])
-        .current_dir(root())
-        .output()
-        .expect("cargo tree runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = cargo(&[
+        "tree",
+        "--workspace",
+        "--offline",
+        "--prefix",
+        "none",
+        "-e",
+        kinds,
+        "-f",
+        "{p}|{f}",
+    ]);
     let mut map: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
-    for line in String::from_utf8_lossy(&out.stdout).lines() {
+    for line in out.lines() {
         let Some((package, features)) = line.split_once('|') else {
             continue;
         };
