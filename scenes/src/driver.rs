@@ -332,14 +332,22 @@ fn needs_aim(spec: &SceneSpec, config: &Config) -> bool {
 
 /// Frames one set of cameras for a group's bands and labels and validates each band.
 fn label_group(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> Vec<SceneResult> {
+    framed_group(runs, config)
+        .map(|(spec, sim)| label_scene(spec, sim, config))
+        .collect()
+}
+
+/// A group's bands with one set of cameras framed for all of them.
+fn framed_group(
+    runs: Vec<(SceneSpec, Simulation)>,
+    config: &Config,
+) -> impl Iterator<Item = (SceneSpec, Simulation)> {
     let bands: Vec<(&SceneSpec, &Simulation)> = runs.iter().map(|(s, m)| (s, m)).collect();
     let framed = cameras::frame_group(&bands, &config.validators.framing()).unwrap_or_default();
-    runs.into_iter()
-        .map(|(mut spec, sim)| {
-            spec.cameras = framed.clone();
-            label_scene(spec, sim, config)
-        })
-        .collect()
+    runs.into_iter().map(move |(mut spec, sim)| {
+        spec.cameras = framed.clone();
+        (spec, sim)
+    })
 }
 
 /// Simulates one spec (plain and counterfactual), frames its cameras (as a group of
@@ -502,11 +510,8 @@ fn label_aimed(
 /// verdicts stay `true` and `Rejections` does not count them; an attempt that the walks
 /// decide gets `label_group`'s results.
 fn label_group_counting(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> Vec<SceneResult> {
-    let bands: Vec<(&SceneSpec, &Simulation)> = runs.iter().map(|(s, m)| (s, m)).collect();
-    let framed = cameras::frame_group(&bands, &config.validators.framing()).unwrap_or_default();
     let mut labelled = Vec::with_capacity(runs.len());
-    for (mut spec, sim) in runs {
-        spec.cameras = framed.clone();
+    for (spec, sim) in framed_group(runs, config) {
         let family =
             families::get(&spec.family).expect("randomize only emits implemented families");
         let labels = counterfactual_labels(&spec, &sim);
@@ -537,11 +542,8 @@ fn label_group_if_valid(
     runs: Vec<(SceneSpec, Simulation)>,
     config: &Config,
 ) -> Option<Vec<SceneResult>> {
-    let bands: Vec<(&SceneSpec, &Simulation)> = runs.iter().map(|(s, m)| (s, m)).collect();
-    let framed = cameras::frame_group(&bands, &config.validators.framing()).unwrap_or_default();
     let mut framed_runs = Vec::with_capacity(runs.len());
-    for (mut spec, sim) in runs {
-        spec.cameras = framed.clone();
+    for (spec, sim) in framed_group(runs, config) {
         let family =
             families::get(&spec.family).expect("randomize only emits implemented families");
         let verdicts = crate::validate::unlabelled(&spec, &sim, family, &config.validators);
