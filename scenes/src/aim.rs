@@ -39,6 +39,10 @@ pub struct AimConfig {
     /// be aimed.
     #[serde(default)]
     pub attempts: u32,
+    /// `attempts` for these families instead (their layouts rarely give all four speed
+    /// bands one meeting point).
+    #[serde(default)]
+    pub attempts_by_family: std::collections::BTreeMap<String, u32>,
     /// Extra time beyond Δ + `reaction_time_min` before the path may meet the observer (s).
     pub reaction_margin_s: f64,
     /// The meeting height band (hazard centre height, m) for every family but those in
@@ -197,6 +201,18 @@ pub fn aims(runs: &[(SceneSpec, Simulation)], cfg: &AimConfig) -> Vec<Aim> {
         );
     }
     found
+}
+
+impl AimConfig {
+    /// How many unaimed layouts of one plan of `family` are drawn before it is planned
+    /// afresh (`attempts_by_family`, else `attempts`; at least 1).
+    pub fn attempts_for(&self, family: &str) -> u32 {
+        self.attempts_by_family
+            .get(family)
+            .copied()
+            .unwrap_or(self.attempts)
+            .max(1)
+    }
 }
 
 /// The intent of a spec whose observer [`aims`] places: events are aimed

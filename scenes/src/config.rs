@@ -441,6 +441,16 @@ impl Config {
         for (family, r) in &a.meet_height_by_family {
             range(&format!("aim.meet_height_by_family.{family}"), *r)?;
         }
+        if let Some(family) = a
+            .attempts_by_family
+            .keys()
+            .find(|f| crate::families::get(f).is_none())
+        {
+            return Err(fail(
+                &format!("aim.attempts_by_family.{family}"),
+                "is not an event family".to_string(),
+            ));
+        }
         for (field, v) in [
             ("aim.reaction_margin_s", a.reaction_margin_s),
             ("aim.lateral", a.lateral),
@@ -643,5 +653,27 @@ mod tests {
             err.contains("labels.harm.face") && err.contains("missing"),
             "{err}"
         );
+        // A per-family number for a family that does not exist.
+        std::fs::write(dir.path().join("labels.toml"), LABELS_TOML).unwrap();
+        let bad = DEFAULT_TOML.replace("shelf_slide = 1", "shelf_slid = 1");
+        assert_ne!(bad, DEFAULT_TOML);
+        std::fs::write(&path, bad).unwrap();
+        let err = Config::load(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("aim.attempts_by_family.shelf_slid")
+                && err.contains("not an event family"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn aim_attempts_per_family_fall_back_to_attempts() {
+        let mut aim = Config::embedded().unwrap().aim;
+        aim.attempts = 4;
+        aim.attempts_by_family = [("shelf_slide".to_string(), 1), ("door_swing".into(), 0)].into();
+        assert_eq!(aim.attempts_for("shelf_slide"), 1);
+        assert_eq!(aim.attempts_for("object_drop"), 4);
+        // At least one layout is always drawn.
+        assert_eq!(aim.attempts_for("door_swing"), 1);
     }
 }

@@ -680,8 +680,7 @@ fn produce_attempts(
     let mut unaimed = 0;
     for attempt in 0..config.validators.max_attempts {
         rejections.attempts += 1;
-        let mut runs = Vec::with_capacity(count as usize);
-        for index in first_index..first_index + count {
+        let mut band_run = |index: u64| -> Result<(SceneSpec, Simulation), RandomizeError> {
             let spec = randomize(
                 selection,
                 &SceneKey::new(build_seed, index, attempt),
@@ -696,18 +695,45 @@ fn produce_attempts(
                 Some(memo) => memo.simulate(&json, &spec),
                 None => simulate(&spec, SimOptions::default()),
             };
-            runs.push((spec, sim));
+            Ok((spec, sim))
+        };
+        // The fastest band first: with `require_aim`, a layout whose fastest band alone
+        // cannot be aimed (no candidate on its path that it meets) is redrawn without
+        // simulating the other bands. (Every band must meet the aim, and the fastest
+        // band's path strays farthest from the others.)
+        let probe_index = first_index + count - 1;
+        let probe = band_run(probe_index)?;
+        let unaimable = require_aim
+            && count > 1
+            && needs_aim(&probe.0, config)
+            && crate::aim::aims(std::slice::from_ref(&probe), &config.aim).is_empty();
+        let mut runs = Vec::with_capacity(count as usize);
+        if unaimable {
+            runs.push(probe);
+        } else {
+            let mut probe = Some(probe);
+            for index in first_index..first_index + count {
+                let run = match probe.take_if(|_| index == probe_index) {
+                    Some(run) => run,
+                    None => band_run(index)?,
+                };
+                runs.push(run);
+            }
         }
         // Label rule v5: the observer stands on the bands' hazard paths (one pose). An
         // aimed pose the validators reject (the hazard out of a camera's view, too early
         // to react) gives way to the next aimed pose, then to the family's own pose,
         // before a new attempt is drawn.
-        let aims = crate::aim::aims(&runs, &config.aim);
+        let aims = if runs.len() as u64 == count {
+            crate::aim::aims(&runs, &config.aim)
+        } else {
+            Vec::new()
+        };
         if require_aim && aims.is_empty() && runs.first().is_some_and(|(s, _)| needs_aim(s, config))
         {
             unaimed += 1;
             // Also when the attempts run out first: no scene was labelled.
-            if unaimed >= config.aim.attempts.max(1)
+            if unaimed >= config.aim.attempts_for(&selection.family)
                 || attempt + 1 == config.validators.max_attempts
             {
                 return Ok(None);
