@@ -152,11 +152,16 @@ pub fn aims(runs: &[(SceneSpec, Simulation)], cfg: &AimConfig) -> Vec<Aim> {
     let mut found = Vec::new();
     let mut best_met = None;
     let at_rest: Vec<Obstacles> = runs.iter().map(|(s, _)| bodies_at_rest(s)).collect();
+    let points: Vec<Vec<u32>> = runs
+        .iter()
+        .map(|(s, m)| meeting_points(s, m, cfg, band, intent))
+        .collect();
     for (c, d) in draws.iter().enumerate() {
         let (spec, sim) = &runs[c % runs.len()];
         let bodies = &at_rest[c % runs.len()];
+        let points = &points[c % runs.len()];
         let Some((x, y, yaw, meet_height)) =
-            clear_candidate(spec, sim, bodies, cfg, band, intent, d)
+            clear_candidate(spec, sim, bodies, points, cfg, intent, d)
         else {
             continue;
         };
@@ -188,7 +193,8 @@ pub fn aims(runs: &[(SceneSpec, Simulation)], cfg: &AimConfig) -> Vec<Aim> {
             .filter(|&c| {
                 let (spec, sim) = &runs[c % runs.len()];
                 let bodies = &at_rest[c % runs.len()];
-                clear_candidate(spec, sim, bodies, cfg, band, intent, &draws[c]).is_some()
+                let points = &points[c % runs.len()];
+                clear_candidate(spec, sim, bodies, points, cfg, intent, &draws[c]).is_some()
             })
             .count();
         eprintln!(
@@ -268,29 +274,27 @@ fn clear_candidate(
     spec: &SceneSpec,
     sim: &Simulation,
     bodies: &Obstacles,
+    points: &[u32],
     cfg: &AimConfig,
-    band: [f64; 2],
     intent: Intent,
     d: &[f64; 4],
 ) -> Option<(f64, f64, f64, f64)> {
     (0..4)
-        .filter_map(|turn| candidate(spec, sim, cfg, band, intent, d, turn))
+        .filter_map(|turn| candidate(spec, sim, points, intent, d, turn))
         .find(|&(x, y, _, _)| stands_clear(spec, bodies, cfg, x, y))
 }
 
-/// A candidate pose from draw `d` = [time fraction, ahead, lateral, miss clearance] on
-/// one band's path: the meeting point is the `d[0]` fraction of the moving path points
-/// after the earliest step whose centre height is in `band`; the offset runs along the
-/// hazard's horizontal motion there, turned by `turn` quarter turns (0, left, right, back).
-fn candidate(
+/// The path points of one band a meeting point is drawn from: the steps after the
+/// earliest step where the hazard moves (aimed at the body: at least `body_speed_share`
+/// of its top speed there) and its centre height is in `band` — all the moving ones if
+/// none is in `band`, or for a near miss.
+fn meeting_points(
     spec: &SceneSpec,
     sim: &Simulation,
     cfg: &AimConfig,
     band: [f64; 2],
     intent: Intent,
-    d: &[f64; 4],
-    turn: usize,
-) -> Option<(f64, f64, f64, f64)> {
+) -> Vec<u32> {
     let from = earliest_step(spec, cfg);
     let fastest = (from..=sim.steps())
         .map(|k| norm(sim.hazard_velocity(k)))
@@ -311,15 +315,29 @@ fn candidate(
         .filter(|&k| (band[0]..=band[1]).contains(&sim.hazard_com(k)[2]))
         .collect();
     // A path that never passes at a height of the band meets the body where it can.
-    let near_miss = intent == Intent::Miss;
-    let points = if near_miss || in_band.is_empty() {
+    if intent == Intent::Miss || in_band.is_empty() {
         moving
     } else {
         in_band
-    };
+    }
+}
+
+/// A candidate pose from draw `d` = [time fraction, ahead, lateral, miss clearance] on
+/// one band's path: the meeting point is the `d[0]` fraction of the moving path points
+/// after the earliest step whose centre height is in `band`; the offset runs along the
+/// hazard's horizontal motion there, turned by `turn` quarter turns (0, left, right, back).
+fn candidate(
+    spec: &SceneSpec,
+    sim: &Simulation,
+    points: &[u32],
+    intent: Intent,
+    d: &[f64; 4],
+    turn: usize,
+) -> Option<(f64, f64, f64, f64)> {
     if points.is_empty() {
         return None;
     }
+    let near_miss = intent == Intent::Miss;
     let k = points[((d[0] * points.len() as f64) as usize).min(points.len() - 1)];
     let p = sim.hazard_com(k);
     let v = sim.hazard_velocity(k);
