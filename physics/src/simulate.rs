@@ -326,13 +326,14 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
             hazard_contact_flags(&world, hazard_collider, floor, source_collider, &observer);
         sim.hazard_contacts.push(flags);
         if keep_at == Some(step) {
-            let handles = Handles {
+            let at_decision = SceneWorld {
+                world: fork_physics(&world),
                 floor,
-                bodies: &body_handles,
-                colliders: &collider_handles,
-                dynamic: &dynamic_bodies,
+                body_handles: body_handles.clone(),
+                collider_handles: collider_handles.clone(),
+                dynamic_bodies: dynamic_bodies.clone(),
             };
-            keep_decision_world(spec, &world, handles, &hasher);
+            keep_decision_world(spec, at_decision, hash_hex(hasher.clone()));
         }
 
         if step == 0 {
@@ -431,24 +432,10 @@ fn decision_key(spec: &SceneSpec) -> String {
     serde_json::to_string(&s).expect("a spec serializes")
 }
 
-/// The handles of a world that `simulate` holds apart from its physics world.
-struct Handles<'a> {
-    floor: ColliderHandle,
-    bodies: &'a [RigidBodyHandle],
-    colliders: &'a [ColliderHandle],
-    dynamic: &'a [usize],
-}
-
-/// Keeps the world of a plain run at Δ (see [`decision_world`]).
-fn keep_decision_world(spec: &SceneSpec, world: &PhysicsWorld, h: Handles, hasher: &Sha256) {
-    let kept = SceneWorld {
-        world: fork_physics(world),
-        floor: h.floor,
-        body_handles: h.bodies.to_vec(),
-        collider_handles: h.colliders.to_vec(),
-        dynamic_bodies: h.dynamic.to_vec(),
-    };
-    let entry = (decision_key(spec), kept, hash_hex(hasher.clone()));
+/// Keeps the world of a plain run at Δ (see [`decision_world`]) with the state hash of
+/// steps `0..=Δ`.
+fn keep_decision_world(spec: &SceneSpec, world: SceneWorld, hash: String) {
+    let entry = (decision_key(spec), world, hash);
     DECISION_WORLDS.with_borrow_mut(|kept| {
         kept.retain(|(k, _, _)| *k != entry.0);
         if kept.len() >= DECISION_WORLDS_KEPT {

@@ -697,37 +697,30 @@ fn produce_attempts(
             };
             Ok((spec, sim))
         };
-        // The fastest band first: with `require_aim`, a layout whose fastest band alone
-        // cannot be aimed (no candidate on its path that it meets) is redrawn without
-        // simulating the other bands. (Every band must meet the aim, and the fastest
-        // band's path strays farthest from the others.)
-        let probe_index = first_index + count - 1;
-        let probe = band_run(probe_index)?;
+        // The fastest band (the last) first: with `require_aim`, a layout whose fastest
+        // band alone cannot be aimed (no candidate on its path that it meets) is redrawn
+        // without simulating the other bands. (Every band must meet the aim, and the
+        // fastest band's path strays farthest from the others.)
+        let fastest = band_run(first_index + count - 1)?;
         let unaimable = require_aim
             && count > 1
-            && needs_aim(&probe.0, config)
-            && crate::aim::aims(std::slice::from_ref(&probe), &config.aim).is_empty();
+            && needs_aim(&fastest.0, config)
+            && crate::aim::aims(std::slice::from_ref(&fastest), &config.aim).is_empty();
         let mut runs = Vec::with_capacity(count as usize);
-        if unaimable {
-            runs.push(probe);
-        } else {
-            let mut probe = Some(probe);
-            for index in first_index..first_index + count {
-                let run = match probe.take_if(|_| index == probe_index) {
-                    Some(run) => run,
-                    None => band_run(index)?,
-                };
-                runs.push(run);
+        if !unaimable {
+            for index in first_index..first_index + count - 1 {
+                runs.push(band_run(index)?);
             }
         }
+        runs.push(fastest);
         // Label rule v5: the observer stands on the bands' hazard paths (one pose). An
         // aimed pose the validators reject (the hazard out of a camera's view, too early
         // to react) gives way to the next aimed pose, then to the family's own pose,
         // before a new attempt is drawn.
-        let aims = if runs.len() as u64 == count {
-            crate::aim::aims(&runs, &config.aim)
-        } else {
+        let aims = if unaimable {
             Vec::new()
+        } else {
+            crate::aim::aims(&runs, &config.aim)
         };
         if require_aim && aims.is_empty() && runs.first().is_some_and(|(s, _)| needs_aim(s, config))
         {
