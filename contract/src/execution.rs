@@ -16,7 +16,7 @@ pub fn hash_hex(hasher: Sha256) -> String {
 
 /// Version of the executor's code (humanoid, controller, outcome rule); part of the
 /// execution cache key together with the config's own `version`.
-pub const EXECUTOR_VERSION: &str = "exec-5";
+pub const EXECUTOR_VERSION: &str = "exec-6";
 
 /// One hand keyframe (body frame; `t` in seconds after the decision moment).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -82,6 +82,11 @@ pub struct ExecConfig {
     pub attempt_radius: f64,
     pub floor_contact_eps: f64,
     pub settle_speed: f64,
+    /// A hazard that started on the floor (a ladder, a wardrobe, a door) ends the run
+    /// once it has stayed still this long (s) after the plan's last motion; 0: never
+    /// (configs of `version` e4 and before).
+    #[serde(default)]
+    pub settle_time_s: f64,
 }
 
 impl ExecConfig {
@@ -129,6 +134,7 @@ impl ExecConfig {
             ("attempt_radius", self.attempt_radius),
             ("floor_contact_eps", self.floor_contact_eps),
             ("settle_speed", self.settle_speed),
+            ("settle_time_s", self.settle_time_s),
         ];
         for (name, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {

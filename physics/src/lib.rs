@@ -4,6 +4,7 @@
 //!   label rule's thresholds it was labelled under, `LabelConfig`);
 //! * [`simulate`] — the deterministic rapier world built from a spec (dt 1/240,
 //!   enhanced determinism) and its per-step state hash;
+//! * [`world`] — the rapier world a spec builds (floor, bodies, joints) and its forks;
 //! * [`shapes`] — the spec's shapes and the humanoid's links as rapier shapes;
 //! * [`obstacles`] — line-of-sight queries against the fixed bodies (cameras, visibility);
 //! * [`body`] — the humanoid observer's links (pure geometry);
@@ -13,8 +14,8 @@
 //!   a control rate over the executor's physics, limits and outcome rule;
 //! * [`seeds`] — the named `rand_chacha` sub-streams.
 //!
-//! Module graph (`A → B`: A uses B): `control → execute → simulate → shapes, body, strike
-//! → spec`; `obstacles → shapes`;
+//! Module graph (`A → B`: A uses B): `control → execute → simulate → world, shapes, body,
+//! strike → spec`; `world → shapes`; `obstacles → shapes`;
 //! `seeds` and `spec` use nothing in the crate.
 
 pub mod body;
@@ -26,3 +27,4 @@ pub mod shapes;
 pub mod simulate;
 pub mod spec;
 pub mod strike;
+pub mod world;

@@ -7,8 +7,8 @@
 //! scene is simulated single-threaded, and nothing here reads a clock or a hash map.
 
 use crate::body::{Geometry, LinkShape, Part, BODY_FRICTION, BODY_RESTITUTION};
-use crate::shapes::{collider_for, link_shape, posed_parts, rot, v3};
-use crate::spec::{BodyKind, JointKind, ObserverSpec, SceneSpec};
+use crate::shapes::{link_shape, posed_parts, rot, v3};
+use crate::spec::{ObserverSpec, SceneSpec};
 use crate::strike::{touch_at, HarmRule, Region, StrikeMonitor};
 use rapier3d::prelude::*;
 use sha2::{Digest, Sha256};
@@ -90,6 +90,34 @@ pub struct Simulation {
     pub strike: Option<Strike>,
     /// Hex SHA-256 (first 16 bytes) of every dynamic body's state at every step.
     pub state_hash: String,
+    /// A plain run's world every [`SNAPSHOT_STEPS`] steps, where [`counterfactual`] may
+    /// start (empty for other runs; shared by clones).
+    pub snapshots: Snapshots,
+}
+
+/// A plain run keeps its world every this many steps (0.2 s at 1/240 s): the latest one
+/// before anything comes near the observer is where its counterfactual run starts.
+pub const SNAPSHOT_STEPS: u32 = 48;
+
+/// The worlds a plain run kept, by step ([`SNAPSHOT_STEPS`] apart, from that step on).
+#[derive(Clone, Default)]
+pub struct Snapshots(std::sync::Arc<Vec<SceneWorld>>);
+
+impl Snapshots {
+    /// The world kept at `step` (a positive multiple of [`SNAPSHOT_STEPS`]), forked.
+    fn at(&self, step: u32) -> Option<SceneWorld> {
+        let i = (step / SNAPSHOT_STEPS).checked_sub(1)? as usize;
+        (step % SNAPSHOT_STEPS == 0)
+            .then(|| self.0.get(i))
+            .flatten()
+            .map(fork_world)
+    }
+}
+
+impl std::fmt::Debug for Snapshots {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Snapshots({} worlds)", self.0.len())
+    }
 }
 
 impl Simulation {
@@ -167,21 +195,19 @@ pub(crate) fn lowest_z(collider: &Collider) -> f64 {
     }
 }
 
-const FLOOR_HALF_EXTENT: Real = 50.0;
-const FLOOR_HALF_THICKNESS: Real = 0.5;
-
-/// A spec's world as built for stepping: the floor, every body and joint, in spec
-/// order — the one place the physics setup lives (`simulate` and `execute` both start
-/// from it, so a replay cannot drift from the build).
-pub struct SceneWorld {
-    pub world: PhysicsWorld,
-    pub floor: ColliderHandle,
-    /// Per spec body.
-    pub body_handles: Vec<RigidBodyHandle>,
-    /// Per spec body.
-    pub collider_handles: Vec<ColliderHandle>,
-    /// Spec indices of the dynamic bodies, in spec order (the hashed state's order).
-    pub dynamic_bodies: Vec<usize>,
+impl BodyState {
+    /// The state's 13 numbers, little-endian, in the state hash's order.
+    pub fn hash_into(&self, hasher: &mut Sha256) {
+        for value in self
+            .position
+            .iter()
+            .chain(&self.rotation)
+            .chain(&self.linvel)
+            .chain(&self.angvel)
+        {
+            hasher.update(value.to_le_bytes());
+        }
+    }
 }
 
 impl SceneWorld {
@@ -198,68 +224,71 @@ impl SceneWorld {
     }
 }
 
-impl BodyState {
-    /// The state's 13 numbers, little-endian, in the state hash's order.
-    pub fn hash_into(&self, hasher: &mut Sha256) {
-        for value in self
-            .position
-            .iter()
-            .chain(&self.rotation)
-            .chain(&self.linvel)
-            .chain(&self.angvel)
-        {
-            hasher.update(value.to_le_bytes());
-        }
-    }
-}
-
+pub use crate::world::{build_world, fork_world, SceneWorld};
 pub use rh_contract::execution::hash_hex;
-
-/// Builds the spec's world at t0 (no observer). Pure in `spec`.
-pub fn build_world(spec: &SceneSpec) -> SceneWorld {
-    let mut world = PhysicsWorld::new();
-    world.gravity = v3(spec.physics.gravity);
-    world.integration_parameters.dt = spec.physics.dt as Real;
-    world.integration_parameters.num_solver_iterations = spec.physics.solver_iterations.max(1);
-
-    let floor = world
-        .insert(
-            RigidBodyBuilder::fixed().translation(Vector::new(0.0, 0.0, -FLOOR_HALF_THICKNESS)),
-            ColliderBuilder::cuboid(FLOOR_HALF_EXTENT, FLOOR_HALF_EXTENT, FLOOR_HALF_THICKNESS)
-                .friction(spec.room.floor_friction as Real)
-                .restitution(spec.room.floor_restitution as Real)
-                .friction_combine_rule(CoefficientCombineRule::Average)
-                .restitution_combine_rule(CoefficientCombineRule::Average),
-        )
-        .1;
-
-    let (body_handles, collider_handles) = insert_bodies(&mut world, spec);
-
-    insert_joints(&mut world, spec, &body_handles);
-    let dynamic_bodies: Vec<usize> = (0..spec.bodies.len())
-        .filter(|&i| spec.bodies[i].kind == BodyKind::Dynamic)
-        .collect();
-    SceneWorld {
-        world,
-        floor,
-        body_handles,
-        collider_handles,
-        dynamic_bodies,
-    }
-}
 
 /// Runs the scene. Pure in `spec` and `options`.
 pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
-    let SceneWorld {
-        mut world,
-        floor,
-        body_handles,
-        collider_handles,
-        dynamic_bodies,
-    } = build_world(spec);
+    run(spec, options, None)
+}
 
+/// The counterfactual run of `spec` (`options` with `observer_collider`) given its plain
+/// run `plain` and the first step `near` at which some dynamic body comes near enough to
+/// the observer's body to touch it: until then the observer's static colliders change
+/// nothing, so the run is the plain run up to the last [`SNAPSHOT_STEPS`] multiple
+/// before `near` and goes on from a fork of the world kept there, with the observer
+/// added (from t0 when that multiple is 0). Pure in (`spec`, `options`, `near`): where
+/// `plain` kept no world there, the plain run is replayed to that step.
+pub fn counterfactual(
+    spec: &SceneSpec,
+    plain: &Simulation,
+    near: u32,
+    options: SimOptions,
+) -> Simulation {
+    let start = near.saturating_sub(1) / SNAPSHOT_STEPS * SNAPSHOT_STEPS;
+    if !options.observer_collider || start == 0 || start >= plain.steps() {
+        return simulate(spec, options);
+    }
+    let world = plain
+        .snapshots
+        .at(start)
+        .unwrap_or_else(|| fork_world(&replay_to(spec, start)));
+    run(
+        spec,
+        options,
+        Some(Resume {
+            world,
+            step: start,
+            plain,
+        }),
+    )
+}
+
+/// The plain world of `spec` stepped `steps` times.
+fn replay_to(spec: &SceneSpec, steps: u32) -> SceneWorld {
+    let mut sw = build_world(spec);
+    for _ in 0..steps {
+        sw.world.step();
+    }
+    sw
+}
+
+/// Where a counterfactual run starts when not at t0: the world at plain step `step`
+/// (forked) and the plain run, whose steps `0..=step` it shares.
+struct Resume<'a> {
+    world: SceneWorld,
+    step: u32,
+    plain: &'a Simulation,
+}
+
+fn run(spec: &SceneSpec, options: SimOptions, resume: Option<Resume>) -> Simulation {
+    let (mut sw, prefix) = match resume {
+        Some(Resume { world, step, plain }) => (world, Some((plain, step))),
+        None => (build_world(spec), None),
+    };
+    let first_step = prefix.map_or(0, |(_, step)| step + 1);
     let observer: Vec<ColliderHandle> = if options.observer_collider {
-        insert_observer(&mut world, &spec.observer)
+        insert_observer(&mut sw.world, &spec.observer)
     } else {
         Vec::new()
     };
@@ -267,73 +296,46 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
         HarmRule::of_labels(&spec.labels, &spec.hazard_flags, spec.physics.dt),
         observer.len(),
     );
-
     let link_shapes = Geometry::of(&spec.observer).shapes();
-    let hazard_slot = dynamic_bodies
-        .iter()
-        .position(|&i| i == spec.hazard)
-        .expect("the hazard is a dynamic body");
-    let hazard_collider = collider_handles[spec.hazard];
-    let source_collider = spec.source_support.map(|i| collider_handles[i]);
+    let hazard_collider = sw.collider_handles[spec.hazard];
+    let source_collider = spec.source_support.map(|i| sw.collider_handles[i]);
 
     // Penetration at t0, by direct shape queries (a collision pass through the world
-    // before the first step would disturb rapier's state).
-    let initial_penetration = initial_penetration(&world);
-
-    let gravity = v3(spec.physics.gravity);
-    let n_dyn = dynamic_bodies.len();
-    let max_steps = spec.physics.max_steps as usize;
-    let mut sim = Simulation {
-        dt: spec.physics.dt,
-        dynamic_bodies: dynamic_bodies.clone(),
-        states: Vec::with_capacity((max_steps + 1) * n_dyn),
-        hazard_slot,
-        hazard_lowest_z: Vec::with_capacity(max_steps + 1),
-        hazard_com: Vec::with_capacity(max_steps + 1),
-        hazard_contacts: Vec::with_capacity(max_steps + 1),
-        energy: Vec::with_capacity(max_steps + 1),
-        initial_penetration,
-        strike: None,
-        state_hash: String::new(),
+    // before the first step would disturb rapier's state); a resumed run's is its plain
+    // run's (nothing was near the observer's body then).
+    let initial_penetration = match prefix {
+        Some((plain, _)) => plain.initial_penetration,
+        None => initial_penetration(&sw.world),
     };
+    let mut sim = Simulation::empty(spec, sw.dynamic_bodies.clone(), initial_penetration);
     let mut hasher = Sha256::new();
     let mut calm_steps = 0u32;
-    // A plain run keeps its world at Δ for this thread's escape walks (`decision_world`).
+    if let Some((plain, step)) = prefix {
+        calm_steps = sim.resume_from(spec, plain, step, &mut hasher);
+    }
+    // A plain run keeps its world at Δ for this thread's escape walks (`decision_world`),
+    // and every SNAPSHOT_STEPS steps for its counterfactual (`counterfactual`).
     let keep_at = (!options.observer_collider).then(|| spec.decision_step());
+    let mut snapshots = Vec::new();
 
-    for step in 0..=spec.physics.max_steps {
+    for step in first_step..=spec.physics.max_steps {
         if step > 0 {
-            world.step();
+            sw.world.step();
         }
-        // Record every dynamic body's state and fold it into the hash.
-        let mut energy = 0.0f64;
-        for &i in &dynamic_bodies {
-            let rb = &world.bodies[body_handles[i]];
-            let state = state_of(rb);
-            state.hash_into(&mut hasher);
-            sim.states.push(state);
-            let com = rb.center_of_mass();
-            energy += rb.kinetic_energy() as f64 - rb.mass() as f64 * (gravity.dot(com) as f64);
+        if keep_at.is_some() && step > 0 && step % SNAPSHOT_STEPS == 0 {
+            snapshots.push(fork_world(&sw));
         }
-        sim.energy.push(energy);
-        sim.hazard_lowest_z
-            .push(lowest_z(&world.colliders[hazard_collider]));
-        let com = world.bodies[body_handles[spec.hazard]].center_of_mass();
-        sim.hazard_com
-            .push([com.x as f64, com.y as f64, com.z as f64]);
-
-        let flags =
-            hazard_contact_flags(&world, hazard_collider, floor, source_collider, &observer);
+        sim.record(spec, &sw, &mut hasher);
+        let flags = hazard_contact_flags(
+            &sw.world,
+            hazard_collider,
+            sw.floor,
+            source_collider,
+            &observer,
+        );
         sim.hazard_contacts.push(flags);
         if keep_at == Some(step) {
-            let at_decision = SceneWorld {
-                world: fork_physics(&world),
-                floor,
-                body_handles: body_handles.clone(),
-                collider_handles: collider_handles.clone(),
-                dynamic_bodies: dynamic_bodies.clone(),
-            };
-            keep_decision_world(spec, at_decision, hash_hex(hasher.clone()));
+            keep_decision_world(spec, fork_world(&sw), hash_hex(hasher.clone()));
         }
 
         if step == 0 {
@@ -344,7 +346,7 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
                 &mut strikes,
                 &sim,
                 step,
-                &world,
+                &sw.world,
                 hazard_collider,
                 &observer,
                 &link_shapes,
@@ -353,18 +355,24 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
                 break;
             }
         }
-        let calm = dynamic_bodies.iter().all(|&i| {
-            let rb = &world.bodies[body_handles[i]];
-            (rb.linvel().length() as f64) < spec.physics.settle_speed
-                && (rb.angvel().length() as f64) < spec.physics.settle_speed * 10.0
-        });
+        let calm = sw
+            .dynamic_bodies
+            .iter()
+            .all(|&i| calm(spec, &sw.body_state(i)));
         calm_steps = if calm { calm_steps + 1 } else { 0 };
         if step >= spec.physics.min_steps && calm_steps >= spec.physics.settle_steps {
             break;
         }
     }
     sim.state_hash = hash_hex(hasher);
-    sim.strike = strikes.report().map(|w| {
+    sim.snapshots = Snapshots(std::sync::Arc::new(snapshots));
+    sim.strike = strike_of(&strikes);
+    sim
+}
+
+/// The strike a counterfactual run records ([`StrikeMonitor::report`] with its verdict).
+fn strike_of(strikes: &StrikeMonitor) -> Option<Strike> {
+    strikes.report().map(|w| {
         let v = strikes.rule().judge(w);
         Strike {
             step: w.start,
@@ -378,37 +386,94 @@ pub fn simulate(spec: &SceneSpec, options: SimOptions) -> Simulation {
             ratio: v.ratio,
             harm: v.harm,
         }
-    });
-    sim
+    })
 }
 
-/// A world ready to step from: `sw`'s state (bodies, colliders, joints, broad and
-/// narrow phase, islands, CCD) cloned into a fresh solver workspace, as `execute` forks
-/// the world at Δ for every plan.
-pub fn fork_world(sw: &SceneWorld) -> SceneWorld {
-    SceneWorld {
-        world: fork_physics(&sw.world),
-        floor: sw.floor,
-        body_handles: sw.body_handles.clone(),
-        collider_handles: sw.collider_handles.clone(),
-        dynamic_bodies: sw.dynamic_bodies.clone(),
+/// Whether a body in state `b` is still for the settle rule.
+fn calm(spec: &SceneSpec, b: &BodyState) -> bool {
+    let speed = |v: [f32; 3]| Vector::from(v).length() as f64;
+    speed(b.linvel) < spec.physics.settle_speed
+        && speed(b.angvel) < spec.physics.settle_speed * 10.0
+}
+
+impl Simulation {
+    /// A run of `spec` with nothing recorded yet (room for its horizon).
+    fn empty(spec: &SceneSpec, dynamic_bodies: Vec<usize>, initial_penetration: f64) -> Self {
+        let hazard_slot = dynamic_bodies
+            .iter()
+            .position(|&i| i == spec.hazard)
+            .expect("the hazard is a dynamic body");
+        let steps = spec.physics.max_steps as usize + 1;
+        Simulation {
+            dt: spec.physics.dt,
+            states: Vec::with_capacity(steps * dynamic_bodies.len()),
+            dynamic_bodies,
+            hazard_slot,
+            hazard_lowest_z: Vec::with_capacity(steps),
+            hazard_com: Vec::with_capacity(steps),
+            hazard_contacts: Vec::with_capacity(steps),
+            energy: Vec::with_capacity(steps),
+            initial_penetration,
+            strike: None,
+            state_hash: String::new(),
+            snapshots: Snapshots::default(),
+        }
     }
-}
 
-fn fork_physics(w: &PhysicsWorld) -> PhysicsWorld {
-    let mut world = PhysicsWorld::new();
-    world.gravity = w.gravity;
-    world.integration_parameters = w.integration_parameters;
-    world.islands = w.islands.clone();
-    world.broad_phase = w.broad_phase.clone();
-    world.narrow_phase = w.narrow_phase.clone();
-    world.bodies = w.bodies.clone();
-    world.colliders = w.colliders.clone();
-    world.impulse_joints = w.impulse_joints.clone();
-    world.multibody_joints = w.multibody_joints.clone();
-    world.soft_bodies = w.soft_bodies.clone();
-    world.ccd_solver = w.ccd_solver.clone();
-    world
+    /// Records this step of `sw` (not its contacts): every dynamic body's state, folded
+    /// into `hasher`, their mechanical energy, the hazard's lowest point and centre of mass.
+    fn record(&mut self, spec: &SceneSpec, sw: &SceneWorld, hasher: &mut Sha256) {
+        let gravity = v3(spec.physics.gravity);
+        let mut energy = 0.0f64;
+        for &i in &sw.dynamic_bodies {
+            let rb = &sw.world.bodies[sw.body_handles[i]];
+            let state = state_of(rb);
+            state.hash_into(hasher);
+            self.states.push(state);
+            let com = rb.center_of_mass();
+            energy += rb.kinetic_energy() as f64 - rb.mass() as f64 * (gravity.dot(com) as f64);
+        }
+        self.energy.push(energy);
+        self.hazard_lowest_z.push(lowest_z(
+            &sw.world.colliders[sw.collider_handles[spec.hazard]],
+        ));
+        let com = sw.world.bodies[sw.body_handles[spec.hazard]].center_of_mass();
+        self.hazard_com
+            .push([com.x as f64, com.y as f64, com.z as f64]);
+    }
+
+    /// Takes steps `0..=step` of `plain` (a counterfactual run resumed there): the
+    /// records, their states folded into `hasher`; returns the settle rule's count of
+    /// calm steps at `step`.
+    fn resume_from(
+        &mut self,
+        spec: &SceneSpec,
+        plain: &Simulation,
+        step: u32,
+        hasher: &mut Sha256,
+    ) -> u32 {
+        let k = step as usize + 1;
+        let n = self.dynamic_bodies.len();
+        self.states.extend_from_slice(&plain.states[..k * n]);
+        for state in &self.states {
+            state.hash_into(hasher);
+        }
+        self.energy.extend_from_slice(&plain.energy[..k]);
+        self.hazard_lowest_z
+            .extend_from_slice(&plain.hazard_lowest_z[..k]);
+        self.hazard_com.extend_from_slice(&plain.hazard_com[..k]);
+        self.hazard_contacts
+            .extend_from_slice(&plain.hazard_contacts[..k]);
+        // Step 0 is never counted (the loop judges steps from 1 on).
+        (1..k)
+            .rev()
+            .take_while(|&j| {
+                self.states[j * n..(j + 1) * n]
+                    .iter()
+                    .all(|b| calm(spec, b))
+            })
+            .count() as u32
+    }
 }
 
 /// How many worlds at Δ a thread keeps (a group's four bands, with room to spare).
@@ -509,69 +574,6 @@ fn state_of(rb: &RigidBody) -> BodyState {
         rotation: [q.x, q.y, q.z, q.w],
         linvel: [v.x, v.y, v.z],
         angvel: [w.x, w.y, w.z],
-    }
-}
-
-/// Inserts every body of the spec with its collider, in spec order.
-fn insert_bodies(
-    world: &mut PhysicsWorld,
-    spec: &SceneSpec,
-) -> (Vec<RigidBodyHandle>, Vec<ColliderHandle>) {
-    let mut body_handles = Vec::with_capacity(spec.bodies.len());
-    let mut collider_handles = Vec::with_capacity(spec.bodies.len());
-    for b in &spec.bodies {
-        let builder = match b.kind {
-            BodyKind::Fixed => RigidBodyBuilder::fixed(),
-            BodyKind::Dynamic => RigidBodyBuilder::dynamic()
-                .linvel(v3(b.linvel))
-                .angvel(v3(b.angvel))
-                .ccd_enabled(b.ccd)
-                // Never frozen by the sleep heuristic (an object balanced on an edge must
-                // tip); `simulate` stops by its own settle rule instead.
-                .can_sleep(false),
-        }
-        .pose(Pose::from_parts(v3(b.position), rot(b.rotation)));
-        let mut collider = collider_for(&b.parts)
-            .friction(b.friction as Real)
-            .restitution(b.restitution as Real)
-            .friction_combine_rule(CoefficientCombineRule::Average)
-            .restitution_combine_rule(CoefficientCombineRule::Average);
-        if b.kind == BodyKind::Dynamic {
-            collider = collider.mass(b.mass as Real);
-        }
-        let (bh, ch) = world.insert(builder, collider);
-        body_handles.push(bh);
-        collider_handles.push(ch);
-    }
-    (body_handles, collider_handles)
-}
-
-/// Inserts the spec's joints, in spec order; a world anchor is a fixed body at the origin.
-fn insert_joints(world: &mut PhysicsWorld, spec: &SceneSpec, body_handles: &[RigidBodyHandle]) {
-    let mut world_anchor = None;
-    for j in &spec.joints {
-        let a = match j.body_a {
-            Some(i) => body_handles[i],
-            None => {
-                *world_anchor.get_or_insert_with(|| world.bodies.insert(RigidBodyBuilder::fixed()))
-            }
-        };
-        let b = body_handles[j.body_b];
-        let joint: GenericJoint = match &j.kind {
-            JointKind::Revolute { axis } => RevoluteJointBuilder::new(v3(*axis).normalize())
-                .local_anchor1(v3(j.anchor_a))
-                .local_anchor2(v3(j.anchor_b))
-                .into(),
-            JointKind::Spherical => SphericalJointBuilder::new()
-                .local_anchor1(v3(j.anchor_a))
-                .local_anchor2(v3(j.anchor_b))
-                .into(),
-            JointKind::Rope { max_length } => RopeJointBuilder::new(*max_length as Real)
-                .local_anchor1(v3(j.anchor_a))
-                .local_anchor2(v3(j.anchor_b))
-                .into(),
-        };
-        world.impulse_joints.insert(a, b, joint, true);
     }
 }
 

@@ -172,5 +172,6 @@ fn slots_of(spec: &SceneSpec) -> Simulation {
         initial_penetration: 0.0,
         strike: None,
         state_hash: String::new(),
+        snapshots: Default::default(),
     }
 }

@@ -6,6 +6,10 @@
 
 use crate::cameras;
 use crate::config::Config;
+pub use crate::counterfactual::{
+    counterfactual_options, counterfactual_run, first_near_step, full_event_simulation,
+    may_touch_observer,
+};
 use crate::families;
 use crate::label::{label, Labels};
 use crate::randomize::{randomize, RandomizeError, SceneKey};
@@ -170,15 +174,12 @@ pub fn produce_planned_group(
         4
     };
     let produce = || {
-        produce_group_counted(
-            &selection,
-            seed,
-            slot.probe_group * 4,
-            probe_count,
-            catalog,
-            &probe_config,
-        )
-        .map_err(|e| e.to_string())
+        let bands = Bands {
+            build_seed: seed,
+            first_index: slot.probe_group * 4,
+            count: probe_count,
+        };
+        probe_group_counted(&selection, bands, catalog, &probe_config).map_err(|e| e.to_string())
     };
     // The probe group and its twin group both take the probe's four bands: produced once
     // per process ([`PROBES`]), by whichever of the two comes first.
@@ -276,12 +277,12 @@ fn replanned_group(
         let selection =
             replan_group(catalog, families, seed, g, &policy, replan).map_err(|e| e.to_string())?;
         let memo = (replan < aim_replans).then_some(&mut memo);
-        let attempts = Attempts {
+        let bands = Bands {
             build_seed: seed,
             first_index: g * 4,
             count,
-            require_aim,
         };
+        let attempts = Attempts { bands, require_aim };
         let produced = produce_attempts(&selection, &attempts, catalog, config, memo)
             .map_err(|e| e.to_string())?;
         match &produced {
@@ -369,13 +370,9 @@ pub fn label_scene(spec: SceneSpec, sim: Simulation, config: &Config) -> SceneRe
 }
 
 /// The labels of a simulated spec: the counterfactual run where the hazard may touch
-/// the observer ([`may_touch_observer`]), then the label rule.
+/// the observer ([`counterfactual_run`]), then the label rule.
 fn counterfactual_labels(spec: &SceneSpec, sim: &Simulation) -> Labels {
-    let strike = if may_touch_observer(spec, sim) {
-        simulate(spec, counterfactual_options(spec)).strike
-    } else {
-        None
-    };
+    let strike = counterfactual_run(spec, sim).and_then(|cf| cf.strike);
     label(spec, sim, strike)
 }
 
@@ -397,58 +394,6 @@ fn scene_result(
         trajectory,
         media: None,
     }
-}
-
-/// The counterfactual run of SPEC §6: the observer's body (the humanoid standing at
-/// rest, `simulate::observer_links`) as fixed colliders, followed by the strike test.
-pub fn counterfactual_options(_spec: &SceneSpec) -> SimOptions {
-    SimOptions {
-        observer_collider: true,
-        run_past_strike: false,
-    }
-}
-
-/// What the full-event video (`videos/full/<id>.mp4`) shows: the counterfactual of
-/// SPEC §6 — the standing observer as a static collider, what the labels mean — run to
-/// the end of the event rather than stopped after the strike window. `None` when no
-/// body ever comes near the observer: that run is then the plain run (see
-/// [`may_touch_observer`]), which the caller already has. The observation videos and
-/// frames always show the plain run (they end at Δ; in a valid scene nothing reaches the
-/// observer before Δ plus a reaction time). Labels, specs and hashes never depend on this run.
-pub fn full_event_simulation(spec: &SceneSpec, sim: &Simulation) -> Option<Simulation> {
-    may_touch_observer(spec, sim).then(|| {
-        simulate(
-            spec,
-            SimOptions {
-                run_past_strike: true,
-                ..counterfactual_options(spec)
-            },
-        )
-    })
-}
-
-/// Clearance kept beyond the bounding spheres before a body could touch the observer
-/// (covers the solver's speculative-contact distance with a wide margin).
-const OBSERVER_CLEARANCE: f64 = 0.1;
-
-/// Whether any dynamic body ever comes near enough to the observer's body to touch it.
-/// If none does, the counterfactual run (observer as a static collider) is step for step
-/// the plain run — a static collider changes nothing until something touches it — so
-/// it cannot strike and need not be simulated.
-pub fn may_touch_observer(spec: &SceneSpec, sim: &Simulation) -> bool {
-    let o = &spec.observer;
-    // The standing body's links reach this far from its axis (arms, hands).
-    let body = rh_physics::body::Geometry::of(o).rest_extent();
-    sim.dynamic_bodies
-        .iter()
-        .enumerate()
-        .any(|(slot, &body_index)| {
-            let reach = spec.bodies[body_index].bounding_radius()
-                + body.max(o.torso_radius)
-                + OBSERVER_CLEARANCE;
-            (0..=sim.steps())
-                .any(|k| o.torso_axis_distance(sim.state(k, slot).position.map(f64::from)) <= reach)
-        })
 }
 
 fn hazard_trajectory(spec: &SceneSpec, sim: &Simulation) -> Vec<[f32; 4]> {
@@ -503,20 +448,32 @@ fn label_aimed(
     }
 }
 
-/// [`label_group`] for an attempt that is not the last: the same labels and verdicts,
-/// but the escape walks (`validate::escapable`, the costliest check) run only when every
-/// other check passes on every band, and stop at the first band they reject. An attempt
-/// another check rejects is discarded whatever its walks say, so its `escapable`
-/// verdicts stay `true` and `Rejections` does not count them; an attempt that the walks
-/// decide gets `label_group`'s results.
+/// [`label_group`] for an attempt that is not the last, checked cheapest first: the
+/// validators that need no labels on every band; only if they all pass, each band's
+/// counterfactual run and the reaction-time rule; only if those pass too, the escape
+/// walks (`validate::escapable`, the costliest check), stopping at the first band they
+/// reject. An attempt a cheaper check rejects is discarded whatever the costlier checks
+/// would say, so their verdicts stay `true` (and `Rejections` does not count them) and
+/// its labels are the plain run's (no strike); an attempt that passes them all gets
+/// `label_group`'s results.
 fn label_group_counting(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> Vec<SceneResult> {
-    let mut labelled = Vec::with_capacity(runs.len());
+    let mut checked = Vec::with_capacity(runs.len());
     for (spec, sim) in framed_group(runs, config) {
         let family =
             families::get(&spec.family).expect("randomize only emits implemented families");
-        let labels = counterfactual_labels(&spec, &sim);
-        let mut verdicts = crate::validate::unlabelled(&spec, &sim, family, &config.validators);
-        verdicts.reaction_time = crate::validate::reaction_time_ok(&spec, &labels);
+        let verdicts = crate::validate::unlabelled(&spec, &sim, family, &config.validators);
+        checked.push((spec, sim, verdicts));
+    }
+    let unlabelled_pass = checked.iter().all(|(_, _, v)| v.all());
+    let mut labelled = Vec::with_capacity(checked.len());
+    for (spec, sim, mut verdicts) in checked {
+        let labels = if unlabelled_pass {
+            let labels = counterfactual_labels(&spec, &sim);
+            verdicts.reaction_time = crate::validate::reaction_time_ok(&spec, &labels);
+            labels
+        } else {
+            label(&spec, &sim, None)
+        };
         labelled.push((spec, sim, labels, verdicts));
     }
     if labelled.iter().all(|(_, _, _, v)| v.all()) {
@@ -616,22 +573,59 @@ pub fn produce_group_counted(
     catalog: &Catalog,
     config: &Config,
 ) -> Result<(Vec<SceneResult>, Rejections), RandomizeError> {
-    let attempts = Attempts {
+    let bands = Bands {
         build_seed,
         first_index,
         count,
-        require_aim: false,
     };
-    let produced = produce_attempts(selection, &attempts, catalog, config, None)?;
-    Ok(produced.unwrap_or_default())
+    produce_requiring(selection, bands, catalog, config, &[false])
 }
 
-/// Which scenes [`produce_attempts`] produces: `first_index .. first_index + count` of
-/// build `build_seed`; with `require_aim`, unaimed attempts are redrawn unlabelled.
-struct Attempts {
+/// A probe group's bands: attempts whose event cannot be aimed are redrawn (`require_aim`,
+/// up to the family's `[aim] attempts_by_family`), since a probe shown at the family's own
+/// pose is a near miss for it and its twin alike; only if every such attempt fails does
+/// the group stand at the family's pose (as [`produce_group_counted`]), its plain runs kept.
+fn probe_group_counted(
+    selection: &Selection,
+    bands: Bands,
+    catalog: &Catalog,
+    config: &Config,
+) -> Result<(Vec<SceneResult>, Rejections), RandomizeError> {
+    produce_requiring(selection, bands, catalog, config, &[true, false])
+}
+
+/// A group's scenes `first_index .. first_index + count` of build `build_seed`.
+#[derive(Clone, Copy)]
+struct Bands {
     build_seed: u64,
     first_index: u64,
     count: u64,
+}
+
+/// [`produce_attempts`] with `require_aim` as each of `tries` in turn (sharing plain runs)
+/// until one produces the group.
+fn produce_requiring(
+    selection: &Selection,
+    bands: Bands,
+    catalog: &Catalog,
+    config: &Config,
+    tries: &[bool],
+) -> Result<(Vec<SceneResult>, Rejections), RandomizeError> {
+    let mut memo = SimMemo::default();
+    for &require_aim in tries {
+        let attempts = Attempts { bands, require_aim };
+        let memo = (tries.len() > 1).then_some(&mut memo);
+        if let Some(produced) = produce_attempts(selection, &attempts, catalog, config, memo)? {
+            return Ok(produced);
+        }
+    }
+    Ok(Default::default())
+}
+
+/// Which scenes [`produce_attempts`] produces: the group's `bands`; with `require_aim`,
+/// unaimed attempts are redrawn unlabelled.
+struct Attempts {
+    bands: Bands,
     require_aim: bool,
 }
 
@@ -669,12 +663,14 @@ fn produce_attempts(
     config: &Config,
     mut memo: Option<&mut SimMemo>,
 ) -> Result<Option<(Vec<SceneResult>, Rejections)>, RandomizeError> {
-    let &Attempts {
-        build_seed,
-        first_index,
-        count,
+    let Attempts {
+        bands: Bands {
+            build_seed,
+            first_index,
+            count,
+        },
         require_aim,
-    } = attempts;
+    } = *attempts;
     let mut results = Vec::new();
     let mut rejections = Rejections::default();
     let mut unaimed = 0;

@@ -32,6 +32,12 @@ pub struct EvalConfig {
     /// count toward the family's CATCH and NO_ACTION targets.
     #[serde(default)]
     pub twin_pairs_per_family: usize,
+    /// The NO_ACTION scenes a family's twin pairs may bring (with `catch_share`), where
+    /// more than `no_action_per_family` (0: that cap — builds before it): a disguised
+    /// object caught whose genuine look-alike passes the standing body harmlessly is a
+    /// probe like any other. Further NO_ACTION scenes stay within `no_action_per_family`.
+    #[serde(default, skip_serializing_if = "is_zero_usize")]
+    pub twin_no_action_per_family: usize,
     /// With `catch_share`: families still short of `per_family` take further NO_ACTION
     /// scenes of their own, one family at a time in name order, while the subset's
     /// NO_ACTION scenes stay within this share of `per_family` × families (0: never —
@@ -44,6 +50,10 @@ fn is_zero(v: &f64) -> bool {
     *v == 0.0
 }
 
+fn is_zero_usize(v: &usize) -> bool {
+    *v == 0
+}
+
 impl Default for EvalConfig {
     /// What builds before label rule v5 used (their manifests have no `[eval]`).
     fn default() -> Self {
@@ -52,6 +62,7 @@ impl Default for EvalConfig {
             catch_share: None,
             no_action_per_family: 0,
             twin_pairs_per_family: 0,
+            twin_no_action_per_family: 0,
             no_action_fill_share: 0.0,
         }
     }
@@ -134,9 +145,9 @@ fn fill_with_no_action(
     }
 }
 
-/// Up to `twin_pairs_per_family` probe pairs whose scenes are both valid members, in the
-/// probe's (the lower index's) order, as long as their NO_ACTION scenes stay within
-/// `no_action_per_family`; then per kind, the first remaining scenes in index
+/// Up to `twin_pairs_per_family` probe pairs whose scenes are both valid members and not
+/// both NO_ACTION, in the probe's (the lower index's) order, as long as their NO_ACTION
+/// scenes stay within `twin_no_action_per_family`; then per kind, the first remaining scenes in index
 /// order: CATCH up to its target, NO_ACTION up to its cap (both less what the pairs
 /// gave), DODGE for the rest; then whatever is left of CATCH and DODGE, in that order,
 /// until `per_family`.
@@ -144,6 +155,7 @@ fn stratified(rows: &[EvalRow], members: &[usize], cfg: &EvalConfig, share: f64)
     let n = cfg.per_family;
     let by_index: BTreeMap<u64, usize> =
         members.iter().map(|&r| (rows[r].scene_index, r)).collect();
+    let pair_none_cap = cfg.no_action_per_family.max(cfg.twin_no_action_per_family);
     let mut taken: Vec<usize> = Vec::new();
     for &r in members {
         if taken.len() + 2 > n.min(2 * cfg.twin_pairs_per_family) {
@@ -151,13 +163,18 @@ fn stratified(rows: &[EvalRow], members: &[usize], cfg: &EvalConfig, share: f64)
         }
         let twin = rows[r].twin.filter(|&t| t > rows[r].scene_index);
         if let Some(&q) = twin.and_then(|t| by_index.get(&t)) {
+            // A pair of two NO_ACTION scenes is no probe: nothing reaches the observer
+            // with either object (the probe's aim failed), so no decision tells them apart.
+            if rows[r].action == "NO_ACTION" && rows[q].action == "NO_ACTION" {
+                continue;
+            }
             // Within the family's NO_ACTION cap, like every other scene.
             let none = [r, q]
                 .iter()
                 .chain(&taken)
                 .filter(|&&x| rows[x].action == "NO_ACTION")
                 .count();
-            if none <= cfg.no_action_per_family {
+            if none <= pair_none_cap {
                 taken.extend([r, q]);
             }
         }
@@ -233,6 +250,19 @@ mod tests {
         }
     }
 
+    /// Scene `i` of family "a", the probe pair's member whose twin is scene `twin`.
+    fn paired(i: u64, twin: u64, action: &'static str) -> EvalRow<'static> {
+        EvalRow {
+            twin: Some(twin),
+            ..row("a", i, action)
+        }
+    }
+
+    /// Both scenes of the probe pair `i`–`j` of family "a" (labels `a`, `b`).
+    fn pair(i: u64, j: u64, a: &'static str, b: &'static str) -> [EvalRow<'static>; 2] {
+        [paired(i, j, a), paired(j, i, b)]
+    }
+
     #[test]
     fn stratified_subset_asks_for_the_configured_shares_and_fills_from_the_rest() {
         let cfg = EvalConfig {
@@ -240,6 +270,7 @@ mod tests {
             catch_share: Some(0.5),
             no_action_per_family: 1,
             twin_pairs_per_family: 0,
+            twin_no_action_per_family: 0,
             no_action_fill_share: 0.0,
         };
         // Family a: 3 CATCH, 12 DODGE, 4 NO_ACTION: CATCH short, DODGE fills.
@@ -297,6 +328,7 @@ mod tests {
             catch_share: Some(0.5),
             no_action_per_family: 1,
             twin_pairs_per_family: 0,
+            twin_no_action_per_family: 0,
             // 3 families × 4 = 12 scenes: at most floor(0.34 × 12) = 4 NO_ACTION.
             no_action_fill_share: 0.34,
         };
@@ -340,37 +372,62 @@ mod tests {
             catch_share: Some(0.5),
             no_action_per_family: 1,
             twin_pairs_per_family: 2,
+            twin_no_action_per_family: 0,
             no_action_fill_share: 0.0,
         };
-        let paired = |i: u64, twin: u64, action| EvalRow {
-            twin: Some(twin),
-            ..row("a", i, action)
-        };
-        let rows = vec![
-            // Pair 0–4: NO_ACTION / NO_ACTION exceeds the cap of one: left out.
-            paired(0, 4, "NO_ACTION"),
-            paired(4, 0, "NO_ACTION"),
-            // Pair 1–5: CATCH / DODGE, taken.
-            paired(1, 5, "CATCH"),
-            paired(5, 1, "DODGE"),
-            // Pair 2–6: CATCH / NO_ACTION, taken (the one NO_ACTION).
-            paired(2, 6, "CATCH"),
-            paired(6, 2, "NO_ACTION"),
-            // Pair 3–7: the twin is invalid: not a pair.
-            paired(3, 7, "CATCH"),
-            EvalRow {
-                valid: false,
-                ..paired(7, 3, "DODGE")
-            },
-            row("a", 8, "CATCH"),
-            row("a", 9, "DODGE"),
-            row("a", 10, "DODGE"),
-        ];
+        // Pair 0–4: NO_ACTION / NO_ACTION, left out (no probe, and over the cap of one);
+        // pair 1–5: CATCH / DODGE, taken; pair 2–6: CATCH / NO_ACTION, taken (the one
+        // NO_ACTION); pair 3–7: the twin is invalid: not a pair.
+        let mut rows: Vec<EvalRow> = [
+            pair(0, 4, "NO_ACTION", "NO_ACTION"),
+            pair(1, 5, "CATCH", "DODGE"),
+            pair(2, 6, "CATCH", "NO_ACTION"),
+            pair(3, 7, "CATCH", "DODGE"),
+        ]
+        .concat();
+        rows[7].valid = false;
+        rows.extend([8, 9, 10].map(|i| row("a", i, if i == 8 { "CATCH" } else { "DODGE" })));
         let (chosen, _) = select(&rows, &cfg);
         let indices: Vec<u64> = chosen.iter().map(|&r| rows[r].scene_index).collect();
         // Pairs 1–5 and 2–6; CATCH target 3 less the pairs' 2: one more (3); DODGE for
         // the rest (9); no further NO_ACTION (the pair used the cap).
         assert_eq!(indices, vec![1, 2, 3, 5, 6, 9]);
+    }
+
+    #[test]
+    fn twin_pairs_may_bring_more_no_action_but_never_two_in_one_pair() {
+        let cfg = EvalConfig {
+            per_family: 8,
+            catch_share: Some(0.5),
+            no_action_per_family: 1,
+            twin_pairs_per_family: 3,
+            twin_no_action_per_family: 2,
+            ..EvalConfig::default()
+        };
+        // NO_ACTION / NO_ACTION: no probe, left out although the cap is two; CATCH /
+        // NO_ACTION twice: both taken (two NO_ACTION, the pairs' cap); a third would
+        // exceed it: left out.
+        let mut rows: Vec<EvalRow> = [
+            pair(0, 10, "NO_ACTION", "NO_ACTION"),
+            pair(1, 11, "CATCH", "NO_ACTION"),
+            pair(2, 12, "CATCH", "NO_ACTION"),
+            pair(3, 13, "CATCH", "NO_ACTION"),
+        ]
+        .concat();
+        rows.extend(
+            [
+                (20, "CATCH"),
+                (21, "DODGE"),
+                (22, "DODGE"),
+                (23, "NO_ACTION"),
+            ]
+            .map(|(i, action)| row("a", i, action)),
+        );
+        let (chosen, _) = select(&rows, &cfg);
+        let indices: Vec<u64> = chosen.iter().map(|&r| rows[r].scene_index).collect();
+        // Pairs 1–11 and 2–12; CATCH target 4 less the pairs' 2: 3 and 20; the rest
+        // DODGE (21, 22); no single NO_ACTION (the pairs already hold two).
+        assert_eq!(indices, vec![1, 2, 3, 11, 12, 20, 21, 22]);
     }
 
     #[test]

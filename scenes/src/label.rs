@@ -472,6 +472,7 @@ mod tests {
             initial_penetration: 0.0,
             strike: None,
             state_hash: String::new(),
+            snapshots: Default::default(),
         };
         let r = 0.04;
         for k in 0..=steps {

@@ -4,7 +4,8 @@
 //! [`selection::plan_group`] (what a scene group shows) → [`randomize::randomize`]
 //! (its `SceneSpec`, one per speed band) → `rh_physics::simulate` → [`aim::aim_group`]
 //! (the observer stands on the hazard's path) → [`cameras::frame`]
-//! → [`label::label`] (ground truth from the counterfactual run) →
+//! → [`label::label`] (ground truth from the counterfactual run,
+//! [`counterfactual::counterfactual_run`]) →
 //! [`validate::validate`] (one verdict per validator column). [`driver::run_group`] chains
 //! them for a group and hands each valid scene to a render stage given as a plain
 //! function. [`config::Config`] is the build policy (`configs/default.toml` +
@@ -14,6 +15,7 @@ pub mod aim;
 pub mod balance;
 pub mod cameras;
 pub mod config;
+pub mod counterfactual;
 pub mod driver;
 pub mod eval_subset;
 pub mod families;

@@ -411,3 +411,36 @@ fn a_strike_is_escapable_only_when_some_walk_clears_it_in_time() {
         }
     }
 }
+
+#[test]
+fn a_hazard_still_on_the_floor_from_the_start_ends_the_run_once_it_has_stayed_still() {
+    // A 1 kg ball resting on the floor 1.5 m in front of the standing humanoid, as a
+    // ladder or a wardrobe comes to rest without ever landing: the run of the `freeze`
+    // plan ends `settle_time_s` after it (execution rule e5), not at the horizon, and is
+    // clear either way.
+    let spec = ball_scene(1.0, [1.5, 0.0, 0.04], 0.0);
+    let cfg = ExecConfig::embedded_default();
+    let freeze = &plans()[0];
+    let out = replay(&spec).execute(freeze, &cfg);
+    assert_eq!(out.outcome, OutcomeKind::Clear, "{out:?}");
+    let settle = (cfg.settle_time_s / spec.physics.dt).round() as u32;
+    assert!(settle > 0);
+    assert!(
+        out.steps >= settle && out.steps <= settle + 12,
+        "{} steps, settle {settle}",
+        out.steps
+    );
+    // Without the rule (settle_time_s 0, configs of e4) it runs to the horizon.
+    let e4 = ExecConfig {
+        settle_time_s: 0.0,
+        ..cfg.clone()
+    };
+    let long = replay(&spec).execute(freeze, &e4);
+    assert_eq!(long.outcome, OutcomeKind::Clear);
+    let horizon = (cfg.horizon_s / spec.physics.dt).round() as u32;
+    assert!(
+        long.steps >= horizon.min(spec.physics.max_steps) - 1,
+        "{}",
+        long.steps
+    );
+}

@@ -546,8 +546,10 @@ fn chain_reaction_target_rests_until_struck_then_moves() {
         assert!(strike > 0);
         // At rest until struck: it stays put (< 2 mm), and its speed is solver noise.
         // Rapier's soft contacts settle a body set exactly on a surface with a residual
-        // of about 1 mm/s in the first steps (1.4 mm/s for a 50 g plastic wine glass),
-        // hence 2 mm/s rather than 1.
+        // of a few mm/s in the first steps: about 1 mm/s with four solver substeps per
+        // step (1.4 mm/s for a 50 g plastic wine glass), up to 3.3 mm/s (an electric
+        // kettle, 12 µm moved) with the two of `physics.solver_iterations` since label
+        // rule v5's throughput work; hence 5 mm/s.
         let p0 = sim.hazard_position(0);
         for k in 0..strike {
             let v = sim.hazard_velocity(k);
@@ -558,7 +560,7 @@ fn chain_reaction_target_rests_until_struck_then_moves() {
             // The timed run-up (rule v5) strikes it up to 0.9 s in: a settling creep at
             // that noise speed (0.2 mm in the first 0.1 s for a hatchet) stays under 2 mm.
             assert!(
-                speed < 2e-3 && moved < families::chain_reaction::REST_CREEP_M,
+                speed < 5e-3 && moved < families::chain_reaction::REST_CREEP_M,
                 "{} step {k}: target not at rest (v {speed}, moved {moved})",
                 r.spec.selection.object_id
             );
@@ -668,9 +670,12 @@ fn surface_cascade_touches_the_stool_between_table_and_floor() {
             panic!("{id}: never touched stool and floor");
         };
         assert!(stool < floor, "{id}: floor before stool");
+        // Once on the stool it never rests on the table alone again; a soft pillow may
+        // straddle the gap for a few steps, its trailing end still on the table's edge.
+        let back = (stool..c.len()).find(|&k| c[k] & TOUCH_SOURCE != 0 && c[k] & TOUCH_OTHER == 0);
         assert!(
-            table_last.is_none_or(|t| t <= stool),
-            "{id}: back on the table after the stool"
+            back.is_none() && table_last.is_none_or(|t| t < floor),
+            "{id}: back on the table after the stool (step {back:?})"
         );
         assert!(families::surface_cascade::touched_stool_before_floor(
             &r.spec, &sim

@@ -409,8 +409,9 @@ fn replay_is_identical_across_runs_and_thread_counts() {
 
 #[test]
 fn counterfactual_strike_matches_a_full_counterfactual_run() {
-    // The shortcut in `scene::may_touch_observer` must agree with simulating the
-    // counterfactual for every scene.
+    // The shortcuts of `driver::counterfactual_run` (none where nothing comes near the
+    // observer, else resumed from the plain run's kept world) must agree with simulating
+    // the counterfactual from t0 for every scene.
     let (_, config) = setup();
     for family in ["thrown_object", "ceiling_drop", "rolling_ball"] {
         for r in scenes(family, 3, 21) {
@@ -429,4 +430,40 @@ fn counterfactual_strike_matches_a_full_counterfactual_run() {
                 .any(|c| c & TOUCH_FLOOR != 0));
         }
     }
+}
+
+#[test]
+fn the_counterfactual_resumed_from_a_kept_world_is_the_run_from_t0_bit_for_bit() {
+    // `driver::counterfactual_run` starts the observer's body at the plain run's last
+    // kept world before anything comes near it (`simulate::counterfactual`): static
+    // colliders that nothing has come near change nothing, so it is the counterfactual
+    // simulated from t0, state for state, in every family; and it is the same run
+    // whether the plain run kept that world or it is replayed.
+    let mut resumed_runs = 0;
+    for family in rh_catalog::FAMILIES {
+        for r in scenes(family, 1, 21) {
+            let plain = simulate(&r.spec, SimOptions::default());
+            let Some(resumed) = rh_scenes::driver::counterfactual_run(&r.spec, &plain) else {
+                continue;
+            };
+            let full = simulate(&r.spec, rh_scenes::driver::counterfactual_options(&r.spec));
+            let id = &r.spec.scene_id;
+            assert_eq!(resumed.state_hash, full.state_hash, "{family} {id}");
+            assert_eq!(resumed.strike, full.strike, "{family} {id}");
+            let near = rh_scenes::driver::first_near_step(&r.spec, &plain).unwrap();
+            let start = near.saturating_sub(1) / rh_physics::simulate::SNAPSHOT_STEPS
+                * rh_physics::simulate::SNAPSHOT_STEPS;
+            if start > 0 && start < plain.steps() {
+                resumed_runs += 1;
+                let mut bare = plain.clone();
+                bare.snapshots = Default::default();
+                let replayed = rh_scenes::driver::counterfactual_run(&r.spec, &bare).unwrap();
+                assert_eq!(replayed.state_hash, full.state_hash, "{family} {id}");
+            }
+        }
+    }
+    assert!(
+        resumed_runs >= 20,
+        "only {resumed_runs} runs resumed from a kept world"
+    );
 }

@@ -56,11 +56,21 @@ pub fn first_unstruck(replay: &Replay, plans: &[ExecPlan], cfg: &ExecConfig) -> 
 /// config of `configs/scoring.toml`, the executor `rh-score --execute` uses by default).
 /// Specs without escape walks (rules ≤ v3) pass.
 pub fn escapable(spec: &SceneSpec) -> bool {
-    let plans = escape_plans(spec);
+    let mut plans = escape_plans(spec);
     if plans.is_empty() {
         return true;
     }
+    // Whether any walk clears does not depend on the order they are tried in: the
+    // sideways walks first, which clear most often (a hazard that follows the observer's
+    // line runs down a walk straight back), and a struck walk ends at its strike.
+    plans.sort_by(|a, b| sideways(b).total_cmp(&sideways(a)));
     static CFG: OnceLock<ExecConfig> = OnceLock::new();
     let cfg = CFG.get_or_init(ExecConfig::embedded_default);
     first_unstruck(&super::replay_reusing(spec), &plans, cfg).is_some()
+}
+
+/// How far a walk heads to the side, 0 (straight back or ahead) to 1 (square across).
+fn sideways(plan: &ExecPlan) -> f64 {
+    let [vx, vy, _] = plan.walking_cmd;
+    vy.abs() / vx.hypot(vy).max(f64::MIN_POSITIVE)
 }

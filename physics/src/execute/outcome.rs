@@ -25,8 +25,9 @@
 //!   `first_contact_t` says).
 //!
 //! The run stops at the first strike, at a catch, once the hazard lies still on the floor
-//! away from the body after the plan's last motion, or at `horizon_s` (at most the scene's
-//! own horizon, `physics.max_steps`, where the label's counterfactual stops too).
+//! after the plan's last motion (one that started on the floor — a ladder, a wardrobe, a
+//! door — once it has stayed still for `settle_time_s`), or at `horizon_s` (at most the
+//! scene's own horizon, `physics.max_steps`, where the label's counterfactual stops too).
 
 use super::grasp::{self, GraspState};
 use super::motion::{Motion, PlanReference, Reference};
@@ -158,6 +159,10 @@ pub struct Execution {
     window_steps: u32,
     hold_steps: u32,
     started_on_floor: bool,
+    /// Steps in a row the hazard has been still (`settle_speed`), and how many end the
+    /// run of a hazard that started on the floor (`settle_time_s`; 0: never).
+    still_steps: u32,
+    settle_steps: u32,
     m: Monitor,
     hasher: Sha256,
     executed: u32,
@@ -205,6 +210,8 @@ impl Execution {
             window_steps: steps(cfg.strike_window_s),
             hold_steps: steps(cfg.hold_time_s),
             started_on_floor,
+            still_steps: 0,
+            settle_steps: (cfg.settle_time_s / dt).round() as u32,
             m: Monitor::new(spec, shapes, dt),
             hasher: Sha256::new(),
             executed: 0,
@@ -269,6 +276,10 @@ impl Execution {
                 self.hasher.update(x.to_le_bytes());
             }
         }
+        let hazard = &sw.world.bodies[self.hazard_b];
+        let still = norm(hazard.linvel()) < self.cfg.settle_speed
+            && norm(hazard.angvel()) < self.cfg.settle_speed * 10.0;
+        self.still_steps = if still { self.still_steps + 1 } else { 0 };
         let cfg = &self.cfg;
         observe(
             &mut self.m,
@@ -298,11 +309,15 @@ impl Execution {
         self.m.strike.is_some() || self.m.caught
     }
 
-    /// Whether the run may stop: the hazard lies still on the floor, no strike window is
-    /// open, and the motion ended (`motion_end` s after Δ) before now.
+    /// Whether the run may stop: the hazard lies still on the floor (or, having started
+    /// on it, has stayed still for `settle_time_s`), no strike window is open, and the
+    /// motion ended (`motion_end` s after Δ) before now.
     pub fn quiet(&self, motion_end: f64) -> bool {
-        self.m.floor_step.is_some()
-            && norm(self.sw.world.bodies[self.hazard_b].linvel()) < self.cfg.settle_speed
+        let landed = self.m.floor_step.is_some()
+            && norm(self.sw.world.bodies[self.hazard_b].linvel()) < self.cfg.settle_speed;
+        let settled =
+            self.started_on_floor && self.settle_steps > 0 && self.still_steps >= self.settle_steps;
+        (landed || settled)
             && !self.m.strikes.window_open()
             && self.executed as f64 * self.dt > motion_end
     }
