@@ -245,7 +245,7 @@ pub fn counterfactual(
     near: u32,
     options: SimOptions,
 ) -> Simulation {
-    let start = near.saturating_sub(1) / SNAPSHOT_STEPS * SNAPSHOT_STEPS;
+    let start = resume_step(near);
     if !options.observer_collider || start == 0 || start >= plain.steps() {
         return simulate(spec, options);
     }
@@ -262,6 +262,13 @@ pub fn counterfactual(
             plain,
         }),
     )
+}
+
+/// The step a counterfactual run whose bodies first come near the observer at step `near`
+/// resumes its plain run from: the last multiple of [`SNAPSHOT_STEPS`] before it (0: the
+/// run starts at t0).
+pub fn resume_step(near: u32) -> u32 {
+    near.saturating_sub(1) / SNAPSHOT_STEPS * SNAPSHOT_STEPS
 }
 
 /// The plain world of `spec` stepped `steps` times.
@@ -391,9 +398,18 @@ fn strike_of(strikes: &StrikeMonitor) -> Option<Strike> {
 
 /// Whether a body in state `b` is still for the settle rule.
 fn calm(spec: &SceneSpec, b: &BodyState) -> bool {
-    let speed = |v: [f32; 3]| Vector::from(v).length() as f64;
-    speed(b.linvel) < spec.physics.settle_speed
-        && speed(b.angvel) < spec.physics.settle_speed * 10.0
+    still(
+        Vector::from(b.linvel),
+        Vector::from(b.angvel),
+        spec.physics.settle_speed,
+    )
+}
+
+/// Whether a body moving at `linvel` and turning at `angvel` is still: slower than
+/// `settle_speed` (m/s) and turning slower than ten times that (rad/s). The settle rule
+/// of `simulate` and of the executor (`execute::outcome`, its own `settle_speed`).
+pub(crate) fn still(linvel: Vector, angvel: Vector, settle_speed: f64) -> bool {
+    (linvel.length() as f64) < settle_speed && (angvel.length() as f64) < settle_speed * 10.0
 }
 
 impl Simulation {

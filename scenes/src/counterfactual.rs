@@ -12,12 +12,15 @@ use rh_physics::spec::SceneSpec;
 /// that run would be the plain run); else the plain run up to the last snapshot before
 /// that step, the observer's body standing from there (`simulate::counterfactual`).
 pub fn counterfactual_run(spec: &SceneSpec, sim: &Simulation) -> Option<Simulation> {
+    resumed(spec, sim, counterfactual_options(spec))
+}
+
+/// The counterfactual run with `options` from the plain run `sim`'s world kept before
+/// any body comes near the observer (`simulate::counterfactual`); `None` if none ever does.
+fn resumed(spec: &SceneSpec, sim: &Simulation, options: SimOptions) -> Option<Simulation> {
     let near = first_near_step(spec, sim)?;
     Some(rh_physics::simulate::counterfactual(
-        spec,
-        sim,
-        near,
-        counterfactual_options(spec),
+        spec, sim, near, options,
     ))
 }
 
@@ -38,14 +41,11 @@ pub fn counterfactual_options(_spec: &SceneSpec) -> SimOptions {
 /// frames always show the plain run (they end at Δ; in a valid scene nothing reaches the
 /// observer before Δ plus a reaction time). Labels, specs and hashes never depend on this run.
 pub fn full_event_simulation(spec: &SceneSpec, sim: &Simulation) -> Option<Simulation> {
-    let near = first_near_step(spec, sim)?;
     let options = SimOptions {
         run_past_strike: true,
         ..counterfactual_options(spec)
     };
-    Some(rh_physics::simulate::counterfactual(
-        spec, sim, near, options,
-    ))
+    resumed(spec, sim, options)
 }
 
 /// Clearance kept beyond the bounding spheres before a body could touch the observer

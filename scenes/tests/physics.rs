@@ -451,8 +451,7 @@ fn the_counterfactual_resumed_from_a_kept_world_is_the_run_from_t0_bit_for_bit()
             assert_eq!(resumed.state_hash, full.state_hash, "{family} {id}");
             assert_eq!(resumed.strike, full.strike, "{family} {id}");
             let near = rh_scenes::driver::first_near_step(&r.spec, &plain).unwrap();
-            let start = near.saturating_sub(1) / rh_physics::simulate::SNAPSHOT_STEPS
-                * rh_physics::simulate::SNAPSHOT_STEPS;
+            let start = rh_physics::simulate::resume_step(near);
             if start > 0 && start < plain.steps() {
                 resumed_runs += 1;
                 let mut bare = plain.clone();

@@ -33,7 +33,7 @@ use super::grasp::{self, GraspState};
 use super::motion::{Motion, PlanReference, Reference};
 use super::{ExecConfig, ExecFrame, ExecPlan, Outcome, OutcomeKind, StrikeRecord};
 use crate::body::{Geometry, LinkShape, Part};
-use crate::simulate::{hash_hex, lowest_z, SceneWorld};
+use crate::simulate::{hash_hex, lowest_z, still, SceneWorld};
 use crate::spec::{SceneSpec, Vec3};
 use crate::strike::{touch_at, HarmRule, StrikeMonitor, StrikeWindow, Touch};
 use rapier3d::prelude::*;
@@ -277,9 +277,11 @@ impl Execution {
             }
         }
         let hazard = &sw.world.bodies[self.hazard_b];
-        let still = norm(hazard.linvel()) < self.cfg.settle_speed
-            && norm(hazard.angvel()) < self.cfg.settle_speed * 10.0;
-        self.still_steps = if still { self.still_steps + 1 } else { 0 };
+        self.still_steps = if still(hazard.linvel(), hazard.angvel(), self.cfg.settle_speed) {
+            self.still_steps + 1
+        } else {
+            0
+        };
         let cfg = &self.cfg;
         observe(
             &mut self.m,
