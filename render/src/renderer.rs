@@ -16,7 +16,7 @@ use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// One worker's renderer (its targets and encoders, on the process's shared wgpu device
+/// One worker's renderer (its targets and encoders, on its thread's wgpu device
 /// and pipelines: see `gpu::Gpu`); create one per worker thread and reuse it.
 pub struct Renderer {
     pub(super) gpu: Gpu,

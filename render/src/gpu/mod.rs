@@ -2,7 +2,6 @@
 //! and one call that draws a set of views of the current geometry and reads them back.
 
 mod copy;
-mod post;
 mod setup;
 
 mod ids;
@@ -47,7 +46,7 @@ pub struct ViewJob {
 }
 
 /// How far (pixels) the post-process pass reads around an output pixel.
-pub const POST_REACH: u32 = post::REACH;
+pub const POST_REACH: u32 = crate::fxaa::REACH;
 
 /// Most rectangles one overlay view redraws (more are merged by the caller).
 pub const MAX_REDRAW_RECTS: usize = 32;
@@ -80,9 +79,9 @@ struct Target {
     /// copied in before each overlay frame.
     cache_color: wgpu::Texture,
     cache_depth: wgpu::Texture,
-    /// The FXAA pass's output, read back instead of `resolve` for lit views (`None`
-    /// without post-process anti-aliasing).
-    post: Option<post::PostTarget>,
+    /// The static image anti-aliased (`crate::fxaa`), which lit overlay frames start
+    /// from (`None` without post-process anti-aliasing, or before `cache_static`).
+    aa_cache: Option<Vec<u8>>,
     readback: wgpu::Buffer,
     padded_row: u32,
     uniform: wgpu::Buffer,
@@ -95,7 +94,7 @@ struct Target {
 }
 
 /// One worker's renderer state: its shadow maps, targets and vertex buffer, on the
-/// process's shared device and pipelines (`setup::Shared`).
+/// thread's device and pipelines (`setup::Shared`).
 pub struct Gpu {
     device: wgpu::Device,
     queue: wgpu::Queue,
@@ -118,8 +117,9 @@ pub struct Gpu {
     shadow_sampler: wgpu::Sampler,
     shadow_uniform: wgpu::Buffer,
     shadow_bind: wgpu::BindGroup,
-    /// Post-process anti-aliasing (FXAA), where MSAA is off and it is enabled.
-    post: Option<post::Post>,
+    /// Post-process anti-aliasing (`crate::fxaa`) of lit frames: MSAA is off and it is
+    /// enabled.
+    fxaa: bool,
     /// The id pass's pipelines, built on first use (shared like the device's).
     id_pipelines: std::sync::Arc<std::sync::OnceLock<ids::IdPipelines>>,
     vbuf: wgpu::Buffer,
@@ -236,11 +236,10 @@ impl Gpu {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: COLOR_FORMAT,
-            usage: attachment | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[post::SOURCE_VIEW_FORMAT],
+            usage: attachment,
+            view_formats: &[],
         });
         let resolve_view = resolve.create_view(&Default::default());
-        let post = self.post.as_ref().map(|p| p.target(&self.device, &resolve));
         let depth = tex(self.samples, DEPTH_FORMAT, attachment);
         let depth_view = depth.create_view(&Default::default());
         // Copies need no render usage, but a multisampled texture must be renderable.
@@ -287,7 +286,7 @@ impl Gpu {
             depth_view,
             cache_color,
             cache_depth,
-            post,
+            aa_cache: None,
             readback,
             padded_row,
             uniform,
@@ -306,7 +305,53 @@ impl Gpu {
     ) -> Result<Vec<Vec<u8>>, RenderError> {
         let enc = self.encode_whole(light_vp, casters, views, false);
         self.queue.submit([enc.finish()]);
-        self.read_back(views.iter().map(|v| v.slot))
+        let images = self.read_back(views.iter().map(|v| v.slot))?;
+        Ok(self.anti_aliased_whole(views, images))
+    }
+
+    /// Whole frames as drawn, the lit ones anti-aliased (with `fxaa`).
+    fn anti_aliased_whole(&self, views: &[ViewJob], images: Vec<Vec<u8>>) -> Vec<Vec<u8>> {
+        let aa = |v: &ViewJob| self.fxaa && lit(&v.uniforms);
+        views
+            .iter()
+            .zip(images)
+            .map(|(v, img)| match aa(v) {
+                true => {
+                    let out = self.anti_aliased(&img, v.width, v.height, None);
+                    self.frames.give(img);
+                    out
+                }
+                false => img,
+            })
+            .collect()
+    }
+
+    /// `img` (a lit frame as drawn, `width` × `height` RGBA) anti-aliased: all of it
+    /// (`over` = `None`), or the static image's anti-aliased pixels `over.0` with the
+    /// filter redone inside the rectangles `over.1`.
+    fn anti_aliased(
+        &self,
+        img: &[u8],
+        width: u32,
+        height: u32,
+        over: Option<(&[u8], &[[u32; 4]])>,
+    ) -> Vec<u8> {
+        let src = crate::fxaa::Frame {
+            rgba: img,
+            width,
+            height,
+        };
+        let mut out = self.frames.take(img.len());
+        match over {
+            None => crate::fxaa::apply(src, &mut out, [0, 0, width, height]),
+            Some((cached, rects)) => {
+                out.copy_from_slice(cached);
+                for &r in rects {
+                    crate::fxaa::apply(src, &mut out, r);
+                }
+            }
+        }
+        out
     }
 
     /// Renders the fixed casters' shadow map and each view's static geometry once, and
@@ -321,9 +366,17 @@ impl Gpu {
     ) -> Result<(), RenderError> {
         let enc = self.encode_whole(light_vp, casters, views, true);
         self.queue.submit([enc.finish()]);
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Gpu(format!("poll: {e}")))?;
+        if !self.fxaa {
+            self.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| RenderError::Gpu(format!("poll: {e}")))?;
+            return Ok(());
+        }
+        // The anti-aliased static image, which lit overlay frames start from.
+        let images = self.read_back(views.iter().map(|v| v.slot))?;
+        for (v, aa) in views.iter().zip(self.anti_aliased_whole(views, images)) {
+            self.targets[v.slot].as_mut().unwrap().aa_cache = Some(aa);
+        }
         Ok(())
     }
 
@@ -382,12 +435,9 @@ impl Gpu {
             if cache {
                 copy_whole(&mut enc, t.color(), &t.cache_color);
                 copy_whole(&mut enc, &t.depth, &t.cache_depth);
-                if let (Some(post), Some(pt)) = (&self.post, &t.post) {
-                    post.encode(&mut enc, pt, None);
-                    copy_whole(&mut enc, &pt.out, &pt.cache);
-                }
-            } else {
-                self.copy_to_readback(&mut enc, t, lit(&v.uniforms));
+            }
+            if !cache || self.fxaa {
+                Self::copy_to_readback(&mut enc, t);
             }
         }
         // A cached view's attachment and FXAA output now equal their caches.
@@ -443,23 +493,27 @@ impl Gpu {
             copy_whole(&mut enc, &t.cache_depth, &t.depth);
             let redraw = Redraw::Regions(rects);
             self.main_pass(&mut enc, t, redraw, &v.dynamic);
-            match (&self.post, &t.post) {
-                // Anti-aliased: the static image's, redone around what changed.
-                (Some(post), Some(pt)) if lit(&v.uniforms) => {
-                    copy::restore(&mut enc, &pt.cache, &pt.out, dirty);
-                    if !v.post_rects.is_empty() {
-                        post.encode(&mut enc, pt, Some(&v.post_rects));
-                    }
-                    Self::copy_texture_to_readback(&mut enc, t, &pt.out);
-                }
-                _ => Self::copy_texture_to_readback(&mut enc, t, &t.resolve),
-            }
+            Self::copy_to_readback(&mut enc, t);
         }
         self.queue.submit([enc.finish()]);
         for v in views {
             self.targets[v.slot].as_mut().unwrap().dirty = Some(v.post_rects.clone());
         }
-        self.read_back(views.iter().map(|v| v.slot))
+        let images = self.read_back(views.iter().map(|v| v.slot))?;
+        let mut out = Vec::with_capacity(views.len());
+        for (v, img) in views.iter().zip(images) {
+            let t = self.targets[v.slot].as_ref().unwrap();
+            match &t.aa_cache {
+                // Anti-aliased: the static image's, redone around what changed.
+                Some(cached) if lit(&v.uniforms) => {
+                    let over = Some((&cached[..], &v.post_rects[..]));
+                    out.push(self.anti_aliased(&img, t.width, t.height, over));
+                    self.frames.give(img);
+                }
+                _ => out.push(img),
+            }
+        }
+        Ok(out)
     }
 
     fn encoder(&self) -> wgpu::CommandEncoder {
@@ -585,40 +639,29 @@ impl Gpu {
         });
         pass.set_bind_group(0, &t.bind, &[]);
         pass.set_vertex_buffer(0, self.vbuf.slice(..));
-        let full;
-        let rects = match redraw {
+        match redraw {
             Redraw::Whole(ranges) => {
-                full = [([0, 0, t.width, t.height], ranges)];
-                &full[..]
+                // Clearing by drawing (not LoadOp::Clear's colour) keeps the background
+                // bit-identical between whole frames and the static image.
+                pass.set_pipeline(&self.fill);
+                pass.draw(0..6, 0..1);
+                pass.set_pipeline(&self.main);
+                for r in ranges.iter().filter(|r| !r.is_empty()) {
+                    pass.draw(r.clone(), 0..1);
+                }
             }
-            Redraw::Regions(r) => r,
-        };
-        // Clearing by drawing (not LoadOp::Clear's colour) keeps the background
-        // bit-identical between whole frames and redrawn regions.
-        pass.set_pipeline(&self.fill);
-        for (i, &([x, y, w, h], _)) in rects.iter().enumerate() {
-            pass.set_scissor_rect(x, y, w, h);
-            pass.draw(0..6, i as u32..i as u32 + 1);
-        }
-        // Then every static piece a group of nearby rectangles needs, once per group, in
-        // draw order, over the group's bounding rectangle: outside the re-cleared pixels
-        // the copied-in depth equals the static surface's, which `Less` rejects, so those
-        // pixels keep their image (drawing per rectangle ran the vertex work of a piece
-        // once per rectangle; one bounding rectangle for all made lavapipe depth-test
-        // every pixel between scattered rectangles). The groups' rectangles are
-        // disjoint, so each pixel sees its pieces in the whole frame's order.
-        for group in redraw_groups(rects, MAX_REDRAW_GROUPS) {
-            let mut statics: Vec<&Range<u32>> =
-                group.iter().flat_map(|&i| rects[i].1.iter()).collect();
-            statics.sort_by_key(|r| (r.start, r.end));
-            statics.dedup();
-            let Some([x, y, w, h]) = group.iter().map(|&i| rects[i].0).reduce(rect_union) else {
-                continue;
-            };
-            pass.set_scissor_rect(x, y, w, h);
-            pass.set_pipeline(&self.main);
-            for r in statics.into_iter().filter(|r| !r.is_empty()) {
-                pass.draw(r.clone(), 0..1);
+            Redraw::Regions(rects) if self.samples == 1 => {
+                self.redraw_static(&mut pass, rects, false)
+            }
+            Redraw::Regions(rects) => {
+                // Multisampled (a GPU): re-cleared, then drawn again as in the static
+                // image (an equal-depth re-shade left a few edge pixels different).
+                pass.set_pipeline(&self.fill);
+                for (i, &([x, y, w, h], _)) in rects.iter().enumerate() {
+                    pass.set_scissor_rect(x, y, w, h);
+                    pass.draw(0..6, i as u32..i as u32 + 1);
+                }
+                self.redraw_static(&mut pass, rects, true)
             }
         }
         pass.set_scissor_rect(0, 0, t.width, t.height);
@@ -630,26 +673,53 @@ impl Gpu {
         }
     }
 
-    /// Queues the frame's read-back: for a lit view (`aa`) through the FXAA pass when
-    /// there is one; diagnostic views (exact hazard masks) as drawn.
-    fn copy_to_readback(&self, enc: &mut wgpu::CommandEncoder, t: &Target, aa: bool) {
-        let source = match (&self.post, &t.post) {
-            (Some(post), Some(pt)) if aa => {
-                post.encode(enc, pt, None);
-                &pt.out
+    /// Draws the static surfaces inside `rects` again (with the frame's shadow map), over
+    /// the copied-in static image and depth: each static piece a group of nearby
+    /// rectangles needs, once per group over the group's bounding rectangle (drawing per
+    /// rectangle ran the vertex work of a piece once per rectangle; one bounding
+    /// rectangle for all made lavapipe depth-test every pixel between scattered
+    /// rectangles). The groups' rectangles are disjoint.
+    ///
+    /// `recleared` (the rectangles were re-cleared to depth 1): the pieces are drawn in
+    /// the static image's order with its `Less` test; outside the rectangles the copied
+    /// depth rejects them. Otherwise each pixel is shaded once, not once per
+    /// overlapping piece: a `LessEqual` test without depth write passes only the surface
+    /// the static image shows (no static fragment lies in front of it), and the pieces
+    /// go in reverse order, so where two show the same depth the earlier one (the one
+    /// `Less` kept) is shaded last; pixels with no static surface keep the background.
+    fn redraw_static(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        rects: &[([u32; 4], &[Range<u32>])],
+        recleared: bool,
+    ) {
+        pass.set_pipeline(if recleared {
+            &self.main
+        } else {
+            &self.main_over
+        });
+        for group in redraw_groups(rects, MAX_REDRAW_GROUPS) {
+            let mut statics: Vec<&Range<u32>> =
+                group.iter().flat_map(|&i| rects[i].1.iter()).collect();
+            statics.sort_by_key(|r| (r.start, r.end));
+            statics.dedup();
+            if !recleared {
+                statics.reverse();
             }
-            _ => &t.resolve,
-        };
-        Self::copy_texture_to_readback(enc, t, source);
+            let Some([x, y, w, h]) = group.iter().map(|&i| rects[i].0).reduce(rect_union) else {
+                continue;
+            };
+            pass.set_scissor_rect(x, y, w, h);
+            for r in statics.into_iter().filter(|r| !r.is_empty()) {
+                pass.draw(r.clone(), 0..1);
+            }
+        }
     }
 
-    fn copy_texture_to_readback(
-        enc: &mut wgpu::CommandEncoder,
-        t: &Target,
-        source: &wgpu::Texture,
-    ) {
+    /// Queues the copy of the frame as drawn (resolved) into the read-back buffer.
+    fn copy_to_readback(enc: &mut wgpu::CommandEncoder, t: &Target) {
         enc.copy_texture_to_buffer(
-            whole(source),
+            whole(&t.resolve),
             wgpu::TexelCopyBufferInfo {
                 buffer: &t.readback,
                 layout: wgpu::TexelCopyBufferLayout {

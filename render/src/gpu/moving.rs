@@ -5,7 +5,7 @@
 //! casters to a copy of it. The pixels are those of [`Gpu::draw`] with every caster (a
 //! shadow map texel keeps the nearest depth, whatever the order the casters are drawn in).
 
-use super::{copy_whole, lit, Gpu, Redraw, ViewJob};
+use super::{copy_whole, Gpu, Redraw, ViewJob};
 use crate::RenderError;
 use std::ops::Range;
 
@@ -47,9 +47,10 @@ impl Gpu {
         for v in views {
             let t = self.targets[v.slot].as_ref().unwrap();
             self.main_pass(&mut enc, t, Redraw::Whole(&v.ranges), &v.dynamic);
-            self.copy_to_readback(&mut enc, t, lit(&v.uniforms));
+            Self::copy_to_readback(&mut enc, t);
         }
         self.queue.submit([enc.finish()]);
-        self.read_back(views.iter().map(|v| v.slot))
+        let images = self.read_back(views.iter().map(|v| v.slot))?;
+        Ok(self.anti_aliased_whole(views, images))
     }
 }

@@ -286,11 +286,11 @@ fn pipelines(
 }
 
 /// The device and what is built once for it (pipelines, bind group layouts, the shadow
-/// sampler, the FXAA and id pipelines): one per process and settings, shared by every
-/// [`Gpu`] (each worker thread's), so that the CPU rasterizer compiles and keeps one set
-/// of shaders and one memory allocator instead of one per worker. wgpu's queue orders
-/// the workers' submissions; each worker draws into its own targets, so no frame
-/// depends on another worker's.
+/// sampler, the id pipelines): one per thread and settings, shared by every [`Gpu`] the
+/// thread makes (a Python process's environments, say). Each worker thread has its own:
+/// lavapipe runs one queue's submissions one after another, so workers sharing a
+/// device waited for each other's frames (two workers used ≈ 78% of two cores, with
+/// their own devices ≈ 95%: docs/rendering.md).
 #[derive(Clone)]
 struct Shared {
     device: wgpu::Device,
@@ -302,30 +302,32 @@ struct Shared {
     main_bgl: wgpu::BindGroupLayout,
     shadow_bgl: wgpu::BindGroupLayout,
     shadow_sampler: wgpu::Sampler,
-    post: Option<post::Post>,
     id_pipelines: std::sync::Arc<std::sync::OnceLock<ids::IdPipelines>>,
 }
 
-/// The process's shared devices, by (samples, cpu_samples, fxaa); kept until it exits.
-type SharedKey = (u32, u32, bool);
-static SHARED: std::sync::Mutex<Vec<(SharedKey, Shared)>> = std::sync::Mutex::new(Vec::new());
+/// The thread's devices, by (samples, cpu_samples); kept until the thread ends.
+type SharedKey = (u32, u32);
+thread_local! {
+    static SHARED: std::cell::RefCell<Vec<(SharedKey, Shared)>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
 
 impl Shared {
-    /// The shared device for these settings, opened on first use.
-    fn get(samples: u32, cpu_samples: u32, fxaa: bool) -> Result<Shared, RenderError> {
-        let key = (samples, cpu_samples, fxaa);
-        let mut all = SHARED.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, shared)) = all.iter().find(|(k, _)| *k == key) {
-            return Ok(shared.clone());
-        }
-        let shared = Shared::open(samples, cpu_samples, fxaa)?;
-        all.push((key, shared.clone()));
-        Ok(shared)
+    /// The thread's device for these settings, opened on first use.
+    fn get(samples: u32, cpu_samples: u32) -> Result<Shared, RenderError> {
+        let key = (samples, cpu_samples);
+        SHARED.with_borrow_mut(|all| {
+            if let Some((_, shared)) = all.iter().find(|(k, _)| *k == key) {
+                return Ok(shared.clone());
+            }
+            let shared = Shared::open(samples, cpu_samples)?;
+            all.push((key, shared.clone()));
+            Ok(shared)
+        })
     }
 
-    fn open(samples: u32, cpu_samples: u32, fxaa: bool) -> Result<Shared, RenderError> {
+    fn open(samples: u32, cpu_samples: u32) -> Result<Shared, RenderError> {
         let (device, queue, adapter, samples) = open_device(samples, cpu_samples)?;
-        let post = (fxaa && samples == 1).then(|| post::Post::new(&device));
         let (shadow_bgl, main_bgl) = bind_group_layouts(&device);
         let layout = |bgl: &wgpu::BindGroupLayout| {
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -353,19 +355,19 @@ impl Shared {
             main_bgl,
             shadow_bgl,
             shadow_sampler,
-            post,
             id_pipelines: Default::default(),
         })
     }
 }
 
 impl Gpu {
-    /// A renderer on the process's shared device (opened with its pipelines on first
+    /// A renderer on the thread's device (opened with its pipelines on first
     /// use: see `Shared`) with `samples` MSAA samples on a hardware GPU, `cpu_samples` on
     /// a CPU rasterizer (4 or 1 each); `fxaa`: a post-process anti-aliasing pass on lit
-    /// frames wherever MSAA is off. Its shadow maps, targets and vertex buffer are its own.
+    /// frames wherever MSAA is off (`crate::fxaa`). Its shadow maps, targets and vertex
+    /// buffer are its own.
     pub fn new(samples: u32, cpu_samples: u32, fxaa: bool) -> Result<Gpu, RenderError> {
-        let shared = Shared::get(samples, cpu_samples, fxaa)?;
+        let shared = Shared::get(samples, cpu_samples)?;
         let device = shared.device;
         let [main, depth_only, main_over, fill, shadow] = shared.pipelines;
         let shadow_map = |label| {
@@ -415,7 +417,7 @@ impl Gpu {
             shadow_sampler: shared.shadow_sampler,
             shadow_uniform,
             shadow_bind,
-            post: shared.post,
+            fxaa: fxaa && shared.samples == 1,
             id_pipelines: shared.id_pipelines,
             vbuf,
             vcap,
