@@ -305,53 +305,16 @@ impl Gpu {
     ) -> Result<Vec<Vec<u8>>, RenderError> {
         let enc = self.encode_whole(light_vp, casters, views, false);
         self.queue.submit([enc.finish()]);
-        let images = self.read_back(views.iter().map(|v| v.slot))?;
-        Ok(self.anti_aliased_whole(views, images))
+        self.read_back(&self.whole_finishes(views))
     }
 
-    /// Whole frames as drawn, the lit ones anti-aliased (with `fxaa`).
-    fn anti_aliased_whole(&self, views: &[ViewJob], images: Vec<Vec<u8>>) -> Vec<Vec<u8>> {
-        let aa = |v: &ViewJob| self.fxaa && lit(&v.uniforms);
-        views
-            .iter()
-            .zip(images)
-            .map(|(v, img)| match aa(v) {
-                true => {
-                    let out = self.anti_aliased(&img, v.width, v.height, None);
-                    self.frames.give(img);
-                    out
-                }
-                false => img,
-            })
-            .collect()
-    }
-
-    /// `img` (a lit frame as drawn, `width` × `height` RGBA) anti-aliased: all of it
-    /// (`over` = `None`), or the static image's anti-aliased pixels `over.0` with the
-    /// filter redone inside the rectangles `over.1`.
-    fn anti_aliased(
-        &self,
-        img: &[u8],
-        width: u32,
-        height: u32,
-        over: Option<(&[u8], &[[u32; 4]])>,
-    ) -> Vec<u8> {
-        let src = crate::fxaa::Frame {
-            rgba: img,
-            width,
-            height,
+    /// How whole frames of `views` are read back: the lit ones anti-aliased (`fxaa`).
+    fn whole_finishes(&self, views: &[ViewJob]) -> Vec<(usize, Finish<'static>)> {
+        let finish = |v: &ViewJob| match self.fxaa && lit(&v.uniforms) {
+            true => Finish::AntiAliased,
+            false => Finish::AsDrawn,
         };
-        let mut out = self.frames.take(img.len());
-        match over {
-            None => crate::fxaa::apply(src, &mut out, [0, 0, width, height]),
-            Some((cached, rects)) => {
-                out.copy_from_slice(cached);
-                for &r in rects {
-                    crate::fxaa::apply(src, &mut out, r);
-                }
-            }
-        }
-        out
+        views.iter().map(|v| (v.slot, finish(v))).collect()
     }
 
     /// Renders the fixed casters' shadow map and each view's static geometry once, and
@@ -373,8 +336,8 @@ impl Gpu {
             return Ok(());
         }
         // The anti-aliased static image, which lit overlay frames start from.
-        let images = self.read_back(views.iter().map(|v| v.slot))?;
-        for (v, aa) in views.iter().zip(self.anti_aliased_whole(views, images)) {
+        let images = self.read_back(&self.whole_finishes(views))?;
+        for (v, aa) in views.iter().zip(images) {
             self.targets[v.slot].as_mut().unwrap().aa_cache = Some(aa);
         }
         Ok(())
@@ -403,7 +366,7 @@ impl Gpu {
         };
         enc.copy_texture_to_buffer(source, buffer, t.cache_depth.size());
         self.queue.submit([enc.finish()]);
-        let bytes = self.read_back(std::iter::once(slot))?.remove(0);
+        let bytes = self.read_back(&[(slot, Finish::AsDrawn)])?.remove(0);
         let depth = bytemuck::pod_collect_to_vec::<u8, f32>(&bytes);
         self.frames.give(bytes);
         Ok(Some(depth))
@@ -499,21 +462,20 @@ impl Gpu {
         for v in views {
             self.targets[v.slot].as_mut().unwrap().dirty = Some(v.post_rects.clone());
         }
-        let images = self.read_back(views.iter().map(|v| v.slot))?;
-        let mut out = Vec::with_capacity(views.len());
-        for (v, img) in views.iter().zip(images) {
-            let t = self.targets[v.slot].as_ref().unwrap();
-            match &t.aa_cache {
-                // Anti-aliased: the static image's, redone around what changed.
-                Some(cached) if lit(&v.uniforms) => {
-                    let over = Some((&cached[..], &v.post_rects[..]));
-                    out.push(self.anti_aliased(&img, t.width, t.height, over));
-                    self.frames.give(img);
+        let finishes: Vec<(usize, Finish)> = views
+            .iter()
+            .map(|v| {
+                let cached = self.targets[v.slot].as_ref().unwrap().aa_cache.as_deref();
+                match cached {
+                    // Anti-aliased: the static image's, redone around what changed.
+                    Some(cached) if lit(&v.uniforms) => {
+                        (v.slot, Finish::Over(cached, &v.post_rects))
+                    }
+                    _ => (v.slot, Finish::AsDrawn),
                 }
-                _ => out.push(img),
-            }
-        }
-        Ok(out)
+            })
+            .collect();
+        self.read_back(&finishes)
     }
 
     fn encoder(&self) -> wgpu::CommandEncoder {
@@ -732,12 +694,10 @@ impl Gpu {
         );
     }
 
-    /// Waits for the submitted work and returns the slots' images, tightly packed.
-    fn read_back(
-        &self,
-        slots: impl Iterator<Item = usize> + Clone,
-    ) -> Result<Vec<Vec<u8>>, RenderError> {
-        for slot in slots.clone() {
+    /// Waits for the submitted work and returns the slots' images, tightly packed, each
+    /// finished as asked (anti-aliased straight from the mapped buffer).
+    fn read_back(&self, jobs: &[(usize, Finish)]) -> Result<Vec<Vec<u8>>, RenderError> {
+        for &(slot, _) in jobs {
             let t = self.targets[slot].as_ref().unwrap();
             t.readback.slice(..).map_async(wgpu::MapMode::Read, |_| {});
         }
@@ -745,8 +705,8 @@ impl Gpu {
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| RenderError::Gpu(format!("poll: {e}")))?;
         let mut out = Vec::new();
-        for slot in slots {
-            let t = self.targets[slot].as_ref().unwrap();
+        for (slot, finish) in jobs {
+            let t = self.targets[*slot].as_ref().unwrap();
             let row = t.width as usize * 4;
             let mut img = self.frames.take(row * t.height as usize);
             {
@@ -755,9 +715,27 @@ impl Gpu {
                     .slice(..)
                     .get_mapped_range()
                     .map_err(|e| RenderError::Gpu(format!("map readback: {e:?}")))?;
-                for y in 0..t.height as usize {
-                    let src = y * t.padded_row as usize;
-                    img[y * row..(y + 1) * row].copy_from_slice(&data[src..src + row]);
+                let src = crate::fxaa::Frame {
+                    rgba: &data,
+                    width: t.width,
+                    height: t.height,
+                    stride: t.padded_row as usize,
+                };
+                match finish {
+                    Finish::AsDrawn => {
+                        for (y, out) in img.chunks_exact_mut(row).enumerate() {
+                            out.copy_from_slice(&data[y * src.stride..][..row]);
+                        }
+                    }
+                    Finish::AntiAliased => {
+                        crate::fxaa::apply(src, &mut img, [0, 0, t.width, t.height])
+                    }
+                    Finish::Over(cached, rects) => {
+                        img.copy_from_slice(cached);
+                        for &r in rects.iter() {
+                            crate::fxaa::apply(src, &mut img, r);
+                        }
+                    }
                 }
             }
             t.readback.unmap();
@@ -765,6 +743,17 @@ impl Gpu {
         }
         Ok(out)
     }
+}
+
+/// How a read-back frame is finished (`Gpu::read_back`).
+enum Finish<'a> {
+    /// As drawn.
+    AsDrawn,
+    /// Anti-aliased (`crate::fxaa`) all over.
+    AntiAliased,
+    /// The anti-aliased static image (`.0`), the filter redone inside the rectangles
+    /// `.1` (every pixel that can differ from it).
+    Over(&'a [u8], &'a [[u32; 4]]),
 }
 
 impl Target {
