@@ -43,14 +43,55 @@ pub fn init() -> Result<(), String> {
     }
 }
 
+/// `rgba` (tightly packed, `width` × `height`) into the planes of `yuv` (4:2:0, through
+/// `planes`, tightly packed scratch planes): BT.601 limited range, as swscale converted
+/// before and players assume for these videos.
+#[cfg(feature = "video")]
+fn to_yuv420(
+    rgba: &[u8],
+    (width, height): (u32, u32),
+    planes: &mut [Vec<u8>; 3],
+    yuv: &mut ff::frame::Video,
+) -> Result<(), String> {
+    let cw = width.div_ceil(2);
+    let [y, u, v] = planes;
+    let mut image = yuv::YuvPlanarImageMut {
+        y_plane: yuv::BufferStoreMut::Borrowed(y),
+        y_stride: width,
+        u_plane: yuv::BufferStoreMut::Borrowed(u),
+        u_stride: cw,
+        v_plane: yuv::BufferStoreMut::Borrowed(v),
+        v_stride: cw,
+        width,
+        height,
+    };
+    yuv::rgba_to_yuv420(
+        &mut image,
+        rgba,
+        width * 4,
+        yuv::YuvRange::Limited,
+        yuv::YuvStandardMatrix::Bt601,
+        yuv::YuvConversionMode::Balanced,
+    )
+    .map_err(|e| format!("RGBA to YUV: {e}"))?;
+    for (p, plane) in planes.iter().enumerate() {
+        let row = if p == 0 { width } else { cw } as usize;
+        let stride = yuv.stride(p);
+        for (r, src) in plane.chunks_exact(row).enumerate() {
+            yuv.data_mut(p)[r * stride..][..row].copy_from_slice(src);
+        }
+    }
+    Ok(())
+}
+
 /// One MP4 being written.
 #[cfg(feature = "video")]
 pub struct Mp4Writer {
     octx: ff::format::context::Output,
     encoder: ff::encoder::Video,
-    scaler: ff::software::scaling::Context,
-    rgba: ff::frame::Video,
     yuv: ff::frame::Video,
+    /// Y, U and V converted from a frame, tightly packed (`to_yuv420`).
+    planes: [Vec<u8>; 3],
     enc_tb: ff::Rational,
     width: u32,
     height: u32,
@@ -131,30 +172,24 @@ impl Mp4Writer {
         mopts.set("movflags", "+faststart");
         octx.write_header_with(mopts)
             .map_err(|e| fferr("write mp4 header", e))?;
-        let scaler = ff::software::scaling::Context::get(
-            ff::format::Pixel::RGBA,
-            width,
-            height,
-            ff::format::Pixel::YUV420P,
-            width,
-            height,
-            ff::software::scaling::Flags::BILINEAR,
-        )
-        .map_err(|e| fferr("swscale", e))?;
         // FFmpeg leaves frame buffers uninitialised, row padding included: zeroed, so
         // nothing but the pixels can reach the encoder.
-        let mut rgba = ff::frame::Video::new(ff::format::Pixel::RGBA, width, height);
         let mut yuv = ff::frame::Video::new(ff::format::Pixel::YUV420P, width, height);
-        rgba.data_mut(0).fill(0);
         for plane in 0..3 {
             yuv.data_mut(plane).fill(0);
         }
         Ok(Mp4Writer {
             octx,
             encoder,
-            scaler,
-            rgba,
             yuv,
+            planes: {
+                let (cw, ch) = (width.div_ceil(2) as usize, height.div_ceil(2) as usize);
+                [
+                    vec![0; (width * height) as usize],
+                    vec![0; cw * ch],
+                    vec![0; cw * ch],
+                ]
+            },
             enc_tb,
             width,
             height,
@@ -175,14 +210,12 @@ impl Mp4Writer {
                 row * self.height as usize
             ));
         }
-        let stride = self.rgba.stride(0);
-        let data = self.rgba.data_mut(0);
-        for y in 0..self.height as usize {
-            data[y * stride..y * stride + row].copy_from_slice(&rgba[y * row..(y + 1) * row]);
-        }
-        self.scaler
-            .run(&self.rgba, &mut self.yuv)
-            .map_err(|e| fferr("swscale", e))?;
+        to_yuv420(
+            rgba,
+            (self.width, self.height),
+            &mut self.planes,
+            &mut self.yuv,
+        )?;
         self.yuv.set_pts(Some(self.frames));
         self.frames += 1;
         self.encoder
