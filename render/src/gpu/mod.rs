@@ -2,6 +2,7 @@
 //! and one call that draws a set of views of the current geometry and reads them back.
 
 mod copy;
+mod readback;
 mod setup;
 
 mod ids;
@@ -11,6 +12,7 @@ use super::mesh::Vertex;
 use super::regions::{rect_area, rect_union, rects_meet};
 use super::RenderError;
 pub use ids::{IdImage, IdPass, IdView};
+use readback::Finish;
 pub use setup::probe_adapter;
 use std::ops::Range;
 
@@ -308,15 +310,6 @@ impl Gpu {
         self.read_back(&self.whole_finishes(views))
     }
 
-    /// How whole frames of `views` are read back: the lit ones anti-aliased (`fxaa`).
-    fn whole_finishes(&self, views: &[ViewJob]) -> Vec<(usize, Finish<'static>)> {
-        let finish = |v: &ViewJob| match self.fxaa && lit(&v.uniforms) {
-            true => Finish::AntiAliased,
-            false => Finish::AsDrawn,
-        };
-        views.iter().map(|v| (v.slot, finish(v))).collect()
-    }
-
     /// Renders the fixed casters' shadow map and each view's static geometry once, and
     /// keeps them: [`Gpu::draw_overlay`] then starts every frame from these images
     /// instead of drawing the room, furniture and observer again (the cameras do not
@@ -341,35 +334,6 @@ impl Gpu {
             self.targets[v.slot].as_mut().unwrap().aa_cache = Some(aa);
         }
         Ok(())
-    }
-
-    /// A view's cached static depth (one sample per pixel: `None` with MSAA), row-major
-    /// (1 = no surface); read back once per scene (`tiles::SurfaceTiles`).
-    pub fn cached_depth(&self, slot: usize) -> Result<Option<Vec<f32>>, RenderError> {
-        let t = self.targets[slot].as_ref().unwrap();
-        if self.samples > 1 {
-            return Ok(None);
-        }
-        let mut enc = self.encoder();
-        let source = wgpu::TexelCopyTextureInfo {
-            aspect: wgpu::TextureAspect::DepthOnly,
-            ..whole(&t.cache_depth)
-        };
-        let layout = wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(t.padded_row),
-            rows_per_image: Some(t.height),
-        };
-        let buffer = wgpu::TexelCopyBufferInfo {
-            buffer: &t.readback,
-            layout,
-        };
-        enc.copy_texture_to_buffer(source, buffer, t.cache_depth.size());
-        self.queue.submit([enc.finish()]);
-        let bytes = self.read_back(&[(slot, Finish::AsDrawn)])?.remove(0);
-        let depth = bytemuck::pod_collect_to_vec::<u8, f32>(&bytes);
-        self.frames.give(bytes);
-        Ok(Some(depth))
     }
 
     /// Encodes the shadow map from `casters` and every view drawn from a cleared
@@ -677,83 +641,6 @@ impl Gpu {
             }
         }
     }
-
-    /// Queues the copy of the frame as drawn (resolved) into the read-back buffer.
-    fn copy_to_readback(enc: &mut wgpu::CommandEncoder, t: &Target) {
-        enc.copy_texture_to_buffer(
-            whole(&t.resolve),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &t.readback,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(t.padded_row),
-                    rows_per_image: Some(t.height),
-                },
-            },
-            t.resolve.size(),
-        );
-    }
-
-    /// Waits for the submitted work and returns the slots' images, tightly packed, each
-    /// finished as asked (anti-aliased straight from the mapped buffer).
-    fn read_back(&self, jobs: &[(usize, Finish)]) -> Result<Vec<Vec<u8>>, RenderError> {
-        for &(slot, _) in jobs {
-            let t = self.targets[slot].as_ref().unwrap();
-            t.readback.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-        }
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Gpu(format!("poll: {e}")))?;
-        let mut out = Vec::new();
-        for (slot, finish) in jobs {
-            let t = self.targets[*slot].as_ref().unwrap();
-            let row = t.width as usize * 4;
-            let mut img = self.frames.take(row * t.height as usize);
-            {
-                let data = t
-                    .readback
-                    .slice(..)
-                    .get_mapped_range()
-                    .map_err(|e| RenderError::Gpu(format!("map readback: {e:?}")))?;
-                let src = crate::fxaa::Frame {
-                    rgba: &data,
-                    width: t.width,
-                    height: t.height,
-                    stride: t.padded_row as usize,
-                };
-                match finish {
-                    Finish::AsDrawn => {
-                        for (y, out) in img.chunks_exact_mut(row).enumerate() {
-                            out.copy_from_slice(&data[y * src.stride..][..row]);
-                        }
-                    }
-                    Finish::AntiAliased => {
-                        crate::fxaa::apply(src, &mut img, [0, 0, t.width, t.height])
-                    }
-                    Finish::Over(cached, rects) => {
-                        img.copy_from_slice(cached);
-                        for &r in rects.iter() {
-                            crate::fxaa::apply(src, &mut img, r);
-                        }
-                    }
-                }
-            }
-            t.readback.unmap();
-            out.push(img);
-        }
-        Ok(out)
-    }
-}
-
-/// How a read-back frame is finished (`Gpu::read_back`).
-enum Finish<'a> {
-    /// As drawn.
-    AsDrawn,
-    /// Anti-aliased (`crate::fxaa`) all over.
-    AntiAliased,
-    /// The anti-aliased static image (`.0`), the filter redone inside the rectangles
-    /// `.1` (every pixel that can differ from it).
-    Over(&'a [u8], &'a [[u32; 4]]),
 }
 
 impl Target {

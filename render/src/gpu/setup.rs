@@ -290,7 +290,7 @@ fn pipelines(
 /// thread makes (a Python process's environments, say). Each worker thread has its own:
 /// lavapipe runs one queue's submissions one after another, so workers sharing a
 /// device waited for each other's frames (two workers used ≈ 78% of two cores, with
-/// their own devices ≈ 95%: docs/rendering.md).
+/// their own devices ≈ 94%: docs/rendering.md).
 #[derive(Clone)]
 struct Shared {
     device: wgpu::Device,
@@ -305,24 +305,57 @@ struct Shared {
     id_pipelines: std::sync::Arc<std::sync::OnceLock<ids::IdPipelines>>,
 }
 
-/// The thread's devices, by (samples, cpu_samples); kept until the thread ends.
+/// A device's settings: (samples, cpu_samples).
 type SharedKey = (u32, u32);
+
+/// Every device the process opened, with its settings and whether a live thread holds
+/// it. Devices are never closed: a worker thread of a dropped thread pool ends while the
+/// process may already be exiting, and lavapipe tearing a device down then crashed the
+/// process now and then (a jump into freed shader code). A thread's claim is released
+/// when the thread ends, and the next thread that needs a device takes it over, so a
+/// process holds at most as many devices as it ever ran rendering threads at once.
+static DEVICES: std::sync::Mutex<Vec<(SharedKey, Shared, bool)>> =
+    std::sync::Mutex::new(Vec::new());
+
+/// A thread's hold on one entry of `DEVICES`, given back when the thread ends.
+struct Claim {
+    key: SharedKey,
+    index: usize,
+}
+
+impl Drop for Claim {
+    fn drop(&mut self) {
+        let mut all = DEVICES.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(entry) = all.get_mut(self.index) {
+            entry.2 = false;
+        }
+    }
+}
+
 thread_local! {
-    static SHARED: std::cell::RefCell<Vec<(SharedKey, Shared)>> =
-        const { std::cell::RefCell::new(Vec::new()) };
+    static CLAIMS: std::cell::RefCell<Vec<Claim>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 impl Shared {
-    /// The thread's device for these settings, opened on first use.
+    /// The thread's device for these settings: the one it holds, else one no live
+    /// thread holds, else a new one.
     fn get(samples: u32, cpu_samples: u32) -> Result<Shared, RenderError> {
         let key = (samples, cpu_samples);
-        SHARED.with_borrow_mut(|all| {
-            if let Some((_, shared)) = all.iter().find(|(k, _)| *k == key) {
-                return Ok(shared.clone());
+        CLAIMS.with_borrow_mut(|claims| {
+            let mut all = DEVICES.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(c) = claims.iter().find(|c| c.key == key) {
+                return Ok(all[c.index].1.clone());
             }
-            let shared = Shared::open(samples, cpu_samples)?;
-            all.push((key, shared.clone()));
-            Ok(shared)
+            let index = match all.iter().position(|(k, _, held)| *k == key && !held) {
+                Some(i) => i,
+                None => {
+                    all.push((key, Shared::open(samples, cpu_samples)?, false));
+                    all.len() - 1
+                }
+            };
+            all[index].2 = true;
+            claims.push(Claim { key, index });
+            Ok(all[index].1.clone())
         })
     }
 
