@@ -174,17 +174,45 @@ mod tests {
         v
     }
 
+    fn tight(rgba: &[u8], width: u32, height: u32) -> Frame<'_> {
+        Frame {
+            rgba,
+            width,
+            height,
+            stride: 4 * width as usize,
+        }
+    }
+
+    /// Read-back rows are padded to 256 bytes: a frame with padded rows gives the
+    /// tightly packed frame's result.
+    #[test]
+    fn padded_rows_give_the_same_result() {
+        let (w, h) = (21, 13);
+        let src = frame(w, h, |x, y| ((x * 53 + y * 29) % 5 * 60) as u8);
+        let stride = 256;
+        let mut padded = vec![99u8; stride * h as usize];
+        for (y, row) in src.chunks_exact(4 * w as usize).enumerate() {
+            padded[y * stride..][..row.len()].copy_from_slice(row);
+        }
+        let (mut a, mut b) = (vec![0u8; src.len()], vec![0u8; src.len()]);
+        apply(tight(&src, w, h), &mut a, [0, 0, w, h]);
+        let p = Frame {
+            rgba: &padded,
+            width: w,
+            height: h,
+            stride,
+        };
+        apply(p, &mut b, [0, 0, w, h]);
+        assert_eq!(a, b);
+        assert_ne!(a, src, "the pattern has edges to smooth");
+    }
+
     #[test]
     fn flat_areas_are_copied_and_a_staircase_edge_is_smoothed() {
         // A hard diagonal edge: black below the line y = x / 2, white above.
         let (w, h) = (32, 32);
         let src = frame(w, h, |x, y| if 2 * y < x { 255 } else { 0 });
-        let f = Frame {
-            rgba: &src,
-            width: w,
-            height: h,
-            stride: 4 * w as usize,
-        };
+        let f = tight(&src, w, h);
         let mut dst = vec![0u8; src.len()];
         apply(f, &mut dst, [0, 0, w, h]);
         // Far from the edge, on either side: unchanged.
@@ -204,12 +232,7 @@ mod tests {
     fn a_rectangle_gives_the_whole_frame_filter_inside_it_and_nothing_outside() {
         let (w, h) = (40, 24);
         let src = frame(w, h, |x, y| ((x * 37 + y * 91) % 7 * 40) as u8);
-        let f = Frame {
-            rgba: &src,
-            width: w,
-            height: h,
-            stride: 4 * w as usize,
-        };
+        let f = tight(&src, w, h);
         let mut whole = vec![0u8; src.len()];
         apply(f, &mut whole, [0, 0, w, h]);
         let mut part = vec![7u8; src.len()];
