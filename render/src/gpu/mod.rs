@@ -55,8 +55,8 @@ pub const MAX_REDRAW_RECTS: usize = 32;
 
 /// One view drawn over its cached static image (see [`Gpu::cache_static`]): each
 /// `redraw` rectangle (x, y, width, height in pixels: where moving bodies may cast
-/// shadows; at most `MAX_REDRAW_RECTS`) is re-cleared and its static ranges drawn
-/// again, then the moving bodies are drawn everywhere.
+/// shadows; at most `MAX_REDRAW_RECTS`) has its static surfaces shaded again (see
+/// `Gpu::redraw_static`), and the moving bodies are drawn everywhere.
 pub struct OverlayJob {
     pub slot: usize,
     pub uniforms: Uniforms,
@@ -376,8 +376,9 @@ impl Gpu {
 
     /// One frame over the cached static images (same pixels as [`Gpu::draw`] of the
     /// whole scene when each job's `redraw` covers every static pixel a moving caster
-    /// can shade): adds `casters` to the cached shadow map, re-clears and redraws the
-    /// static geometry inside `redraw`, then draws the moving bodies.
+    /// can shade): adds `casters` to the cached shadow map, shades the static surfaces
+    /// inside `redraw` again and draws the moving bodies (`main_pass`), then reads the
+    /// frame back, anti-aliased around what changed.
     pub fn draw_overlay(
         &mut self,
         light_vp: [[f32; 4]; 4],
@@ -505,9 +506,9 @@ impl Gpu {
     }
 
     /// One lit pass into a target. `Redraw::Whole` clears it and draws its ranges;
-    /// `Redraw::Regions` continues from the copied-in static image and re-clears and
-    /// redraws each rectangle (scissored). `dynamic` is then drawn over the whole target,
-    /// depth first, then shaded.
+    /// `Redraw::Regions` continues from the copied-in static image and shades the static
+    /// surfaces inside its rectangles again (`redraw_static`: re-cleared first only with
+    /// MSAA). `dynamic` is then drawn over the whole target, depth first, then shaded.
     /// The colour is resolved (MSAA) at the end.
     fn main_pass(
         &self,
