@@ -88,10 +88,10 @@ struct Target {
     padded_row: u32,
     uniform: wgpu::Buffer,
     bind: wgpu::BindGroup,
-    /// Where the colour attachment and the FXAA output may differ from their cached
-    /// static images (the last overlay frame's `post_rects`: every pixel it changed, and
-    /// every pixel FXAA redid); the next overlay frame restores only these from the
-    /// caches. `None`: unknown (a whole frame was drawn, or no cache yet), restore all.
+    /// Where the colour attachment may differ from the cached static image (the last
+    /// overlay frame's `post_rects`, which hold every pixel it changed); the next overlay
+    /// frame restores only these from the cache. `None`: unknown (a whole frame was
+    /// drawn, or no cache yet), restore all.
     dirty: Option<Vec<[u32; 4]>>,
 }
 
@@ -367,7 +367,7 @@ impl Gpu {
                 Self::copy_to_readback(&mut enc, t);
             }
         }
-        // A cached view's attachment and FXAA output now equal their caches.
+        // A cached view's attachment now equals its cache.
         for v in views {
             self.targets[v.slot].as_mut().unwrap().dirty = cache.then(Vec::new);
         }
