@@ -77,8 +77,9 @@ fn to_yuv420(
     for (p, plane) in planes.iter().enumerate() {
         let row = if p == 0 { width } else { cw } as usize;
         let stride = yuv.stride(p);
+        let data = yuv.data_mut(p);
         for (r, src) in plane.chunks_exact(row).enumerate() {
-            yuv.data_mut(p)[r * stride..][..row].copy_from_slice(src);
+            data[r * stride..][..row].copy_from_slice(src);
         }
     }
     Ok(())

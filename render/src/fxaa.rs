@@ -37,9 +37,7 @@ impl Frame<'_> {
     fn texel(&self, x: i64, y: i64) -> [f32; 3] {
         let x = x.clamp(0, self.width as i64 - 1) as usize;
         let y = y.clamp(0, self.height as i64 - 1) as usize;
-        let i = y * self.stride + x * 4;
-        let p = &self.rgba[i..i + 3];
-        [p[0], p[1], p[2]].map(|v| v as f32 / 255.0)
+        unit(&self.rgba[y * self.stride + x * 4..])
     }
 
     /// A bilinear sample at (x, y) in pixel units (texel centres at half-integers),
@@ -56,13 +54,18 @@ impl Frame<'_> {
     }
 }
 
+/// An RGBA8 pixel's colour as three values in [0, 1] (its first three bytes).
+fn unit(p: &[u8]) -> [f32; 3] {
+    [p[0], p[1], p[2]].map(|v| v as f32 / 255.0)
+}
+
 fn luma(c: [f32; 3]) -> f32 {
     c[0] * 0.299 + c[1] * 0.587 + c[2] * 0.114
 }
 
 /// The luma of an RGBA8 pixel (the same value as `luma` of its texel).
 fn luma8(p: &[u8]) -> f32 {
-    luma([p[0], p[1], p[2]].map(|v| v as f32 / 255.0))
+    luma(unit(p))
 }
 
 /// `f32::min` and `max` for values that are never NaN (these vectorise).

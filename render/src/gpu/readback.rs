@@ -27,16 +27,7 @@ impl Gpu {
             aspect: wgpu::TextureAspect::DepthOnly,
             ..whole(&t.cache_depth)
         };
-        let layout = wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(t.padded_row),
-            rows_per_image: Some(t.height),
-        };
-        let buffer = wgpu::TexelCopyBufferInfo {
-            buffer: &t.readback,
-            layout,
-        };
-        enc.copy_texture_to_buffer(source, buffer, t.cache_depth.size());
+        enc.copy_texture_to_buffer(source, readback_buffer(t), t.cache_depth.size());
         self.queue.submit([enc.finish()]);
         let bytes = self.read_back(&[(slot, Finish::AsDrawn)])?.remove(0);
         let depth = bytemuck::pod_collect_to_vec::<u8, f32>(&bytes);
@@ -46,18 +37,7 @@ impl Gpu {
 
     /// Queues the copy of the frame as drawn (resolved) into the read-back buffer.
     pub(super) fn copy_to_readback(enc: &mut wgpu::CommandEncoder, t: &Target) {
-        enc.copy_texture_to_buffer(
-            whole(&t.resolve),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &t.readback,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(t.padded_row),
-                    rows_per_image: Some(t.height),
-                },
-            },
-            t.resolve.size(),
-        );
+        enc.copy_texture_to_buffer(whole(&t.resolve), readback_buffer(t), t.resolve.size());
     }
 
     /// Waits for the submitted work and returns the slots' images, tightly packed, each
@@ -108,6 +88,19 @@ impl Gpu {
             out.push(img);
         }
         Ok(out)
+    }
+}
+
+/// Where a copy of a whole target image lands: its read-back buffer, rows
+/// `padded_row` bytes apart.
+fn readback_buffer(t: &Target) -> wgpu::TexelCopyBufferInfo<'_> {
+    wgpu::TexelCopyBufferInfo {
+        buffer: &t.readback,
+        layout: wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(t.padded_row),
+            rows_per_image: Some(t.height),
+        },
     }
 }
 

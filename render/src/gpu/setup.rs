@@ -317,16 +317,14 @@ type SharedKey = (u32, u32);
 static DEVICES: std::sync::Mutex<Vec<(SharedKey, Shared, bool)>> =
     std::sync::Mutex::new(Vec::new());
 
-/// A thread's hold on one entry of `DEVICES`, given back when the thread ends.
-struct Claim {
-    key: SharedKey,
-    index: usize,
-}
+/// A thread's hold on one entry of `DEVICES` (its index), given back when the thread
+/// ends.
+struct Claim(usize);
 
 impl Drop for Claim {
     fn drop(&mut self) {
         let mut all = DEVICES.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(entry) = all.get_mut(self.index) {
+        if let Some(entry) = all.get_mut(self.0) {
             entry.2 = false;
         }
     }
@@ -343,8 +341,8 @@ impl Shared {
         let key = (samples, cpu_samples);
         CLAIMS.with_borrow_mut(|claims| {
             let mut all = DEVICES.lock().unwrap_or_else(|e| e.into_inner());
-            if let Some(c) = claims.iter().find(|c| c.key == key) {
-                return Ok(all[c.index].1.clone());
+            if let Some(Claim(i)) = claims.iter().find(|c| all[c.0].0 == key) {
+                return Ok(all[*i].1.clone());
             }
             let index = match all.iter().position(|(k, _, held)| *k == key && !held) {
                 Some(i) => i,
@@ -354,7 +352,7 @@ impl Shared {
                 }
             };
             all[index].2 = true;
-            claims.push(Claim { key, index });
+            claims.push(Claim(index));
             Ok(all[index].1.clone())
         })
     }
