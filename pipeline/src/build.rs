@@ -536,6 +536,10 @@ pub fn build(
                 Ok(())
             })
     });
+    // Each worker's renderer goes while the pool is alive (`release_thread_renderer`).
+    #[cfg(feature = "render")]
+    pool.broadcast(|_| rh_render::release_thread_renderer());
+    drop(pool);
     // Every submitted group is made durable, also when a worker failed.
     let synced = syncer.finish();
     synced?;

@@ -138,6 +138,9 @@ fn main() {
             .unwrap();
     }
     let id_pass = t.elapsed().as_secs_f64() / scenes.len().max(1) as f64;
+    // Every renderer goes before the pool and the process do (see the function).
+    pool.broadcast(|_| rh_render::release_thread_renderer());
+    rh_render::release_thread_renderer();
     for (_, line) in &times {
         println!("{line}");
     }

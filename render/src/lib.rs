@@ -68,7 +68,7 @@ pub use ego::EgoCamera;
 pub use execution::{ExecTrack, ExecVideoOptions, ExecVideos, TiledVideo};
 pub use gpu::probe_adapter;
 pub use measure::Observed;
-pub use renderer::{render_stage, with_thread_renderer, Renderer};
+pub use renderer::{release_thread_renderer, render_stage, with_thread_renderer, Renderer};
 pub use rh_contract::layout::{frame_file_name, frame_path};
 pub use rh_contract::{CAMERAS, FRAME_TIMES, FULL_EVENT};
 pub use sheet::{contact_sheet, ContactSheet};
@@ -85,6 +85,9 @@ pub enum RenderError {
     Io(String),
     #[error("scene {0}: {1}")]
     Scene(String, String),
+    /// A renderer setting from the environment that makes no sense.
+    #[error("{0}")]
+    Setting(String),
 }
 
 /// Renderer settings (from the `[render]` config section).

@@ -46,6 +46,17 @@ pub fn with_thread_renderer<R>(
     })
 }
 
+/// Drops this thread's renderer (its targets, buffers and encoders), if it has one. A
+/// thread pool calls it on each worker (`ThreadPool::broadcast`) before the pool goes:
+/// a worker of a dropped pool ends on its own time, and its renderer torn down then can
+/// meet the process's exit. NVIDIA's Vulkan driver then hung the exiting process
+/// now and then (docs/rendering.md, "On a GPU machine"); afterwards a worker's end
+/// touches no driver (its device stays open: `gpu::Shared`).
+pub fn release_thread_renderer() {
+    let renderer = THREAD_RENDERER.with(|cell| cell.borrow_mut().take());
+    drop(renderer);
+}
+
 impl Renderer {
     /// Opens the GPU (a clear `RenderError::NoAdapter` when there is none) and checks
     /// that FFmpeg has an H.264 encoder.

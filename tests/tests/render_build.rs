@@ -2,7 +2,8 @@
 //! valid scene of a small rendered build has its three camera videos and the full-event
 //! video (ffprobe: H.264, yuv420p, the configured size and rate, the exact frame count),
 //! its fifteen observation frames, and the Parquet columns that name them; two rendered
-//! shards merge into the same bytes as one build; `rh-pipeline sheet` tiles the families.
+//! shards merge into the same bytes as one build drawn on one device shared by its
+//! workers; `rh-pipeline sheet` tiles the families.
 
 use rh_e2e::{files_under, python, run, run_ok};
 use std::path::{Path, PathBuf};
@@ -83,7 +84,19 @@ fn rendered_build_has_probed_videos_frames_columns_and_merges_byte_equal() {
     let tmp = tempfile::tempdir().unwrap();
     let config = small_config(tmp.path());
     let single = tmp.path().join("single");
-    build(&config, &single, &["--jobs", "2"]);
+    // Both workers draw on one device, as they do on a GPU (`RH_RENDER_DEVICES`); the
+    // shards below, each worker on its own device, must merge into the same bytes.
+    let shared = Command::new(rh_e2e::bin("rh-pipeline"))
+        .args(build_args(&config, &single, &["--jobs", "2"]))
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .env("RH_RENDER_DEVICES", "shared")
+        .output()
+        .unwrap();
+    assert!(
+        shared.status.success(),
+        "{}",
+        String::from_utf8_lossy(&shared.stderr)
+    );
     // Rerunning the finished build does nothing, and says only that (no renderer banner).
     let args: Vec<&str> = build_args(&config, &single, &[])
         .into_iter()

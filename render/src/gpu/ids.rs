@@ -270,7 +270,7 @@ impl Gpu {
             copy_out(&mut enc, &t.ids, &t.ids_readback, t.ids_row, t.height);
             copy_out(&mut enc, &t.cover, &t.cover_readback, t.cover_row, t.height);
         }
-        self.queue.submit([enc.finish()]);
+        self.submit(enc);
         for v in views {
             let t = pass.targets[v.slot].as_ref().unwrap();
             t.ids_readback
@@ -280,9 +280,7 @@ impl Gpu {
                 .slice(..)
                 .map_async(wgpu::MapMode::Read, |_| {});
         }
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Gpu(format!("poll: {e}")))?;
+        self.wait()?;
         views
             .iter()
             .map(|v| read_id_image(pass.targets[v.slot].as_ref().unwrap()))

@@ -130,6 +130,8 @@ pub struct Gpu {
     targets: Vec<Option<Target>>,
     /// Where read-back images come from (the encoders hand them back).
     pub frames: super::encode::FramePool,
+    /// This renderer's last submission (`Gpu::submit`), which `Gpu::wait` waits for.
+    last_submit: std::cell::Cell<Option<wgpu::SubmissionIndex>>,
 }
 
 /// What a lit pass draws of the static scene.
@@ -306,7 +308,7 @@ impl Gpu {
         views: &[ViewJob],
     ) -> Result<Vec<Vec<u8>>, RenderError> {
         let enc = self.encode_whole(light_vp, casters, views, false);
-        self.queue.submit([enc.finish()]);
+        self.submit(enc);
         self.read_back(&self.whole_finishes(views))
     }
 
@@ -321,11 +323,9 @@ impl Gpu {
         views: &[ViewJob],
     ) -> Result<(), RenderError> {
         let enc = self.encode_whole(light_vp, casters, views, true);
-        self.queue.submit([enc.finish()]);
+        self.submit(enc);
         if !self.fxaa {
-            self.device
-                .poll(wgpu::PollType::wait_indefinitely())
-                .map_err(|e| RenderError::Gpu(format!("poll: {e}")))?;
+            self.wait()?;
             return Ok(());
         }
         // The anti-aliased static image, which lit overlay frames start from.
@@ -423,7 +423,7 @@ impl Gpu {
             self.main_pass(&mut enc, t, redraw, &v.dynamic);
             Self::copy_to_readback(&mut enc, t);
         }
-        self.queue.submit([enc.finish()]);
+        self.submit(enc);
         for v in views {
             self.targets[v.slot].as_mut().unwrap().dirty = Some(v.post_rects.clone());
         }

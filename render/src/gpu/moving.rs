@@ -21,10 +21,8 @@ impl Gpu {
         let mut enc = self.encoder();
         self.shadow_pass(&mut enc, casters, true);
         copy_whole(&mut enc, &self.shadow_tex, &self.static_shadow);
-        self.queue.submit([enc.finish()]);
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Gpu(format!("poll: {e}")))?;
+        self.submit(enc);
+        self.wait()?;
         Ok(())
     }
 
@@ -49,7 +47,7 @@ impl Gpu {
             self.main_pass(&mut enc, t, Redraw::Whole(&v.ranges), &v.dynamic);
             Self::copy_to_readback(&mut enc, t);
         }
-        self.queue.submit([enc.finish()]);
+        self.submit(enc);
         self.read_back(&self.whole_finishes(views))
     }
 }

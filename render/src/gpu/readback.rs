@@ -6,6 +6,27 @@ use super::{lit, whole, Gpu, Target, ViewJob};
 use crate::RenderError;
 
 impl Gpu {
+    /// Submits this renderer's commands; [`Gpu::wait`] then waits for them.
+    pub(super) fn submit(&self, enc: wgpu::CommandEncoder) {
+        let index = self.queue.submit([enc.finish()]);
+        self.last_submit.set(Some(index));
+    }
+
+    /// Waits until this renderer's last submission (and so all its earlier ones) is
+    /// done and its read-backs mapped: on a device shared by the workers (a GPU), not
+    /// for the other workers' frames too.
+    pub(super) fn wait(&self) -> Result<(), RenderError> {
+        let index = self.last_submit.take();
+        self.last_submit.set(index.clone());
+        self.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: index,
+                timeout: None,
+            })
+            .map(|_| ())
+            .map_err(|e| RenderError::Gpu(format!("poll: {e}")))
+    }
+
     /// How whole frames of `views` are read back: the lit ones anti-aliased (`fxaa`).
     pub(super) fn whole_finishes(&self, views: &[ViewJob]) -> Vec<(usize, Finish<'static>)> {
         let finish = |v: &ViewJob| match self.fxaa && lit(&v.uniforms) {
@@ -28,7 +49,7 @@ impl Gpu {
             ..whole(&t.cache_depth)
         };
         enc.copy_texture_to_buffer(source, readback_buffer(t), t.cache_depth.size());
-        self.queue.submit([enc.finish()]);
+        self.submit(enc);
         let bytes = self.read_back(&[(slot, Finish::AsDrawn)])?.remove(0);
         let depth = bytemuck::pod_collect_to_vec::<u8, f32>(&bytes);
         self.frames.give(bytes);
@@ -47,9 +68,7 @@ impl Gpu {
             let t = self.targets[slot].as_ref().unwrap();
             t.readback.slice(..).map_async(wgpu::MapMode::Read, |_| {});
         }
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Gpu(format!("poll: {e}")))?;
+        self.wait()?;
         let mut out = Vec::new();
         for (slot, finish) in jobs {
             let t = self.targets[*slot].as_ref().unwrap();

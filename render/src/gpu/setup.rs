@@ -286,13 +286,17 @@ fn pipelines(
 }
 
 /// The device and what is built once for it (pipelines, bind group layouts, the shadow
-/// sampler, the id pipelines): one per thread and settings, shared by every [`Gpu`] the
-/// thread makes (a Python process's environments, say). Each worker thread has its own:
-/// lavapipe runs one queue's submissions one after another, so workers sharing a
-/// device waited for each other's frames (two workers used ≈ 78% of two cores, with
-/// their own devices ≈ 94%: docs/rendering.md).
+/// sampler, the id pipelines), shared by every [`Gpu`] of the threads that use it (a
+/// Python process's environments, say). Which threads share one ([`DeviceSharing`]):
+/// on a CPU rasterizer each worker thread has its own, because lavapipe runs one
+/// queue's submissions one after another, so workers sharing a device waited for each
+/// other's frames (two workers used ≈ 78% of two cores, with their own devices ≈ 94%);
+/// on a GPU all threads share one, because each device is a context the GPU switches
+/// between (docs/rendering.md, "On a GPU machine").
 #[derive(Clone)]
 struct Shared {
+    /// Every thread may use it at once (`DeviceSharing`), not only its holder.
+    all_threads: bool,
     device: wgpu::Device,
     queue: wgpu::Queue,
     adapter: RenderAdapter,
@@ -334,9 +338,48 @@ thread_local! {
     static CLAIMS: std::cell::RefCell<Vec<Claim>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
+/// Which threads share a device: `RH_RENDER_DEVICES` = `per-worker` (each thread its
+/// own), `shared` (one for all), or `auto` (unset: per worker on a CPU rasterizer,
+/// shared on a GPU). Only speed depends on it, never a pixel.
+#[derive(Clone, Copy, PartialEq, Debug)]
+enum DeviceSharing {
+    Auto,
+    PerWorker,
+    Shared,
+}
+
+impl DeviceSharing {
+    const VAR: &str = "RH_RENDER_DEVICES";
+
+    fn from_env() -> Result<DeviceSharing, RenderError> {
+        Self::parse(std::env::var(Self::VAR).ok().as_deref())
+    }
+
+    fn parse(value: Option<&str>) -> Result<DeviceSharing, RenderError> {
+        match value {
+            None | Some("") | Some("auto") => Ok(DeviceSharing::Auto),
+            Some("per-worker") => Ok(DeviceSharing::PerWorker),
+            Some("shared") => Ok(DeviceSharing::Shared),
+            Some(other) => Err(RenderError::Setting(format!(
+                "{}={other}: expected auto, per-worker or shared",
+                Self::VAR
+            ))),
+        }
+    }
+
+    /// Whether every thread may use a device of this adapter at once.
+    fn all_threads(self, adapter: &RenderAdapter) -> bool {
+        match self {
+            DeviceSharing::Auto => adapter.device_type != "cpu",
+            DeviceSharing::PerWorker => false,
+            DeviceSharing::Shared => true,
+        }
+    }
+}
+
 impl Shared {
-    /// The thread's device for these settings: the one it holds, else one no live
-    /// thread holds, else a new one.
+    /// The thread's device for these settings: the one it holds, else one every thread
+    /// may use, else one no live thread holds, else a new one.
     fn get(samples: u32, cpu_samples: u32) -> Result<Shared, RenderError> {
         let key = (samples, cpu_samples);
         CLAIMS.with_borrow_mut(|claims| {
@@ -344,7 +387,9 @@ impl Shared {
             if let Some(Claim(i)) = claims.iter().find(|c| all[c.0].0 == key) {
                 return Ok(all[*i].1.clone());
             }
-            let index = match all.iter().position(|(k, _, held)| *k == key && !held) {
+            let free =
+                |(k, s, held): &(SharedKey, Shared, bool)| *k == key && (s.all_threads || !held);
+            let index = match all.iter().position(free) {
                 Some(i) => i,
                 None => {
                     all.push((key, Shared::open(samples, cpu_samples)?, false));
@@ -358,6 +403,7 @@ impl Shared {
     }
 
     fn open(samples: u32, cpu_samples: u32) -> Result<Shared, RenderError> {
+        let sharing = DeviceSharing::from_env()?;
         let (device, queue, adapter, samples) = open_device(samples, cpu_samples)?;
         let (shadow_bgl, main_bgl) = bind_group_layouts(&device);
         let layout = |bgl: &wgpu::BindGroupLayout| {
@@ -378,6 +424,7 @@ impl Shared {
             ..Default::default()
         });
         Ok(Shared {
+            all_threads: sharing.all_threads(&adapter),
             device,
             queue,
             adapter,
@@ -455,6 +502,38 @@ impl Gpu {
             static_len: 0,
             targets: Vec::new(),
             frames: Default::default(),
+            last_submit: Default::default(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{DeviceSharing, RenderAdapter};
+
+    fn adapter(device_type: &str) -> RenderAdapter {
+        RenderAdapter {
+            name: "test".into(),
+            backend: "vulkan".into(),
+            device_type: device_type.into(),
+            driver: String::new(),
+            driver_info: String::new(),
+            cpu_features: Vec::new(),
+            lp_native_vector_width: None,
+        }
+    }
+
+    #[test]
+    fn workers_share_a_gpu_device_and_keep_their_own_on_a_cpu_rasterizer() {
+        let auto = DeviceSharing::parse(None).unwrap();
+        assert_eq!(auto, DeviceSharing::parse(Some("auto")).unwrap());
+        assert!(auto.all_threads(&adapter("discrete_gpu")));
+        assert!(!auto.all_threads(&adapter("cpu")));
+        let shared = DeviceSharing::parse(Some("shared")).unwrap();
+        assert!(shared.all_threads(&adapter("cpu")));
+        let own = DeviceSharing::parse(Some("per-worker")).unwrap();
+        assert!(!own.all_threads(&adapter("discrete_gpu")));
+        let err = DeviceSharing::parse(Some("both")).unwrap_err().to_string();
+        assert!(err.contains("RH_RENDER_DEVICES=both"), "{err}");
     }
 }
