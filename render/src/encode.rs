@@ -23,6 +23,8 @@ pub struct EncodeSettings {
     pub crf: u32,
     /// libx264 threads per video (0 = libx264's automatic choice).
     pub threads: u32,
+    /// B-frames between reference frames (libx264's `bframes`).
+    pub bframes: u32,
 }
 
 #[cfg(feature = "video")]
@@ -157,7 +159,10 @@ impl Mp4Writer {
         // for identical frames when scenes were encoded concurrently. Without it the
         // encoder reads only what it wrote, and a build's videos are reproducible byte
         // for byte (tested by merging shards and resuming killed builds).
-        opts.set("x264-params", "mbtree=0");
+        opts.set(
+            "x264-params",
+            &format!("mbtree=0:bframes={}", settings.bframes),
+        );
         if settings.threads > 0 {
             opts.set("threads", &settings.threads.to_string());
         }

@@ -177,6 +177,9 @@ pub struct RenderConfig {
     /// libx264 threads per video (0 = automatic).
     #[serde(default = "default_encoder_threads")]
     pub encoder_threads: u32,
+    /// libx264 B-frames between reference frames (0: none; the preset's own is 3).
+    #[serde(default)]
+    pub bframes: u32,
     /// MSAA samples (4 or 1) on a hardware GPU.
     #[serde(default = "default_msaa")]
     pub msaa: u32,
@@ -400,6 +403,9 @@ impl Config {
                 "render",
                 "width, height and fps must be positive".into(),
             ));
+        }
+        if self.render.bframes > 16 {
+            return Err(fail("render.bframes", "must be at most 16".into()));
         }
         for family in &self.build.families {
             if !rh_contract::FAMILIES.contains(&family.as_str()) {

@@ -43,6 +43,9 @@ pub struct ExecVideoConfig {
     pub tile_columns: u32,
     pub preset: String,
     pub crf: u32,
+    /// libx264 B-frames (0: none), as the dataset's `[render]`.
+    #[serde(default)]
+    pub bframes: u32,
 }
 
 impl ExecVideoConfig {
@@ -69,8 +72,8 @@ impl ExecVideoConfig {
         if v.width > 3840 || v.height > 2160 || v.fps > 240 {
             bail!("config fields execution_video.width/height/fps are at most 3840/2160/240");
         }
-        if v.tile_columns == 0 || v.crf > 51 || v.preset.is_empty() {
-            bail!("config fields execution_video.tile_columns must be >= 1, crf <= 51, preset not empty");
+        if v.tile_columns == 0 || v.crf > 51 || v.preset.is_empty() || v.bframes > 16 {
+            bail!("config fields execution_video.tile_columns must be >= 1, crf <= 51, bframes <= 16, preset not empty");
         }
         Ok(())
     }

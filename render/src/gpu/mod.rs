@@ -421,7 +421,11 @@ impl Gpu {
             copy_whole(&mut enc, &t.cache_depth, &t.depth);
             let redraw = Redraw::Regions(rects);
             self.main_pass(&mut enc, t, redraw, &v.dynamic);
-            Self::copy_to_readback(&mut enc, t);
+            match self.over_static(t, v) {
+                // Anti-aliased over the static image: only what the filter reads.
+                true => Self::copy_rects_to_readback(&mut enc, t, &v.post_rects),
+                false => Self::copy_to_readback(&mut enc, t),
+            }
         }
         self.submit(enc);
         for v in views {
@@ -430,17 +434,21 @@ impl Gpu {
         let finishes: Vec<(usize, Finish)> = views
             .iter()
             .map(|v| {
-                let cached = self.targets[v.slot].as_ref().unwrap().aa_cache.as_deref();
-                match cached {
+                let t = self.targets[v.slot].as_ref().unwrap();
+                match (self.over_static(t, v), t.aa_cache.as_deref()) {
                     // Anti-aliased: the static image's, redone around what changed.
-                    Some(cached) if lit(&v.uniforms) => {
-                        (v.slot, Finish::Over(cached, &v.post_rects))
-                    }
+                    (true, Some(cached)) => (v.slot, Finish::Over(cached, &v.post_rects)),
                     _ => (v.slot, Finish::AsDrawn),
                 }
             })
             .collect();
         self.read_back(&finishes)
+    }
+
+    /// Whether an overlay frame of `v` is finished over its view's anti-aliased static
+    /// image (`Finish::Over`): lit, with an anti-aliased cache.
+    fn over_static(&self, t: &Target, v: &OverlayJob) -> bool {
+        t.aa_cache.is_some() && lit(&v.uniforms)
     }
 
     fn encoder(&self) -> wgpu::CommandEncoder {

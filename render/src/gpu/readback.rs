@@ -61,6 +61,38 @@ impl Gpu {
         enc.copy_texture_to_buffer(whole(&t.resolve), readback_buffer(t), t.resolve.size());
     }
 
+    /// Queues the copies into the read-back buffer of what anti-aliasing `rects` reads
+    /// (each grown by `fxaa::REACH`): the rest of the buffer is never read
+    /// (`Finish::Over`), so it may hold an older frame.
+    pub(super) fn copy_rects_to_readback(
+        enc: &mut wgpu::CommandEncoder,
+        t: &Target,
+        rects: &[[u32; 4]],
+    ) {
+        let reach = crate::fxaa::REACH;
+        for &[x, y, w, h] in rects {
+            let (x0, y0) = (x.saturating_sub(reach), y.saturating_sub(reach));
+            let x1 = (x + w + reach).min(t.width);
+            let y1 = (y + h + reach).min(t.height);
+            if x1 <= x0 || y1 <= y0 {
+                continue;
+            }
+            let source = wgpu::TexelCopyTextureInfo {
+                origin: wgpu::Origin3d { x: x0, y: y0, z: 0 },
+                ..whole(&t.resolve)
+            };
+            let mut dest = readback_buffer(t);
+            dest.layout.offset = y0 as u64 * t.padded_row as u64 + x0 as u64 * 4;
+            dest.layout.rows_per_image = Some(y1 - y0);
+            let size = wgpu::Extent3d {
+                width: x1 - x0,
+                height: y1 - y0,
+                depth_or_array_layers: 1,
+            };
+            enc.copy_texture_to_buffer(source, dest, size);
+        }
+    }
+
     /// Waits for the submitted work and returns the slots' images, tightly packed, each
     /// finished as asked (anti-aliased straight from the mapped buffer).
     pub(super) fn read_back(&self, jobs: &[(usize, Finish)]) -> Result<Vec<Vec<u8>>, RenderError> {

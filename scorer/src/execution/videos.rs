@@ -168,6 +168,7 @@ pub fn write_videos(
         tile_columns: vcfg.tile_columns,
         encode: EncodeSettings {
             preset: vcfg.preset.clone(),
+            bframes: vcfg.bframes,
             crf: vcfg.crf,
             threads: 1,
         },
