@@ -9,7 +9,7 @@ use super::mesh::*;
 use super::observer::observer_mesh;
 use super::recipes;
 use super::regions::{bounds, cover, rects_meet, screen_rect, shadow_regions};
-use super::tiles::SurfaceTiles;
+use super::tiles::{LightRows, SurfaceTiles};
 use super::Shading;
 use rh_catalog::Catalog;
 use rh_contract::layout::instance;
@@ -61,10 +61,10 @@ pub(super) struct FixedView<'a> {
 impl FixedView<'_> {
     /// Takes the view's cached static depth (one sample per pixel): redraws are then
     /// the screen tiles whose surface the moving casters' shadow can reach.
-    pub(super) fn set_surface(&mut self, depth: &[f32]) {
+    pub(super) fn set_surface(&mut self, depth: &[f32], sun: &LightRows) {
         let inv = inverse_view_proj_rows(self.cam);
-        let (w, h) = (self.cam.width, self.cam.height);
-        self.tiles = Some(SurfaceTiles::from_depth(depth, w, h, inv));
+        let size = (self.cam.width, self.cam.height);
+        self.tiles = Some(SurfaceTiles::from_depth(depth, size, inv, sun));
     }
 }
 
@@ -112,6 +112,10 @@ pub(super) struct SceneGeometry {
     pieces: Vec<Piece>,
     /// Distance (m) from a shadow volume within which shading may depend on it.
     shadow_reach: f64,
+    /// The sun's view-projection rows, and the shadow map's reach in its clip space
+    /// (`Lighting::shadow_reach_light`).
+    sun: LightRows,
+    shadow_reach_light: [f64; 2],
     /// Each fixed body's vertex range with its instance id (the id pass: `ids`).
     fixed_ids: Vec<(Range<u32>, u16)>,
 }
@@ -205,6 +209,8 @@ impl SceneGeometry {
             background: [0.04, 0.045, 0.05, 1.0],
             pieces,
             shadow_reach: light.shadow_reach,
+            sun: LightRows::of(&light.light_vp),
+            shadow_reach_light: light.shadow_reach_light,
             fixed_ids,
         }
     }
@@ -310,17 +316,27 @@ impl SceneGeometry {
         }
     }
 
-    /// Where moving geometry with bounds `moving` may shade static surfaces in a view
-    /// (`shadow_regions`), each rectangle with the static pieces it must redraw: those
-    /// the camera sees whose screen bounds meet it.
+    /// The sun's view-projection (rows), for `FixedView::set_surface`.
+    pub(super) fn sun(&self) -> &LightRows {
+        &self.sun
+    }
+
+    /// Where moving geometry `dynamic` (bounds `moving`) may shade static surfaces in a
+    /// view (`shadow_regions`, or the view's surface tiles), each rectangle with the
+    /// static pieces it must redraw: those the camera sees whose screen bounds meet it.
     pub(super) fn shadow_redraws(
         &self,
         v: &FixedView,
         moving: [Vec3; 2],
+        dynamic: &[Vertex],
     ) -> Vec<([u32; 4], Vec<Range<u32>>)> {
-        match &v.tiles {
-            Some(tiles) => tiles.redraw_rects(moving, self.shadow_reach, self.sun_dir),
-            None => shadow_regions(
+        let caster = self.sun.caster_bounds(dynamic);
+        match (&v.tiles, caster) {
+            (Some(tiles), Some(caster)) => tiles.redraw_rects(
+                (moving, self.shadow_reach, self.sun_dir),
+                (caster, self.shadow_reach_light),
+            ),
+            _ => shadow_regions(
                 v.cam,
                 v.view.as_ref(),
                 moving,

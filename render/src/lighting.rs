@@ -15,6 +15,9 @@ pub(super) struct Lighting {
     pub ambient: [f32; 4],
     /// Distance (m) from a shadow volume within which shading may depend on it.
     pub shadow_reach: f64,
+    /// The same in the sun's clip space (x, y): how far from a caster's footprint in the
+    /// shadow map a point's shading may depend on it (`tiles::SurfaceTiles`).
+    pub shadow_reach_light: [f64; 2],
 }
 
 impl Lighting {
@@ -39,6 +42,7 @@ impl Lighting {
         let texel = 2.0 * light_radius / gpu::SHADOW_SIZE as f64;
         let shadow_reach =
             SHADOW_NORMAL_OFFSET + (SHADOW_SLOPE_OFFSET + SHADOW_PCF_TEXELS + 1.0) * texel + 0.01;
+        let shadow_reach_light = light_space_reach(&light_vp);
         Lighting {
             light_vp,
             sun_dir: [dir[0] as f32, dir[1] as f32, dir[2] as f32, 0.0],
@@ -50,8 +54,25 @@ impl Lighting {
                 0.0,
             ],
             shadow_reach,
+            shadow_reach_light,
         }
     }
+}
+
+/// How far (the sun's clip-space x and y) from a caster's shadow-map footprint a point's
+/// shading may depend on it, from the shader's `shadow_factor`: its lookup point is
+/// the point moved along its normal by at most `SHADOW_NORMAL_OFFSET` +
+/// `SHADOW_SLOPE_OFFSET` texels (each clip axis sees at most that length times the
+/// axis's scale), and the four bilinear taps read texels whose centres lie within 1.5
+/// texels of it on each axis; half a texel spare for rounding.
+fn light_space_reach(light_vp: &[[f32; 4]; 4]) -> [f64; 2] {
+    // Column-major: row r of the matrix is light_vp[0..3][r].
+    let scale = |r: usize| norm([0, 1, 2].map(|c| light_vp[c][r] as f64));
+    // A texel's world size as the shader takes it (from the first row).
+    let texel = 2.0 / (scale(0) * gpu::SHADOW_SIZE as f64);
+    let offset = SHADOW_NORMAL_OFFSET + SHADOW_SLOPE_OFFSET * texel;
+    let texel_clip = 2.0 / gpu::SHADOW_SIZE as f64;
+    [0, 1].map(|r| offset * scale(r) + 2.0 * texel_clip)
 }
 
 fn color_temperature(k: f64) -> [f32; 3] {

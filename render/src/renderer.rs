@@ -252,7 +252,7 @@ impl Renderer {
         )?;
         let mut view = scene.fixed_view(slot, cam);
         if let Some(depth) = self.gpu.cached_depth(slot)? {
-            view.set_surface(&depth);
+            view.set_surface(&depth, scene.sun());
         }
         Ok(view)
     }
@@ -343,7 +343,7 @@ impl Renderer {
         let dyn_range = self.gpu.set_dynamic(&dynamic)?;
         let moving = bounds(&dynamic);
         let redraw = moving
-            .map(|m| scene.shadow_redraws(view, m))
+            .map(|m| scene.shadow_redraws(view, m, &dynamic))
             .unwrap_or_default();
         let post_rects = moving
             .map(|m| scene.post_rects(view, m, &redraw))

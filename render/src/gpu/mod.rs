@@ -150,11 +150,26 @@ impl Gpu {
     }
 
     /// Uploads the scene's static geometry (kept until the next call).
+    /// Uploads the static geometry, followed by the same triangles in reverse order
+    /// (`Gpu::reversed`, for the equal-depth re-shade).
     pub fn set_static(&mut self, verts: &[Vertex]) {
-        self.ensure_capacity(std::mem::size_of_val(verts) as u64 * 2);
+        debug_assert_eq!(verts.len() % 3, 0, "a triangle list");
+        self.ensure_capacity(std::mem::size_of_val(verts) as u64 * 3);
         self.queue
             .write_buffer(&self.vbuf, 0, bytemuck::cast_slice(verts));
+        let reversed: Vec<Vertex> = verts.rchunks(3).flatten().copied().collect();
+        self.queue.write_buffer(
+            &self.vbuf,
+            std::mem::size_of_val(verts) as u64,
+            bytemuck::cast_slice(&reversed),
+        );
         self.static_len = verts.len() as u32;
+    }
+
+    /// Where the static vertices `r` lie in the reversed copy: the same triangles, last
+    /// first.
+    fn reversed(&self, r: &Range<u32>) -> Range<u32> {
+        2 * self.static_len - r.end..2 * self.static_len - r.start
     }
 
     fn ensure_capacity(&mut self, bytes: u64) {
@@ -168,7 +183,8 @@ impl Gpu {
     /// Uploads the moving geometry after the static part; returns its vertex range.
     pub fn set_dynamic(&mut self, verts: &[Vertex]) -> Result<Range<u32>, RenderError> {
         let stride = std::mem::size_of::<Vertex>() as u64;
-        let need = (self.static_len as u64 + verts.len() as u64) * stride;
+        let base = 2 * self.static_len;
+        let need = (base as u64 + verts.len() as u64) * stride;
         if need > self.vcap {
             return Err(RenderError::Gpu(format!(
                 "vertex buffer of {} bytes too small for {need}",
@@ -178,16 +194,17 @@ impl Gpu {
         if !verts.is_empty() {
             self.queue.write_buffer(
                 &self.vbuf,
-                self.static_len as u64 * stride,
+                base as u64 * stride,
                 bytemuck::cast_slice(verts),
             );
         }
-        Ok(self.static_len..self.static_len + verts.len() as u32)
+        Ok(base..base + verts.len() as u32)
     }
 
-    /// Reserves room for `static_len + dynamic` vertices (call before `set_static`).
+    /// Reserves room for `static_len + dynamic` vertices (call before `set_static`),
+    /// and the reversed copy of the static ones.
     pub fn reserve(&mut self, vertices: usize) {
-        self.ensure_capacity(vertices as u64 * std::mem::size_of::<Vertex>() as u64);
+        self.ensure_capacity(2 * vertices as u64 * std::mem::size_of::<Vertex>() as u64);
     }
 
     /// Frees a slot's target (made again by the next draw into it).
@@ -618,10 +635,12 @@ impl Gpu {
     /// `recleared` (the rectangles were re-cleared to depth 1): the pieces are drawn in
     /// the static image's order with its `Less` test; outside the rectangles the copied
     /// depth rejects them. Otherwise each pixel is shaded once, not once per
-    /// overlapping piece: a `LessEqual` test without depth write passes only the surface
-    /// the static image shows (no static fragment lies in front of it), and the pieces
-    /// go in reverse order, so where two show the same depth the earlier one (the one
-    /// `Less` kept) is shaded last; pixels with no static surface keep the background.
+    /// overlapping piece: a `LessEqual` test without depth write passes only the surfaces
+    /// at the depth the static image shows (no static fragment lies in front of it), and
+    /// every triangle goes in reverse order (the pieces, and within each piece its
+    /// triangles: `Gpu::reversed`), so where several show the same depth the first one
+    /// in drawing order, the one `Less` kept, is shaded last; pixels with no static
+    /// surface keep the background.
     fn redraw_static(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
@@ -638,15 +657,16 @@ impl Gpu {
                 group.iter().flat_map(|&i| rects[i].1.iter()).collect();
             statics.sort_by_key(|r| (r.start, r.end));
             statics.dedup();
-            if !recleared {
-                statics.reverse();
-            }
+            let statics: Vec<Range<u32>> = match recleared {
+                true => statics.into_iter().cloned().collect(),
+                false => statics.iter().rev().map(|r| self.reversed(r)).collect(),
+            };
             let Some([x, y, w, h]) = group.iter().map(|&i| rects[i].0).reduce(rect_union) else {
                 continue;
             };
             pass.set_scissor_rect(x, y, w, h);
             for r in statics.into_iter().filter(|r| !r.is_empty()) {
-                pass.draw(r.clone(), 0..1);
+                pass.draw(r, 0..1);
             }
         }
     }
