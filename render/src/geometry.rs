@@ -58,6 +58,9 @@ pub(super) struct FixedView<'a> {
     tiles: Option<SurfaceTiles>,
 }
 
+/// Triangles per run of a static piece in a view's redraw lists (`SceneGeometry::chunks`).
+const REDRAW_CHUNK: u32 = 64;
+
 impl FixedView<'_> {
     /// Takes the view's cached static depth (one sample per pixel): redraws are then
     /// the screen tiles whose surface the moving casters' shadow can reach.
@@ -309,11 +312,25 @@ impl SceneGeometry {
                 .collect(),
             visible: pieces
                 .into_iter()
-                .map(|(p, rect)| (p.range.clone(), rect))
+                .flat_map(|(p, _)| self.chunks(p.range.clone()))
+                .filter_map(|(range, b)| screen_rect(cam, view.as_ref(), b).map(|r| (range, r)))
                 .collect(),
             view,
             tiles: None,
         }
+    }
+
+    /// A static piece's vertex range cut into runs of at most `REDRAW_CHUNK` triangles,
+    /// each with its bounds: a redraw draws only the runs near its rectangles (a piece's
+    /// triangles lie close together in order), not the whole piece.
+    fn chunks(&self, range: Range<u32>) -> impl Iterator<Item = (Range<u32>, [Vec3; 2])> + '_ {
+        let step = 3 * REDRAW_CHUNK;
+        (range.start..range.end)
+            .step_by(step as usize)
+            .filter_map(move |s| {
+                let r = s..(s + step).min(range.end);
+                bounds(&self.statics[r.start as usize..r.end as usize]).map(|b| (r, b))
+            })
     }
 
     /// The sun's view-projection (rows), for `FixedView::set_surface`.

@@ -657,6 +657,15 @@ impl Gpu {
                 group.iter().flat_map(|&i| rects[i].1.iter()).collect();
             statics.sort_by_key(|r| (r.start, r.end));
             statics.dedup();
+            // Runs that follow each other in the buffer (a piece's nearby chunks) as one.
+            let statics: Vec<Range<u32>> = statics.into_iter().fold(Vec::new(), |mut runs, r| {
+                match runs.last_mut() {
+                    Some(last) if last.end == r.start => last.end = r.end,
+                    _ => runs.push(r.clone()),
+                }
+                runs
+            });
+            let statics: Vec<&Range<u32>> = statics.iter().collect();
             let statics: Vec<Range<u32>> = match recleared {
                 true => statics.into_iter().cloned().collect(),
                 false => statics.iter().rev().map(|r| self.reversed(r)).collect(),
