@@ -28,16 +28,27 @@ pub fn bin(name: &str) -> PathBuf {
 
 /// Runs a workspace binary with arguments and returns its output (never panics on exit code).
 pub fn run(name: &str, args: &[&str]) -> Output {
+    run_env(name, args, &[])
+}
+
+/// Like `run`, with these environment variables set too.
+pub fn run_env(name: &str, args: &[&str], env: &[(&str, &str)]) -> Output {
     Command::new(bin(name))
         .args(args)
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .envs(env.iter().copied())
         .output()
         .unwrap_or_else(|e| panic!("cannot start {name}: {e}"))
 }
 
 /// Like `run`, but asserts success and returns stdout as text.
 pub fn run_ok(name: &str, args: &[&str]) -> String {
-    let out = run(name, args);
+    run_ok_env(name, args, &[])
+}
+
+/// Like `run_env`, but asserts success and returns stdout as text.
+pub fn run_ok_env(name: &str, args: &[&str], env: &[(&str, &str)]) -> String {
+    let out = run_env(name, args, env);
     assert!(
         out.status.success(),
         "{name} {args:?} failed with {:?}\nstdout:\n{}\nstderr:\n{}",

@@ -86,16 +86,11 @@ fn rendered_build_has_probed_videos_frames_columns_and_merges_byte_equal() {
     let single = tmp.path().join("single");
     // Both workers draw on one device, as they do on a GPU (`RH_RENDER_DEVICES`); the
     // shards below, each worker on its own device, must merge into the same bytes.
-    let shared = Command::new(rh_e2e::bin("rh-pipeline"))
-        .args(build_args(&config, &single, &["--jobs", "2"]))
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .env("RH_RENDER_DEVICES", "shared")
-        .output()
-        .unwrap();
-    assert!(
-        shared.status.success(),
-        "{}",
-        String::from_utf8_lossy(&shared.stderr)
+    let shared = [("RH_RENDER_DEVICES", "shared")];
+    rh_e2e::run_ok_env(
+        "rh-pipeline",
+        &build_args(&config, &single, &["--jobs", "2"]),
+        &shared,
     );
     // Rerunning the finished build does nothing, and says only that (no renderer banner).
     let args: Vec<&str> = build_args(&config, &single, &[])
