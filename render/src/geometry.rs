@@ -118,7 +118,7 @@ pub(super) struct SceneGeometry {
     /// The sun's view-projection rows, and the shadow map's reach in its clip space
     /// (`Lighting::shadow_reach_light`).
     sun: LightRows,
-    shadow_reach_light: [f64; 2],
+    shadow_reach_light: f64,
     /// Each fixed body's vertex range with its instance id (the id pass: `ids`).
     fixed_ids: Vec<(Range<u32>, u16)>,
 }
@@ -347,7 +347,10 @@ impl SceneGeometry {
         moving: [Vec3; 2],
         dynamic: &[Vertex],
     ) -> Vec<([u32; 4], Vec<Range<u32>>)> {
-        let caster = self.sun.caster_bounds(dynamic);
+        let caster = v
+            .tiles
+            .as_ref()
+            .and_then(|_| self.sun.caster_bounds(dynamic));
         match (&v.tiles, caster) {
             (Some(tiles), Some(caster)) => tiles.redraw_rects(
                 (moving, self.shadow_reach, self.sun_dir),

@@ -32,7 +32,7 @@
 //! | `camera` | view-projection matrices (basis from `view::View`), full-event camera |
 //! | `regions` | shadow-tile rectangle maths: where a moving shadow can change pixels |
 //! | `measure` | the instance-id pass at the observation frames: hazard visibility, masks, depth |
-//! | `gpu` | the wgpu device and pipelines (one per worker thread), static cache and overlay drawing |
+//! | `gpu` | the wgpu device and pipelines (one per worker thread on a CPU rasterizer, one for all workers on a GPU), static cache and overlay drawing |
 //! | `fxaa` | post-process anti-aliasing of read-back frames (where MSAA is off) |
 //! | `encode` | H.264 encoding through FFmpeg (feature `video`, default; `encode_off` without it) |
 //! | `execution` | execution videos: outside and ego views of executed plans, tiled ([`Renderer::render_executions`]) |

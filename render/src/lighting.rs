@@ -15,9 +15,13 @@ pub(super) struct Lighting {
     pub ambient: [f32; 4],
     /// Distance (m) from a shadow volume within which shading may depend on it.
     pub shadow_reach: f64,
-    /// The same in the sun's clip space (x, y): how far from a caster's footprint in the
-    /// shadow map a point's shading may depend on it (`tiles::SurfaceTiles`).
-    pub shadow_reach_light: [f64; 2],
+    /// The same in the sun's clip space (x and y alike): how far from a caster's
+    /// footprint in the shadow map a point's shading may depend on it: the lookup point's
+    /// largest normal offset (`SHADOW_NORMAL_OFFSET` + `SHADOW_SLOPE_OFFSET` texels, at
+    /// most that far along either clip axis), and the four bilinear taps, which read
+    /// texels whose centres lie within 1.5 texels of it on each axis; half a texel spare
+    /// for rounding (`tiles::SurfaceTiles`).
+    pub shadow_reach_light: f64,
 }
 
 impl Lighting {
@@ -42,7 +46,10 @@ impl Lighting {
         let texel = 2.0 * light_radius / gpu::SHADOW_SIZE as f64;
         let shadow_reach =
             SHADOW_NORMAL_OFFSET + (SHADOW_SLOPE_OFFSET + SHADOW_PCF_TEXELS + 1.0) * texel + 0.01;
-        let shadow_reach_light = light_space_reach(&light_vp);
+        // The light matrix scales x and y by 1 / light_radius: a texel is 2 / SHADOW_SIZE.
+        let texel_clip = 2.0 / gpu::SHADOW_SIZE as f64;
+        let shadow_reach_light =
+            (SHADOW_NORMAL_OFFSET + SHADOW_SLOPE_OFFSET * texel) / light_radius + 2.0 * texel_clip;
         Lighting {
             light_vp,
             sun_dir: [dir[0] as f32, dir[1] as f32, dir[2] as f32, 0.0],
@@ -57,22 +64,6 @@ impl Lighting {
             shadow_reach_light,
         }
     }
-}
-
-/// How far (the sun's clip-space x and y) from a caster's shadow-map footprint a point's
-/// shading may depend on it, from the shader's `shadow_factor`: its lookup point is
-/// the point moved along its normal by at most `SHADOW_NORMAL_OFFSET` +
-/// `SHADOW_SLOPE_OFFSET` texels (each clip axis sees at most that length times the
-/// axis's scale), and the four bilinear taps read texels whose centres lie within 1.5
-/// texels of it on each axis; half a texel spare for rounding.
-fn light_space_reach(light_vp: &[[f32; 4]; 4]) -> [f64; 2] {
-    // Column-major: row r of the matrix is light_vp[0..3][r].
-    let scale = |r: usize| norm([0, 1, 2].map(|c| light_vp[c][r] as f64));
-    // A texel's world size as the shader takes it (from the first row).
-    let texel = 2.0 / (scale(0) * gpu::SHADOW_SIZE as f64);
-    let offset = SHADOW_NORMAL_OFFSET + SHADOW_SLOPE_OFFSET * texel;
-    let texel_clip = 2.0 / gpu::SHADOW_SIZE as f64;
-    [0, 1].map(|r| offset * scale(r) + 2.0 * texel_clip)
 }
 
 fn color_temperature(k: f64) -> [f32; 3] {

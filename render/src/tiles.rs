@@ -132,14 +132,14 @@ impl SurfaceTiles {
     pub(super) fn redraw_rects(
         &self,
         (moving, reach, sun_dir): ([Vec3; 2], f64, [f32; 4]),
-        (caster, reach_light): ([Vec3; 2], [f64; 2]),
+        (caster, reach_light): ([Vec3; 2], f64),
     ) -> Vec<[u32; 4]> {
         let [lo, hi] = moving;
         let swept = [lo.map(|v| v - reach), hi.map(|v| v + reach)];
         let d = [sun_dir[0] as f64, sun_dir[1] as f64, sun_dir[2] as f64];
         let [clo, chi] = caster;
         let in_reach = |[tlo, thi]: [Vec3; 2]| {
-            (0..2).all(|i| thi[i] >= clo[i] - reach_light[i] && tlo[i] <= chi[i] + reach_light[i])
+            (0..2).all(|i| thi[i] >= clo[i] - reach_light && tlo[i] <= chi[i] + reach_light)
                 && thi[2] >= clo[2] - DEPTH_SLACK
         };
         let marked: Vec<bool> = self

@@ -149,9 +149,8 @@ impl Gpu {
         self.samples
     }
 
-    /// Uploads the scene's static geometry (kept until the next call).
-    /// Uploads the static geometry, followed by the same triangles in reverse order
-    /// (`Gpu::reversed`, for the equal-depth re-shade).
+    /// Uploads the scene's static geometry (kept until the next call), followed by the
+    /// same triangles in reverse order (`Gpu::reversed`, for the equal-depth re-shade).
     pub fn set_static(&mut self, verts: &[Vertex]) {
         debug_assert_eq!(verts.len() % 3, 0, "a triangle list");
         self.ensure_capacity(std::mem::size_of_val(verts) as u64 * 3);
@@ -658,23 +657,21 @@ impl Gpu {
             statics.sort_by_key(|r| (r.start, r.end));
             statics.dedup();
             // Runs that follow each other in the buffer (a piece's nearby chunks) as one.
-            let statics: Vec<Range<u32>> = statics.into_iter().fold(Vec::new(), |mut runs, r| {
+            let mut runs: Vec<Range<u32>> = Vec::new();
+            for r in statics {
                 match runs.last_mut() {
                     Some(last) if last.end == r.start => last.end = r.end,
                     _ => runs.push(r.clone()),
                 }
-                runs
-            });
-            let statics: Vec<&Range<u32>> = statics.iter().collect();
-            let statics: Vec<Range<u32>> = match recleared {
-                true => statics.into_iter().cloned().collect(),
-                false => statics.iter().rev().map(|r| self.reversed(r)).collect(),
-            };
+            }
+            if !recleared {
+                runs = runs.iter().rev().map(|r| self.reversed(r)).collect();
+            }
             let Some([x, y, w, h]) = group.iter().map(|&i| rects[i].0).reduce(rect_union) else {
                 continue;
             };
             pass.set_scissor_rect(x, y, w, h);
-            for r in statics.into_iter().filter(|r| !r.is_empty()) {
+            for r in runs.into_iter().filter(|r| !r.is_empty()) {
                 pass.draw(r, 0..1);
             }
         }
