@@ -90,12 +90,9 @@ fn greater(a: f32, b: f32) -> f32 {
 /// is. Pixels off an edge are copied as they are; blended ones are written opaque.
 pub(crate) fn apply(src: Frame, dst: &mut [u8], rect: [u32; 4]) {
     let (w, h) = (src.width as usize, src.height as usize);
-    let (x0, y0) = ((rect[0] as usize).min(w), (rect[1] as usize).min(h));
-    let x1 = (rect[0] as usize + rect[2] as usize).min(w);
-    let y1 = (rect[1] as usize + rect[3] as usize).min(h);
-    if x0 >= x1 || y0 >= y1 {
+    let Some([x0, y0, x1, y1]) = clip(rect, w, h) else {
         return;
-    }
+    };
     let at = |x: usize, y: usize| y * src.stride + x * 4;
     let n = (x1 - x0) * 4;
     for y in y0..y1 {
@@ -136,6 +133,91 @@ pub(crate) fn apply(src: Frame, dst: &mut [u8], rect: [u32; 4]) {
             out[3] = 255;
         }
     }
+}
+
+/// Side (pixels) of the cells in which [`apply_changed`] looks for changed pixels: with
+/// `REACH` at most one cell, every pixel within `REACH` of a changed one lies in its cell
+/// or one of the eight around it.
+const CELL: usize = 8;
+const _: () = assert!(REACH as usize <= CELL);
+
+/// [`apply`] inside `rects` of a frame `src` that differs from `base` (tightly packed,
+/// the same size) only inside `rects`, at least `REACH` pixels from their edges, into
+/// `dst`, which holds `base` filtered: only around the pixels where `src` differs from
+/// `base` (the cells holding one, and their neighbours) is the filter run; elsewhere its
+/// output is `dst`'s already, as the filter reads nothing farther than `REACH`. Reads
+/// `src` only inside `rects` grown by `REACH`.
+pub(crate) fn apply_changed(src: Frame, base: &[u8], dst: &mut [u8], rects: &[[u32; 4]]) {
+    let (w, h) = (src.width as usize, src.height as usize);
+    let (cols, rows) = (w.div_ceil(CELL), h.div_ceil(CELL));
+    let clipped: Vec<[usize; 4]> = rects.iter().filter_map(|&r| clip(r, w, h)).collect();
+    let mut changed = vec![false; cols * rows];
+    for &[x0, y0, x1, y1] in &clipped {
+        for y in y0..y1 {
+            let s = &src.rgba[y * src.stride..][x0 * 4..x1 * 4];
+            let b = &base[y * w * 4..][x0 * 4..x1 * 4];
+            if s == b {
+                continue;
+            }
+            for cx in x0 / CELL..x1.div_ceil(CELL) {
+                let cell = &mut changed[y / CELL * cols + cx];
+                let (a, e) = ((cx * CELL).max(x0) - x0, ((cx + 1) * CELL).min(x1) - x0);
+                *cell = *cell || s[a * 4..e * 4] != b[a * 4..e * 4];
+            }
+        }
+    }
+    let near = |cx: usize, cy: usize| {
+        let (c0, c1) = (cx.saturating_sub(1), (cx + 1).min(cols - 1));
+        let (r0, r1) = (cy.saturating_sub(1), (cy + 1).min(rows - 1));
+        (r0..=r1).any(|r| (c0..=c1).any(|c| changed[r * cols + c]))
+    };
+    let near: Vec<bool> = (0..cols * rows).map(|i| near(i % cols, i / cols)).collect();
+    for &[x0, y0, x1, y1] in &clipped {
+        // Runs of cells near a change, row by row; a run continued in the rows below
+        // (the same columns) is filtered as one rectangle.
+        let mut open: Vec<[usize; 4]> = Vec::new();
+        for cy in y0 / CELL..y1.div_ceil(CELL) {
+            let mut runs = Vec::new();
+            let mut cx = x0 / CELL;
+            while cx < x1.div_ceil(CELL) {
+                let start = cx;
+                while cx < x1.div_ceil(CELL) && near[cy * cols + cx] {
+                    cx += 1;
+                }
+                if cx > start {
+                    runs.push((start, cx));
+                }
+                cx += 1;
+            }
+            let (ry0, ry1) = ((cy * CELL).max(y0), ((cy + 1) * CELL).min(y1));
+            let mut next = Vec::new();
+            for (a, e) in runs {
+                let (rx0, rx1) = ((a * CELL).max(x0), (e * CELL).min(x1));
+                match open.iter().position(|o| o[0] == rx0 && o[2] == rx1) {
+                    Some(i) => {
+                        let mut o = open.swap_remove(i);
+                        o[3] = ry1;
+                        next.push(o);
+                    }
+                    None => next.push([rx0, ry0, rx1, ry1]),
+                }
+            }
+            for [a, b, c, d] in std::mem::replace(&mut open, next) {
+                apply(src, dst, [a, b, c - a, d - b].map(|v| v as u32));
+            }
+        }
+        for [a, b, c, d] in open {
+            apply(src, dst, [a, b, c - a, d - b].map(|v| v as u32));
+        }
+    }
+}
+
+/// `rect` (x, y, width, height) clipped to a `w` × `h` frame as (x0, y0, x1, y1).
+fn clip(rect: [u32; 4], w: usize, h: usize) -> Option<[usize; 4]> {
+    let (x0, y0) = ((rect[0] as usize).min(w), (rect[1] as usize).min(h));
+    let x1 = (rect[0] as usize + rect[2] as usize).min(w);
+    let y1 = (rect[1] as usize + rect[3] as usize).min(h);
+    (x0 < x1 && y0 < y1).then_some([x0, y0, x1, y1])
 }
 
 /// The blend of an edge pixel at (x, y): `lmin`, `lmax` of its cross, the lumas of its
@@ -252,5 +334,39 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Filtering only around the changed pixels gives the whole frame's filter.
+    #[test]
+    fn filtering_around_the_changes_gives_the_whole_frame_filter() {
+        let (w, h) = (70, 45);
+        let base = frame(w, h, |x, y| ((x * 37 + y * 91) % 7 * 40) as u8);
+        let mut aa_base = vec![0u8; base.len()];
+        apply(tight(&base, w, h), &mut aa_base, [0, 0, w, h]);
+        // Two changed patches, one at the frame's edge; the rectangles hold them with
+        // `REACH` around (the second one far larger than its change).
+        let mut src = base.clone();
+        let patches = [[0u32, 3, 5, 4], [40, 20, 3, 2]];
+        for &[px, py, pw, ph] in &patches {
+            for y in py..py + ph {
+                for x in px..px + pw {
+                    let i = ((y * w + x) * 4) as usize;
+                    src[i..i + 3].copy_from_slice(&[255, (x * 9) as u8, 0]);
+                }
+            }
+        }
+        let rects = [[0, 0, 13, 15], [10, 5, 60, 40]];
+        let mut want = vec![0u8; src.len()];
+        apply(tight(&src, w, h), &mut want, [0, 0, w, h]);
+        assert_ne!(want, aa_base, "the patches change the filtered frame");
+        let mut got = aa_base.clone();
+        apply_changed(tight(&src, w, h), &base, &mut got, &rects);
+        assert_eq!(got, want);
+        // Nothing changed: nothing is filtered again (a marker survives).
+        let mut marked = aa_base.clone();
+        marked[(30 * w as usize + 30) * 4] ^= 1;
+        let kept = marked.clone();
+        apply_changed(tight(&base, w, h), &base, &mut marked, &rects);
+        assert_eq!(marked, kept);
     }
 }

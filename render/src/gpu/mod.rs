@@ -81,9 +81,10 @@ struct Target {
     /// copied in before each overlay frame.
     cache_color: wgpu::Texture,
     cache_depth: wgpu::Texture,
-    /// The static image anti-aliased (`crate::fxaa`), which lit overlay frames start
-    /// from (`None` without post-process anti-aliasing, or before `cache_static`).
-    aa_cache: Option<Vec<u8>>,
+    /// The static image as drawn and anti-aliased (`crate::fxaa`): lit overlay frames
+    /// start from the latter and are filtered again only where they differ from the
+    /// former (`None` without post-process anti-aliasing, or before `cache_static`).
+    aa_cache: Option<StaticImage>,
     readback: wgpu::Buffer,
     padded_row: u32,
     uniform: wgpu::Buffer,
@@ -93,6 +94,12 @@ struct Target {
     /// frame restores only these from the cache. `None`: unknown (a whole frame was
     /// drawn, or no cache yet), restore all.
     dirty: Option<Vec<[u32; 4]>>,
+}
+
+/// A view's cached static image read back (tightly packed RGBA8).
+struct StaticImage {
+    drawn: Vec<u8>,
+    filtered: Vec<u8>,
 }
 
 /// One worker's renderer state: its shadow maps, targets and vertex buffer, on the
@@ -344,10 +351,22 @@ impl Gpu {
             self.wait()?;
             return Ok(());
         }
-        // The anti-aliased static image, which lit overlay frames start from.
-        let images = self.read_back(&self.whole_finishes(views))?;
-        for (v, aa) in views.iter().zip(images) {
-            self.targets[v.slot].as_mut().unwrap().aa_cache = Some(aa);
+        // The static image as drawn and anti-aliased, which lit overlay frames start from.
+        let drawn: Vec<(usize, Finish)> = views.iter().map(|v| (v.slot, Finish::AsDrawn)).collect();
+        let images = self.read_back(&drawn)?;
+        for (v, drawn) in views.iter().zip(images) {
+            let mut filtered = drawn.clone();
+            if lit(&v.uniforms) {
+                let frame = crate::fxaa::Frame {
+                    rgba: &drawn,
+                    width: v.width,
+                    height: v.height,
+                    stride: 4 * v.width as usize,
+                };
+                crate::fxaa::apply(frame, &mut filtered, [0, 0, v.width, v.height]);
+            }
+            let cache = StaticImage { drawn, filtered };
+            self.targets[v.slot].as_mut().unwrap().aa_cache = Some(cache);
         }
         Ok(())
     }
@@ -451,9 +470,9 @@ impl Gpu {
             .iter()
             .map(|v| {
                 let t = self.targets[v.slot].as_ref().unwrap();
-                match (self.over_static(t, v), t.aa_cache.as_deref()) {
+                match (self.over_static(t, v), &t.aa_cache) {
                     // Anti-aliased: the static image's, redone around what changed.
-                    (true, Some(cached)) => (v.slot, Finish::Over(cached, &v.post_rects)),
+                    (true, Some(c)) => (v.slot, Finish::Over(&c.filtered, &c.drawn, &v.post_rects)),
                     _ => (v.slot, Finish::AsDrawn),
                 }
             })
@@ -602,7 +621,19 @@ impl Gpu {
                 }
             }
             Redraw::Regions(rects) if self.samples == 1 => {
-                self.redraw_static(&mut pass, rects, false)
+                // The moving bodies' depth first: the re-shade then skips the static
+                // pixels they cover, which their shading below overwrites anyway.
+                if !dynamic.is_empty() {
+                    pass.set_pipeline(&self.depth_only);
+                    pass.draw(dynamic.clone(), 0..1);
+                }
+                self.redraw_static(&mut pass, rects, false);
+                pass.set_scissor_rect(0, 0, t.width, t.height);
+                if !dynamic.is_empty() {
+                    pass.set_pipeline(&self.main_over);
+                    pass.draw(dynamic.clone(), 0..1);
+                }
+                return;
             }
             Redraw::Regions(rects) => {
                 // Multisampled (a GPU): re-cleared, then drawn again as in the static

@@ -127,11 +127,9 @@ impl Gpu {
                     Finish::AntiAliased => {
                         crate::fxaa::apply(src, &mut img, [0, 0, t.width, t.height])
                     }
-                    Finish::Over(cached, rects) => {
-                        img.copy_from_slice(cached);
-                        for &r in rects.iter() {
-                            crate::fxaa::apply(src, &mut img, r);
-                        }
+                    Finish::Over(filtered, drawn, rects) => {
+                        img.copy_from_slice(filtered);
+                        crate::fxaa::apply_changed(src, drawn, &mut img, rects);
                     }
                 }
             }
@@ -162,6 +160,7 @@ pub(super) enum Finish<'a> {
     /// Anti-aliased (`crate::fxaa`) all over.
     AntiAliased,
     /// The anti-aliased static image (`.0`), the filter redone inside the rectangles
-    /// `.1` (every pixel that can differ from it).
-    Over(&'a [u8], &'a [[u32; 4]]),
+    /// `.2` (every pixel that can differ from it, with `POST_REACH` around) where the
+    /// frame differs from the static image as drawn (`.1`).
+    Over(&'a [u8], &'a [u8], &'a [[u32; 4]]),
 }
