@@ -720,7 +720,7 @@ impl Target {
 }
 
 /// Most groups of redraw rectangles whose static pieces are drawn together.
-const MAX_REDRAW_GROUPS: usize = 4;
+const MAX_REDRAW_GROUPS: usize = 8;
 
 /// Groups of `rects` (indices) with disjoint bounding rectangles, at most `max` (unless
 /// overlaps force fewer): starting from one group per rectangle, overlapping groups are
