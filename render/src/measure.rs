@@ -11,6 +11,7 @@
 use super::camera::view_proj;
 use super::geometry::SceneGeometry;
 use super::gpu::{IdImage, IdPass, IdView};
+use super::mesh::Vertex;
 use super::{RenderError, Renderer, FRAME_TIMES};
 use rh_catalog::Catalog;
 use rh_contract::layout::{depth_path, instance, mask_path};
@@ -18,6 +19,7 @@ use rh_physics::simulate::Simulation;
 use rh_physics::spec::{CameraSpec, SceneSpec};
 use rh_scenes::driver::HazardVisibility;
 use std::collections::BTreeMap;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 /// What the id pass gave for one scene.
@@ -68,6 +70,39 @@ impl Renderer {
         cams: &[&CameraSpec],
         masks_root: Option<&Path>,
     ) -> Result<(Observed, Vec<Png16>), RenderError> {
+        let hazard = instance::body(spec.hazard);
+        let images = self.id_images(spec, sim, scene, cams, true)?;
+        let mut observed = Observed::default();
+        let mut pngs = Vec::new();
+        for (cam, images) in cams.iter().zip(images) {
+            let mut counts = Vec::new();
+            for (&t, img) in FRAME_TIMES.iter().zip(images) {
+                let visible = img.ids.iter().filter(|&&id| id == hazard).count() as u32;
+                counts.push((visible, img.covered));
+                if let Some(root) = masks_root {
+                    pngs.extend(mask_pngs(&mut observed, root, &spec.scene_id, cam, t, img));
+                }
+            }
+            observed
+                .visibility
+                .insert(cam.name.clone(), HazardVisibility::from_counts(&counts));
+        }
+        Ok((observed, pngs))
+    }
+
+    /// The id images of each camera (`cams` order) at each `FRAME_TIMES` frame: drawn
+    /// over the camera's static geometry drawn once (`cached`), or each whole (the
+    /// reference the cached images are tested against). One camera at a time through
+    /// one target (per worker, a 720p id target, its static image and its read-backs
+    /// are about 20 MB).
+    fn id_images(
+        &mut self,
+        spec: &SceneSpec,
+        sim: &Simulation,
+        scene: &SceneGeometry,
+        cams: &[&CameraSpec],
+        cached: bool,
+    ) -> Result<Vec<Vec<IdImage>>, RenderError> {
         let pass = match &mut self.ids {
             Some(p) => p,
             None => self.ids.insert(IdPass::new(&self.gpu)),
@@ -75,47 +110,50 @@ impl Renderer {
         let hazard = instance::body(spec.hazard);
         let steps = spec.observation_frame_steps(sim.steps());
         let last = steps.len() as u32 - 1;
-        let mut counts: Vec<Vec<(u32, u32)>> = vec![Vec::new(); cams.len()];
-        let mut observed = Observed::default();
-        let mut pngs = Vec::new();
-        for &t in &FRAME_TIMES {
-            let k = ((t * spec.video.fps as f64).round() as u32).min(last);
-            let dynamic = scene.dynamic_at(sim, steps[k as usize], false);
-            let dyn_range = self.gpu.set_dynamic(&dynamic)?;
-            let dyn_ids = scene.dynamic_ids(&dyn_range);
-            // One camera at a time through one target (per worker, a 720p id target
-            // and its read-backs are about 13 MB).
-            for (ci, cam) in cams.iter().enumerate() {
-                let mut ranges = scene.id_ranges_for(cam);
-                ranges.extend(dyn_ids.iter().cloned());
-                let alone = ranges
+        // The moving geometry at each observation frame, uploaded again per camera.
+        let moving: Vec<Vec<Vertex>> = FRAME_TIMES
+            .iter()
+            .map(|&t| {
+                let k = ((t * spec.video.fps as f64).round() as u32).min(last);
+                scene.dynamic_at(sim, steps[k as usize], false)
+            })
+            .collect();
+        let mut out = Vec::new();
+        for cam in cams {
+            let statics = scene.id_ranges_for(cam);
+            let view = |ranges: Vec<(Range<u32>, u16)>, alone| IdView {
+                slot: 0,
+                width: cam.width,
+                height: cam.height,
+                view_proj: view_proj(cam),
+                cam_pos: cam.position.map(|c| c as f32),
+                ranges,
+                alone,
+            };
+            if cached {
+                self.gpu
+                    .cache_static_ids(pass, &view(statics.clone(), Vec::new()))?;
+            }
+            let mut images = Vec::new();
+            for dynamic in &moving {
+                let dyn_range = self.gpu.set_dynamic(dynamic)?;
+                let dyn_ids = scene.dynamic_ids(&dyn_range);
+                let alone = statics
                     .iter()
+                    .chain(&dyn_ids)
                     .filter(|(_, id)| *id == hazard)
                     .map(|(r, _)| r.clone())
                     .collect();
-                let view = IdView {
-                    slot: 0,
-                    width: cam.width,
-                    height: cam.height,
-                    view_proj: view_proj(cam),
-                    cam_pos: cam.position.map(|c| c as f32),
-                    ranges,
-                    alone,
-                };
-                let img = self.gpu.draw_ids(pass, &[view])?.remove(0);
-                let visible = img.ids.iter().filter(|&&id| id == hazard).count() as u32;
-                counts[ci].push((visible, img.covered));
-                if let Some(root) = masks_root {
-                    pngs.extend(mask_pngs(&mut observed, root, &spec.scene_id, cam, t, img));
-                }
+                images.push(if cached {
+                    self.gpu.draw_ids_over(pass, &view(dyn_ids, alone))?
+                } else {
+                    let all = statics.iter().chain(&dyn_ids).cloned().collect();
+                    self.gpu.draw_ids(pass, &[view(all, alone)])?.remove(0)
+                });
             }
+            out.push(images);
         }
-        for (cam, c) in cams.iter().zip(&counts) {
-            observed
-                .visibility
-                .insert(cam.name.clone(), HazardVisibility::from_counts(c));
-        }
-        Ok((observed, pngs))
+        Ok(out)
     }
 }
 
@@ -159,4 +197,62 @@ fn write_png16(p: &Png16) -> Result<(), String> {
         p.height,
         rh_contract::png::PngColor::L16,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::RenderOptions;
+    use rh_physics::simulate::{simulate, SimOptions};
+    use rh_scenes::config::Config;
+    use rh_scenes::driver::produce_group;
+    use rh_scenes::selection::plan_group;
+
+    /// The id images drawn over each camera's static geometry drawn once equal the
+    /// whole-scene id images (ids, depth, coverage) pixel for pixel, at 720p.
+    #[test]
+    fn cached_static_id_images_equal_whole_scene_ones() {
+        let catalog = Catalog::embedded().unwrap();
+        let config = Config::embedded().unwrap();
+        let families = config.build.families.clone();
+        let opts = RenderOptions::from_config(&config.render);
+        let mut renderer = Renderer::new(opts).expect("a Vulkan adapter (lavapipe)");
+        let (mut scenes, mut hazard_pixels) = (0, 0);
+        for g in 0..4u64 {
+            let selection = plan_group(&catalog, &families, 5, g).unwrap();
+            let r = produce_group(&selection, 5, g * 4, 1, &catalog, &config).unwrap();
+            let spec = &r[0].spec;
+            if spec.cameras.is_empty() {
+                continue;
+            }
+            let sim = simulate(spec, SimOptions::default());
+            let scene = SceneGeometry::build(spec, &sim, &catalog);
+            renderer
+                .gpu
+                .reserve(scene.statics.len() + scene.max_dynamic + 1024);
+            renderer.gpu.set_static(&scene.statics);
+            let cams: Vec<&CameraSpec> = spec.cameras.iter().collect();
+            let cached = renderer.id_images(spec, &sim, &scene, &cams, true).unwrap();
+            let whole = renderer
+                .id_images(spec, &sim, &scene, &cams, false)
+                .unwrap();
+            let hazard = instance::body(spec.hazard);
+            for (a, b) in cached.iter().flatten().zip(whole.iter().flatten()) {
+                assert!(a.ids == b.ids, "{}: ids differ", spec.scene_id);
+                assert!(a.depth_mm == b.depth_mm, "{}: depth differs", spec.scene_id);
+                assert_eq!(a.covered, b.covered, "{}", spec.scene_id);
+                hazard_pixels += a.ids.iter().filter(|&&id| id == hazard).count();
+            }
+            assert_eq!(
+                cached.iter().flatten().count(),
+                cams.len() * FRAME_TIMES.len()
+            );
+            scenes += 1;
+        }
+        assert!(scenes >= 3, "{scenes} scenes framed");
+        assert!(
+            hazard_pixels > 0,
+            "the moving hazard is drawn over the static images"
+        );
+    }
 }

@@ -1,12 +1,14 @@
 //! The instance-id pass: per view, an unlit single-sample image of (instance id, depth in
 //! mm) per pixel, plus the pixels one body (the hazard) covers when drawn with nothing
 //! else. Cheap by construction: no lighting, no shadow map, no MSAA, flat outputs, and
-//! run only at the observation frames. Its pipelines are built on first use
-//! ([`IdPass::new`]), so a renderer that never measures pays nothing.
+//! run only at the observation frames; the static geometry of a camera is drawn once
+//! ([`Gpu::cache_static_ids`]) and each frame only adds the moving bodies over it
+//! ([`Gpu::draw_ids_over`]). Its pipelines are built on first use ([`IdPass::new`]), so
+//! a renderer that never measures pays nothing.
 
 use super::super::mesh::Vertex;
 use super::RenderError;
-use super::{extent, whole, Gpu, DEPTH_FORMAT};
+use super::{copy_whole, extent, whole, Gpu, DEPTH_FORMAT};
 use std::ops::Range;
 
 const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Uint;
@@ -49,7 +51,11 @@ struct IdTarget {
     height: u32,
     ids: wgpu::Texture,
     ids_view: wgpu::TextureView,
+    depth: wgpu::Texture,
     depth_view: wgpu::TextureView,
+    /// The static geometry's ids and depth (`Gpu::cache_static_ids`).
+    cache_ids: wgpu::Texture,
+    cache_depth: wgpu::Texture,
     cover: wgpu::Texture,
     cover_view: wgpu::TextureView,
     ids_readback: wgpu::Buffer,
@@ -201,8 +207,11 @@ fn make_target(
         })
     };
     let color = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-    let ids = tex(ID_FORMAT, color);
-    let depth = tex(DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
+    let copied = color | wgpu::TextureUsages::COPY_DST;
+    let ids = tex(ID_FORMAT, copied);
+    let depth = tex(DEPTH_FORMAT, copied);
+    let cache_ids = tex(ID_FORMAT, copied);
+    let cache_depth = tex(DEPTH_FORMAT, copied);
     let cover = tex(COVER_FORMAT, color);
     let readback = |row: u32| {
         device.create_buffer(&wgpu::BufferDescriptor {
@@ -234,6 +243,9 @@ fn make_target(
         ids_view: ids.create_view(&Default::default()),
         ids,
         depth_view: depth.create_view(&Default::default()),
+        depth,
+        cache_ids,
+        cache_depth,
         cover_view: cover.create_view(&Default::default()),
         cover,
         ids_readback: readback(ids_row),
@@ -246,6 +258,36 @@ fn make_target(
 }
 
 impl Gpu {
+    /// Draws `view`'s id image from its ranges (the camera's static geometry) and keeps
+    /// its ids and depth as the slot's static image for [`Gpu::draw_ids_over`].
+    pub fn cache_static_ids(
+        &mut self,
+        pass: &mut IdPass,
+        view: &IdView,
+    ) -> Result<(), RenderError> {
+        self.id_target(pass, view);
+        let t = pass.targets[view.slot].as_ref().unwrap();
+        let mut enc = self.encoder();
+        self.id_pass(&mut enc, pass, t, view, false);
+        copy_whole(&mut enc, &t.ids, &t.cache_ids);
+        copy_whole(&mut enc, &t.depth, &t.cache_depth);
+        self.submit(enc);
+        self.wait()
+    }
+
+    /// The id image of the slot's cached static image (`cache_static_ids`, the same
+    /// camera) with `view`'s ranges (the moving bodies) drawn over it, and `view`'s
+    /// coverage image; read back. The same images as [`Gpu::draw_ids`] of the static and
+    /// moving ranges together (static first: the depth test then meets the same values).
+    pub fn draw_ids_over(
+        &mut self,
+        pass: &mut IdPass,
+        view: &IdView,
+    ) -> Result<IdImage, RenderError> {
+        self.id_images(pass, std::slice::from_ref(view), true)
+            .map(|mut v| v.remove(0))
+    }
+
     /// Draws each view's id image and coverage image from the vertex buffer as it is
     /// (statics and the current moving geometry) and reads them back, in view order.
     pub fn draw_ids(
@@ -253,20 +295,28 @@ impl Gpu {
         pass: &mut IdPass,
         views: &[IdView],
     ) -> Result<Vec<IdImage>, RenderError> {
+        self.id_images(pass, views, false)
+    }
+
+    /// `draw_ids`, or (`over_cache`) `draw_ids_over` of each view.
+    fn id_images(
+        &mut self,
+        pass: &mut IdPass,
+        views: &[IdView],
+        over_cache: bool,
+    ) -> Result<Vec<IdImage>, RenderError> {
         for v in views {
-            pass.target(&self.device, v.slot, v.width, v.height);
-            let t = pass.targets[v.slot].as_ref().unwrap();
-            let u = IdUniforms {
-                view_proj: v.view_proj,
-                cam_pos: [v.cam_pos[0], v.cam_pos[1], v.cam_pos[2], 1.0],
-            };
-            self.queue
-                .write_buffer(&t.uniform, 0, bytemuck::bytes_of(&u));
+            self.id_target(pass, v);
         }
         let mut enc = self.encoder();
         for v in views {
             let t = pass.targets[v.slot].as_ref().unwrap();
-            self.id_pass(&mut enc, pass, t, v);
+            if over_cache {
+                copy_whole(&mut enc, &t.cache_ids, &t.ids);
+                copy_whole(&mut enc, &t.cache_depth, &t.depth);
+            }
+            self.id_pass(&mut enc, pass, t, v, over_cache);
+            self.cover_pass(&mut enc, pass, t, v);
             copy_out(&mut enc, &t.ids, &t.ids_readback, t.ids_row, t.height);
             copy_out(&mut enc, &t.cover, &t.cover_readback, t.cover_row, t.height);
         }
@@ -287,40 +337,68 @@ impl Gpu {
             .collect()
     }
 
-    /// The id pass (cleared: id 0, depth 0) and the coverage pass of one view.
-    fn id_pass(&self, enc: &mut wgpu::CommandEncoder, pass: &IdPass, t: &IdTarget, v: &IdView) {
-        {
-            let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("ids"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &t.ids_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
+    /// Makes the slot's target for `v` (to its size) and writes `v`'s uniforms.
+    fn id_target(&self, pass: &mut IdPass, v: &IdView) {
+        pass.target(&self.device, v.slot, v.width, v.height);
+        let t = pass.targets[v.slot].as_ref().unwrap();
+        let u = IdUniforms {
+            view_proj: v.view_proj,
+            cam_pos: [v.cam_pos[0], v.cam_pos[1], v.cam_pos[2], 1.0],
+        };
+        self.queue
+            .write_buffer(&t.uniform, 0, bytemuck::bytes_of(&u));
+    }
+
+    /// The id pass of one view: its ranges drawn into the target, cleared first (id 0,
+    /// depth 1) or (`over`) over what it holds.
+    fn id_pass(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        pass: &IdPass,
+        t: &IdTarget,
+        v: &IdView,
+        over: bool,
+    ) {
+        let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("ids"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &t.ids_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: match over {
+                        true => wgpu::LoadOp::Load,
+                        false => wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
                     },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &t.depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &t.depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: match over {
+                        true => wgpu::LoadOp::Load,
+                        false => wgpu::LoadOp::Clear(1.0),
+                    },
+                    store: wgpu::StoreOp::Store,
                 }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            rp.set_pipeline(&pass.pipes.ids);
-            rp.set_bind_group(0, &t.bind, &[]);
-            rp.set_vertex_buffer(0, self.vbuf.slice(..));
-            for (r, id) in v.ranges.iter().filter(|(r, _)| !r.is_empty()) {
-                let id = *id as u32;
-                rp.draw(r.clone(), id..id + 1);
-            }
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        rp.set_pipeline(&pass.pipes.ids);
+        rp.set_bind_group(0, &t.bind, &[]);
+        rp.set_vertex_buffer(0, self.vbuf.slice(..));
+        for (r, id) in v.ranges.iter().filter(|(r, _)| !r.is_empty()) {
+            let id = *id as u32;
+            rp.draw(r.clone(), id..id + 1);
         }
+    }
+
+    /// The coverage pass of one view: its `alone` ranges into the cleared coverage image.
+    fn cover_pass(&self, enc: &mut wgpu::CommandEncoder, pass: &IdPass, t: &IdTarget, v: &IdView) {
         let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("cover"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -371,19 +449,20 @@ fn copy_out(
 fn read_id_image(t: &IdTarget) -> Result<IdImage, RenderError> {
     let (w, h) = (t.width as usize, t.height as usize);
     let map_err = |e| RenderError::Gpu(format!("map id readback: {e:?}"));
-    let mut ids = Vec::with_capacity(w * h);
-    let mut depth_mm = Vec::with_capacity(w * h);
+    let mut ids = vec![0u16; w * h];
+    let mut depth_mm = vec![0u16; w * h];
     {
         let data = t
             .ids_readback
             .slice(..)
             .get_mapped_range()
             .map_err(map_err)?;
-        for y in 0..h {
+        let rows = ids.chunks_exact_mut(w).zip(depth_mm.chunks_exact_mut(w));
+        for (y, (ids, depth)) in rows.enumerate() {
             let row = &data[y * t.ids_row as usize..][..w * 4];
-            for px in row.chunks_exact(4) {
-                ids.push(u16::from_le_bytes([px[0], px[1]]));
-                depth_mm.push(u16::from_le_bytes([px[2], px[3]]));
+            for ((px, id), d) in row.chunks_exact(4).zip(ids).zip(depth) {
+                *id = u16::from_le_bytes([px[0], px[1]]);
+                *d = u16::from_le_bytes([px[2], px[3]]);
             }
         }
     }
