@@ -3,6 +3,7 @@
 
 mod copy;
 mod readback;
+use readback::StaticImage;
 mod setup;
 
 mod ids;
@@ -94,12 +95,6 @@ struct Target {
     /// frame restores only these from the cache. `None`: unknown (a whole frame was
     /// drawn, or no cache yet), restore all.
     dirty: Option<Vec<[u32; 4]>>,
-}
-
-/// A view's cached static image read back (tightly packed RGBA8).
-struct StaticImage {
-    drawn: Vec<u8>,
-    filtered: Vec<u8>,
 }
 
 /// One worker's renderer state: its shadow maps, targets and vertex buffer, on the
@@ -351,24 +346,7 @@ impl Gpu {
             self.wait()?;
             return Ok(());
         }
-        // The static image as drawn and anti-aliased, which lit overlay frames start from.
-        let drawn: Vec<(usize, Finish)> = views.iter().map(|v| (v.slot, Finish::AsDrawn)).collect();
-        let images = self.read_back(&drawn)?;
-        for (v, drawn) in views.iter().zip(images) {
-            let mut filtered = drawn.clone();
-            if lit(&v.uniforms) {
-                let frame = crate::fxaa::Frame {
-                    rgba: &drawn,
-                    width: v.width,
-                    height: v.height,
-                    stride: 4 * v.width as usize,
-                };
-                crate::fxaa::apply(frame, &mut filtered, [0, 0, v.width, v.height]);
-            }
-            let cache = StaticImage { drawn, filtered };
-            self.targets[v.slot].as_mut().unwrap().aa_cache = Some(cache);
-        }
-        Ok(())
+        self.keep_static_images(views)
     }
 
     /// Encodes the shadow map from `casters` and every view drawn from a cleared
@@ -551,8 +529,8 @@ impl Gpu {
     /// One lit pass into a target. `Redraw::Whole` clears it and draws its ranges;
     /// `Redraw::Regions` continues from the copied-in static image and shades the static
     /// surfaces inside its rectangles again (`redraw_static`: re-cleared first only with
-    /// MSAA). `dynamic` is then drawn over the whole target, depth first, then shaded.
-    /// The colour is resolved (MSAA) at the end.
+    /// MSAA). `dynamic` is drawn over the whole target, depth first (before the re-shade
+    /// without MSAA), then shaded. The colour is resolved (MSAA) at the end.
     fn main_pass(
         &self,
         enc: &mut wgpu::CommandEncoder,

@@ -93,6 +93,28 @@ impl Gpu {
         }
     }
 
+    /// Reads back the views just drawn as the static cache (`cache_static`) and keeps
+    /// each one's image as drawn and anti-aliased, which lit overlay frames start from.
+    pub(super) fn keep_static_images(&mut self, views: &[ViewJob]) -> Result<(), RenderError> {
+        let drawn: Vec<(usize, Finish)> = views.iter().map(|v| (v.slot, Finish::AsDrawn)).collect();
+        let images = self.read_back(&drawn)?;
+        for (v, drawn) in views.iter().zip(images) {
+            let mut filtered = drawn.clone();
+            if lit(&v.uniforms) {
+                let frame = crate::fxaa::Frame {
+                    rgba: &drawn,
+                    width: v.width,
+                    height: v.height,
+                    stride: 4 * v.width as usize,
+                };
+                crate::fxaa::apply(frame, &mut filtered, [0, 0, v.width, v.height]);
+            }
+            let cache = StaticImage { drawn, filtered };
+            self.targets[v.slot].as_mut().unwrap().aa_cache = Some(cache);
+        }
+        Ok(())
+    }
+
     /// Waits for the submitted work and returns the slots' images, tightly packed, each
     /// finished as asked (anti-aliased straight from the mapped buffer).
     pub(super) fn read_back(&self, jobs: &[(usize, Finish)]) -> Result<Vec<Vec<u8>>, RenderError> {
@@ -151,6 +173,13 @@ fn readback_buffer(t: &Target) -> wgpu::TexelCopyBufferInfo<'_> {
             rows_per_image: Some(t.height),
         },
     }
+}
+
+/// A view's cached static image read back (tightly packed RGBA8): as drawn, and
+/// anti-aliased (`crate::fxaa`; the same without post-process anti-aliasing or unlit).
+pub(super) struct StaticImage {
+    pub(super) drawn: Vec<u8>,
+    pub(super) filtered: Vec<u8>,
 }
 
 /// How a read-back frame is finished (`Gpu::read_back`).
