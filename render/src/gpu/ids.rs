@@ -359,35 +359,7 @@ impl Gpu {
         v: &IdView,
         over: bool,
     ) {
-        let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("ids"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &t.ids_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: match over {
-                        true => wgpu::LoadOp::Load,
-                        false => wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    },
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &t.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: match over {
-                        true => wgpu::LoadOp::Load,
-                        false => wgpu::LoadOp::Clear(1.0),
-                    },
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut rp = begin(enc, "ids", &t.ids_view, Some(&t.depth_view), over);
         rp.set_pipeline(&pass.pipes.ids);
         rp.set_bind_group(0, &t.bind, &[]);
         rp.set_vertex_buffer(0, self.vbuf.slice(..));
@@ -399,28 +371,53 @@ impl Gpu {
 
     /// The coverage pass of one view: its `alone` ranges into the cleared coverage image.
     fn cover_pass(&self, enc: &mut wgpu::CommandEncoder, pass: &IdPass, t: &IdTarget, v: &IdView) {
-        let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("cover"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &t.cover_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut rp = begin(enc, "cover", &t.cover_view, None, false);
         rp.set_pipeline(&pass.pipes.cover);
         rp.set_bind_group(0, &t.bind, &[]);
         rp.set_vertex_buffer(0, self.vbuf.slice(..));
         for r in v.alone.iter().filter(|r| !r.is_empty()) {
             rp.draw(r.clone(), 0..1);
         }
+    }
+}
+
+/// A render pass into `color` and `depth` (if any), each cleared (id 0, depth 1) or
+/// (`over`) continued from what it holds.
+fn begin<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    color: &wgpu::TextureView,
+    depth: Option<&wgpu::TextureView>,
+    over: bool,
+) -> wgpu::RenderPass<'e> {
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: color,
+            depth_slice: None,
+            resolve_target: None,
+            ops: operations(over, wgpu::Color::TRANSPARENT),
+        })],
+        depth_stencil_attachment: depth.map(|view| wgpu::RenderPassDepthStencilAttachment {
+            view,
+            depth_ops: Some(operations(over, 1.0)),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
+/// Cleared to `clear`, or (`over`) continued from what the attachment holds; stored.
+fn operations<V>(over: bool, clear: V) -> wgpu::Operations<V> {
+    wgpu::Operations {
+        load: if over {
+            wgpu::LoadOp::Load
+        } else {
+            wgpu::LoadOp::Clear(clear)
+        },
+        store: wgpu::StoreOp::Store,
     }
 }
 
