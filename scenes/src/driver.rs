@@ -16,6 +16,7 @@ use crate::randomize::{randomize, RandomizeError, SceneKey};
 use crate::selection::{plan_group_with, replan_group};
 use crate::twins;
 use crate::validate::{validate, Verdicts, VALIDATOR_COLUMNS};
+use rayon::prelude::*;
 use rh_catalog::Catalog;
 use rh_physics::simulate::{simulate, SimOptions, Simulation};
 use rh_physics::spec::{SceneSpec, Selection};
@@ -91,7 +92,9 @@ pub enum GroupError {
 /// The whole DAG for scene group `g` of a build (`count` speed bands, scenes
 /// `4g … 4g + count − 1`): plan the group's selection, produce its labelled scenes
 /// ([`produce_group_counted`]), then render each (`render`; `None` for a label-only
-/// build). Also returns the group's family and how its attempts went.
+/// build), the scenes as parallel tasks of the caller's rayon pool (a worker idle at
+/// the end of a build takes scenes of another's last group). Also returns the group's
+/// family and how its attempts went.
 pub fn run_group(
     catalog: &Catalog,
     families: &[String],
@@ -106,9 +109,10 @@ pub fn run_group(
         plan_and_produce(catalog, families, planned, seed, g, count, config)
             .map_err(GroupError::Input)?;
     if let Some(render) = render {
-        for r in results.iter_mut() {
+        results.par_iter_mut().try_for_each(|r| {
             r.media = render(r).map_err(GroupError::Render)?;
-        }
+            Ok(())
+        })?;
     }
     Ok((results, rejections))
 }
