@@ -10,6 +10,8 @@
 //! each view's static image once per scene and per frame only around what changed
 //! (`Gpu::draw_overlay`); the result is the same as filtering the whole frame.
 
+use super::cells::runs_to_rects;
+
 /// How far (pixels) an output pixel reads from: its neighbours and diagonals (1), the
 /// taps along the edge (at most `SPAN_MAX / 2` = 4 away) with their bilinear footprint
 /// (1); with slack. Outside a rectangle grown by this much around every changed input
@@ -172,42 +174,17 @@ pub(crate) fn apply_changed(src: Frame, base: &[u8], dst: &mut [u8], rects: &[[u
         (r0..=r1).any(|r| (c0..=c1).any(|c| changed[r * cols + c]))
     };
     let near: Vec<bool> = (0..cols * rows).map(|i| near(i % cols, i / cols)).collect();
+    // The cells near a change as rectangles, filtered where they meet `rects` (the
+    // read-back holds this frame only there).
+    let grid = (cols as u32, rows as u32, CELL as u32);
+    let near = runs_to_rects(&near, grid.0, grid.1, grid.2, src.width, src.height);
     for &[x0, y0, x1, y1] in &clipped {
-        // Runs of cells near a change, row by row; a run continued in the rows below
-        // (the same columns) is filtered as one rectangle.
-        let mut open: Vec<[usize; 4]> = Vec::new();
-        for cy in y0 / CELL..y1.div_ceil(CELL) {
-            let mut runs = Vec::new();
-            let mut cx = x0 / CELL;
-            while cx < x1.div_ceil(CELL) {
-                let start = cx;
-                while cx < x1.div_ceil(CELL) && near[cy * cols + cx] {
-                    cx += 1;
-                }
-                if cx > start {
-                    runs.push((start, cx));
-                }
-                cx += 1;
-            }
-            let (ry0, ry1) = ((cy * CELL).max(y0), ((cy + 1) * CELL).min(y1));
-            let mut next = Vec::new();
-            for (a, e) in runs {
-                let (rx0, rx1) = ((a * CELL).max(x0), (e * CELL).min(x1));
-                match open.iter().position(|o| o[0] == rx0 && o[2] == rx1) {
-                    Some(i) => {
-                        let mut o = open.swap_remove(i);
-                        o[3] = ry1;
-                        next.push(o);
-                    }
-                    None => next.push([rx0, ry0, rx1, ry1]),
-                }
-            }
-            for [a, b, c, d] in std::mem::replace(&mut open, next) {
+        for &[nx, ny, nw, nh] in &near {
+            let (a, b) = ((nx as usize).max(x0), (ny as usize).max(y0));
+            let (c, d) = (((nx + nw) as usize).min(x1), ((ny + nh) as usize).min(y1));
+            if a < c && b < d {
                 apply(src, dst, [a, b, c - a, d - b].map(|v| v as u32));
             }
-        }
-        for [a, b, c, d] in open {
-            apply(src, dst, [a, b, c - a, d - b].map(|v| v as u32));
         }
     }
 }

@@ -40,6 +40,7 @@
 //! | `sheet` | the contact sheet (`rh-pipeline sheet`) |
 
 mod camera;
+mod cells;
 mod ego;
 pub mod encode;
 #[cfg(not(feature = "video"))]

@@ -6,9 +6,10 @@
 //! clip-space box) lies within the shadow map's reach of the casters' footprint there
 //! and not in front of them. Each test is conservative, so both must pass.
 
+use super::cells::runs_to_rects;
 use super::gpu;
 use super::mesh::Vertex;
-use super::regions::{merge_rects, runs_to_rects, sweep_meets};
+use super::regions::{merge_rects, sweep_meets};
 use rh_physics::spec::Vec3;
 
 /// Slack (the sun's clip-space depth, 1 ≈ the room's diagonal and more) for a receiver
