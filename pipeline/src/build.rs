@@ -371,8 +371,7 @@ fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<RenderChec
     }
     #[cfg(feature = "render")]
     {
-        memory::no_huge_pages();
-        memory::large_buffers_mapped();
+        rh_render::memory::set_render_policy();
         let renderer =
             rh_render::Renderer::new(rh_render::RenderOptions::from_config(&config.render))
                 .map_err(|e| {
@@ -491,7 +490,7 @@ pub fn build(
     let render_stage = |r: &rh_scenes::driver::SceneResult| {
         let media = rh_render::render_stage(r, catalog, &render_opts, out)
             .map_err(|e| format!("render {}: {e}", r.spec.scene_id));
-        memory::release_free_pages();
+        rh_render::memory::release_free_pages();
         media
     };
     #[cfg(feature = "render")]
@@ -603,51 +602,6 @@ fn summarize(
         *summary.per_action.entry(action[i].clone()).or_default() += 1;
     }
     summary
-}
-
-/// Process memory policy of a rendered build (glibc, Linux; nothing elsewhere). Peak RSS
-/// with two workers fell from 507 to about 470 MB with both (docs/rendering.md).
-#[cfg(feature = "render")]
-mod memory {
-    /// libx264 asks for transparent huge pages for its frame buffers
-    /// (`madvise(MADV_HUGEPAGE)`), which makes every 2 MB region it touches at all
-    /// resident: off for this process.
-    pub fn no_huge_pages() {
-        #[cfg(target_os = "linux")]
-        // SAFETY: prctl with integer arguments only; a failure leaves the default.
-        unsafe {
-            libc::prctl(libc::PR_SET_THP_DISABLE, 1, 0, 0, 0);
-        }
-    }
-
-    /// Allocations from this size up always come from the system (mmap) and go back to
-    /// it when freed: a 720p frame (3.7 MB), its RGB copy for a PNG (2.8 MB), lavapipe's
-    /// memory blocks (4 MB and up). glibc otherwise raises its mmap threshold to the
-    /// largest block freed so far (up to 32 MB), after which such buffers are carved from
-    /// the malloc arenas, whose freed space fragments and stays resident: peak RSS crept
-    /// up scene by scene (docs/benchmarks.md, "Render memory"). Not lower: lavapipe
-    /// allocates and frees about 1.2 MB per frame, which mapped each time cost 5x the
-    /// system time.
-    const MMAP_THRESHOLD: i32 = 2 << 20;
-
-    pub fn large_buffers_mapped() {
-        #[cfg(all(target_os = "linux", target_env = "gnu"))]
-        // SAFETY: mallopt only sets an allocator parameter; M_MMAP_THRESHOLD is valid for
-        // glibc (setting it also turns its adjustment off).
-        unsafe {
-            libc::mallopt(libc::M_MMAP_THRESHOLD, MMAP_THRESHOLD);
-        }
-    }
-
-    /// Returns the free pages of every malloc arena to the system (a scene's encoder
-    /// and frame buffers are freed in threads' arenas, which glibc keeps otherwise).
-    pub fn release_free_pages() {
-        #[cfg(all(target_os = "linux", target_env = "gnu"))]
-        // SAFETY: malloc_trim only walks the allocator's own free lists.
-        unsafe {
-            libc::malloc_trim(0);
-        }
-    }
 }
 
 /// Ctrl-C (SIGINT) or SIGTERM during a build: say that the finished groups are kept and

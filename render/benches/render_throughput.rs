@@ -9,10 +9,17 @@
 //! configuration's `msaa`, or `msaa_cpu` on a CPU rasterizer), `RH_BENCH_FXAA` (0 or 1:
 //! the post-process anti-aliasing pass; default: the configuration's `fxaa`).
 //!
+//! The process runs under the memory policy of a rendered build
+//! (`rh_render::memory`), so the two measure the same thing.
+//!
 //! Prints each scene's own time and the figure that matters for a build: wall-clock
 //! seconds per scene with every worker busy; and, independent of other load on the
 //! machine, the CPU seconds per scene with the encoder threads' share (the encode-only
 //! bound).
+//!
+//! `RH_BENCH_BUILD_SEED=S` takes instead the scenes `rh-pipeline build --n N --seed S`
+//! renders (every speed band of each group, in order), so that the bench and a build
+//! can be compared on the same scenes.
 //!
 //! `RH_BENCH_MASKS=1` also writes the mask and depth PNGs (as `build --masks`). The
 //! instance-id pass alone (`Renderer::measure_hazard`: the five observation frames of
@@ -20,10 +27,11 @@
 
 use rayon::prelude::*;
 use rh_catalog::Catalog;
-use rh_physics::simulate::{simulate, SimOptions};
+use rh_physics::simulate::{simulate, SimOptions, Simulation};
+use rh_physics::spec::SceneSpec;
 use rh_render::{with_thread_renderer, RenderOptions};
 use rh_scenes::config::Config;
-use rh_scenes::driver::produce_group;
+use rh_scenes::driver::{plan_and_produce, produce_group};
 use rh_scenes::selection::plan_group;
 use std::time::Instant;
 
@@ -38,6 +46,49 @@ fn process_cpu_seconds() -> f64 {
 
 fn env_parse<T: std::str::FromStr>(name: &str) -> Option<T> {
     std::env::var(name).ok().and_then(|v| v.parse().ok())
+}
+
+/// The first speed band of groups 0, 1, … (seed 5) until `n` scenes with cameras.
+fn first_bands(catalog: &Catalog, config: &Config, n: usize) -> Vec<(SceneSpec, Simulation)> {
+    let families = &config.build.families;
+    let mut scenes = Vec::new();
+    let mut g = 0u64;
+    while scenes.len() < n && g < 10 * n as u64 {
+        let selection = plan_group(catalog, families, 5, g).unwrap();
+        let r = produce_group(&selection, 5, g * 4, 1, catalog, config).unwrap();
+        g += 1;
+        let spec = r[0].spec.clone();
+        if spec.cameras.is_empty() {
+            continue;
+        }
+        let sim = simulate(&spec, SimOptions::default());
+        scenes.push((spec, sim));
+    }
+    scenes
+}
+
+/// The scenes a rendered `build --n n --seed seed` renders: every valid scene with
+/// cameras of groups 0 … ⌈n/4⌉ − 1, the last group cut at n (as the build's manifest).
+fn build_scenes(
+    catalog: &Catalog,
+    config: &Config,
+    n: usize,
+    seed: u64,
+) -> Vec<(SceneSpec, Simulation)> {
+    let families = &config.build.families;
+    let mut scenes = Vec::new();
+    for g in 0..n.div_ceil(4) as u64 {
+        let count = (n as u64 - 4 * g).min(4);
+        let (results, _) =
+            plan_and_produce(catalog, families, None, seed, g, count, config).unwrap();
+        for r in results {
+            if r.verdicts.all() && !r.spec.cameras.is_empty() {
+                let sim = simulate(&r.spec, SimOptions::default());
+                scenes.push((r.spec, sim));
+            }
+        }
+    }
+    scenes
 }
 
 fn main() {
@@ -65,25 +116,17 @@ fn main() {
             .map(|n| n.get())
             .unwrap_or(1)
     });
-    let families = config.build.families.clone();
-    let mut scenes = Vec::new();
-    let mut g = 0u64;
-    while scenes.len() < n && g < 10 * n as u64 {
-        let selection = plan_group(&catalog, &families, 5, g).unwrap();
-        let r = produce_group(&selection, 5, g * 4, 1, &catalog, &config).unwrap();
-        g += 1;
-        let spec = r[0].spec.clone();
-        if spec.cameras.is_empty() {
-            continue;
-        }
-        let sim = simulate(&spec, SimOptions::default());
-        scenes.push((spec, sim));
-    }
+    let scenes = match env_parse::<u64>("RH_BENCH_BUILD_SEED") {
+        Some(seed) => build_scenes(&catalog, &config, n, seed),
+        None => first_bands(&catalog, &config, n),
+    };
     let opts = RenderOptions {
         masks: std::env::var_os("RH_BENCH_MASKS").is_some(),
         ..RenderOptions::from_config(&config.render)
     };
     let dir = std::env::temp_dir().join(format!("rh-render-bench-{}", std::process::id()));
+    // The process a rendered build is (before any rendering thread starts).
+    rh_render::memory::set_render_policy();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
         .build()
@@ -108,6 +151,7 @@ fn main() {
                 let r = with_thread_renderer(&opts, |r| r.render_scene(spec, sim, &catalog, &dir))
                     .unwrap()
                     .unwrap();
+                rh_render::memory::release_free_pages();
                 let s = t.elapsed().as_secs_f64();
                 let line = format!(
                     "{} {:<16} {:.2} s ({} window frames x3 at {}x{}, {} full-event frames at {}x{}/{} fps)",

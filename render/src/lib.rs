@@ -33,6 +33,7 @@
 //! | `regions` | shadow-tile rectangle maths: where a moving shadow can change pixels |
 //! | `measure` | the instance-id pass at the observation frames: hazard visibility, masks, depth |
 //! | `gpu` | the wgpu device and pipelines (one per worker thread on a CPU rasterizer, one for all workers on a GPU), static cache and overlay drawing |
+//! | `memory` | the process memory policy of rendering many scenes (glibc: mmap and trim thresholds, one arena, no huge pages) |
 //! | `fxaa` | post-process anti-aliasing of read-back frames (where MSAA is off) |
 //! | `encode` | H.264 encoding through FFmpeg (feature `video`, default; `encode_off` without it) |
 //! | `execution` | execution videos: outside and ego views of executed plans, tiled ([`Renderer::render_executions`]) |
@@ -52,6 +53,7 @@ mod geometry;
 pub mod gpu;
 mod lighting;
 mod measure;
+pub mod memory;
 pub mod mesh;
 mod observer;
 pub mod recipes;
