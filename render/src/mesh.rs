@@ -164,6 +164,39 @@ fn normalize(a: V3) -> V3 {
     [a[0] / n, a[1] / n, a[2] / n]
 }
 
+/// The mean of a quad's corners (where its painter is asked for the colour).
+fn centroid(p: &[V3; 4]) -> V3 {
+    [
+        (p[0][0] + p[1][0] + p[2][0] + p[3][0]) / 4.0,
+        (p[0][1] + p[1][1] + p[2][1] + p[3][1]) / 4.0,
+        (p[0][2] + p[1][2] + p[2][2] + p[3][2]) / 4.0,
+    ]
+}
+
+/// The grid lines (`0..=cells[e]`) along box edge direction `e` that some face's colour
+/// changes across: a face (axis, sign, colours over `cells[u]` × `cells[v]`, u and v the
+/// axes after `axis`) lying along `e` has line k when two of its cells on either side
+/// of k differ. The outer lines are always kept.
+fn kept_lines(faces: &[(usize, f32, Vec<Rgba>)], cells: [usize; 3], e: usize) -> Vec<usize> {
+    let same = |a: &Rgba, b: &Rgba| a.map(f32::to_bits) == b.map(f32::to_bits);
+    let changes_across = |k: usize| {
+        faces.iter().any(|(axis, _, colours)| {
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            let (nu, nv) = (cells[u], cells[v]);
+            if e == u {
+                (0..nv).any(|j| !same(&colours[(k - 1) * nv + j], &colours[k * nv + j]))
+            } else if e == v {
+                (0..nu).any(|i| !same(&colours[i * nv + k - 1], &colours[i * nv + k]))
+            } else {
+                false
+            }
+        })
+    };
+    (0..=cells[e])
+        .filter(|&k| k == 0 || k == cells[e] || changes_across(k))
+        .collect()
+}
+
 /// A painter: colour of the face around a local point (the face's centroid).
 pub type Paint<'a> = &'a dyn Fn(V3) -> Rgba;
 
@@ -211,46 +244,60 @@ impl Mesh {
     }
 
     fn quad(&mut self, xf: &Xf, p: [V3; 4], n: Option<[V3; 4]>, paint: Paint) {
-        let c = [
-            (p[0][0] + p[1][0] + p[2][0] + p[3][0]) / 4.0,
-            (p[0][1] + p[1][1] + p[2][1] + p[3][1]) / 4.0,
-            (p[0][2] + p[1][2] + p[2][2] + p[3][2]) / 4.0,
-        ];
-        let one = |_: V3| paint(c);
+        let one = |_: V3| paint(centroid(&p));
         self.tri(xf, [p[0], p[1], p[2]], n.map(|n| [n[0], n[1], n[2]]), &one);
         self.tri(xf, [p[0], p[2], p[3]], n.map(|n| [n[0], n[2], n[3]]), &one);
     }
 
     /// Axis-aligned box of half extents `h` centred at the local origin; faces are split
-    /// into a grid of `div` cells per side so painters can draw patterns.
+    /// into a grid of `div` cells per side so painters can draw patterns. A cell takes
+    /// the painter's colour at its centre. Grid lines across which no face's colour
+    /// changes are left out ([`kept_lines`]): a plain box is 12 triangles, and every
+    /// face still meets its neighbours vertex to vertex (no T-junction, so no pixel
+    /// cracks along edges).
     pub fn boxy(&mut self, xf: &Xf, h: V3, div: usize, paint: Paint) {
         // `div` cells along the longest edge, proportionally fewer along shorter ones
         // (a thin panel's rim needs no grid: it only carries the paint's resolution).
         let longest = h[0].max(h[1]).max(h[2]).max(1e-9);
         let cells = h.map(|e| ((div.max(1) as f32 * e / longest).ceil() as usize).max(1));
-        for axis in 0..3 {
-            for sign in [-1.0f32, 1.0] {
+        let at = |axis: usize, k: usize| -1.0 + 2.0 * k as f32 / cells[axis] as f32;
+        // Face (axis, sign)'s quad over grid lines i0..i1 along u and j0..j1 along v.
+        let face_quad = |axis: usize, sign: f32, [i0, i1, j0, j1]: [usize; 4]| {
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            let pt = |a: f32, b: f32| {
+                let mut p = [0.0; 3];
+                p[axis] = sign * h[axis];
+                p[u] = a * h[u];
+                p[v] = b * h[v];
+                p
+            };
+            let (a0, a1, b0, b1) = (at(u, i0), at(u, i1), at(v, j0), at(v, j1));
+            let mut q = [pt(a0, b0), pt(a1, b0), pt(a1, b1), pt(a0, b1)];
+            if sign < 0.0 {
+                q.reverse();
+            }
+            q
+        };
+        // Each face's cell colours, `i * nv + j`.
+        let faces: Vec<(usize, f32, Vec<Rgba>)> = (0..3)
+            .flat_map(|axis| [-1.0f32, 1.0].map(|sign| (axis, sign)))
+            .map(|(axis, sign)| {
                 let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-                let (nu, nv) = (cells[u], cells[v]);
-                for i in 0..nu {
-                    for j in 0..nv {
-                        let a0 = -1.0 + 2.0 * i as f32 / nu as f32;
-                        let a1 = -1.0 + 2.0 * (i + 1) as f32 / nu as f32;
-                        let b0 = -1.0 + 2.0 * j as f32 / nv as f32;
-                        let b1 = -1.0 + 2.0 * (j + 1) as f32 / nv as f32;
-                        let pt = |a: f32, b: f32| {
-                            let mut p = [0.0; 3];
-                            p[axis] = sign * h[axis];
-                            p[u] = a * h[u];
-                            p[v] = b * h[v];
-                            p
-                        };
-                        let mut q = [pt(a0, b0), pt(a1, b0), pt(a1, b1), pt(a0, b1)];
-                        if sign < 0.0 {
-                            q.reverse();
-                        }
-                        self.quad(xf, q, None, paint);
-                    }
+                let colours = (0..cells[u])
+                    .flat_map(|i| (0..cells[v]).map(move |j| [i, i + 1, j, j + 1]))
+                    .map(|r| paint(centroid(&face_quad(axis, sign, r))))
+                    .collect();
+                (axis, sign, colours)
+            })
+            .collect();
+        let lines: Vec<Vec<usize>> = (0..3).map(|e| kept_lines(&faces, cells, e)).collect();
+        for (axis, sign, colours) in &faces {
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            for iw in lines[u].windows(2) {
+                for jw in lines[v].windows(2) {
+                    let colour = colours[iw[0] * cells[v] + jw[0]];
+                    let q = face_quad(*axis, *sign, [iw[0], iw[1], jw[0], jw[1]]);
+                    self.quad(xf, q, None, &|_| colour);
                 }
             }
         }
@@ -501,4 +548,115 @@ impl Mesh {
 /// A constant painter.
 pub fn solid(c: Rgba) -> impl Fn(V3) -> Rgba {
     move |_| c
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeMap;
+
+    const H: V3 = [0.3, 0.1, 0.45];
+    const RED: Rgba = [0.8, 0.1, 0.1, MAT_PLAIN];
+    const GREY: Rgba = [0.5, 0.5, 0.5, MAT_PLAIN];
+
+    /// Red where x > 0 and y < 0.02: on a 12-cell grid (8 × 3 × 12 cells) the colour
+    /// changes across x line 4 and y line 2 only.
+    fn half_red(p: V3) -> Rgba {
+        if p[0] > 0.0 && p[1] < 0.02 {
+            RED
+        } else {
+            GREY
+        }
+    }
+
+    /// The face (axis, sign) a box triangle lies in.
+    fn face_of(t: &[Vertex]) -> (usize, bool) {
+        (0..3)
+            .find_map(|a| {
+                let c = t[0].pos[a];
+                (c.abs() == H[a] && t.iter().all(|v| v.pos[a] == c)).then_some((a, c > 0.0))
+            })
+            .expect("a box triangle lies in a face")
+    }
+
+    #[test]
+    fn a_plain_box_is_twelve_triangles_whatever_its_grid() {
+        let mut m = Mesh::new();
+        m.boxy(&Xf::ID, H, 24, &solid(GREY));
+        assert_eq!(m.verts.len(), 36);
+    }
+
+    #[test]
+    fn a_painted_box_keeps_every_cell_colour_with_only_the_lines_it_needs() {
+        let mut m = Mesh::new();
+        m.boxy(&Xf::ID, H, 12, &half_red);
+        // Faces ±x: 2 × 1 quads, ±y: 1 × 2, ±z: 2 × 2 — 16 quads, 32 triangles.
+        assert_eq!(m.verts.len(), 96);
+        let cells = [8usize, 3, 12];
+        for axis in 0..3 {
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            for sign in [-1.0f32, 1.0] {
+                for i in 0..cells[u] {
+                    for j in 0..cells[v] {
+                        // The centre of fine cell (i, j) and the triangle drawn over it.
+                        let centre = |k: usize, a: usize| {
+                            H[a] * (-1.0 + (2 * k + 1) as f32 / cells[a] as f32)
+                        };
+                        let mut p = [0.0; 3];
+                        p[axis] = sign * H[axis];
+                        p[u] = centre(i, u);
+                        p[v] = centre(j, v);
+                        let inside = |t: &[Vertex]| {
+                            let lo = |a: usize| t.iter().map(|q| q.pos[a]).fold(f32::MAX, f32::min);
+                            let hi = |a: usize| t.iter().map(|q| q.pos[a]).fold(f32::MIN, f32::max);
+                            face_of(t) == (axis, sign > 0.0)
+                                && [u, v].iter().all(|&a| lo(a) <= p[a] && p[a] <= hi(a))
+                        };
+                        let t = m.verts.chunks(3).find(|t| inside(t)).expect("covered");
+                        assert_eq!(t[0].color, half_red(p), "face {axis}{sign} cell {i},{j}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn neighbouring_faces_share_every_vertex_along_their_edge() {
+        let mut m = Mesh::new();
+        m.boxy(&Xf::ID, H, 12, &half_red);
+        // Box edge (the two coordinates at ±h) → face → the vertices on that edge.
+        type Face = (usize, bool);
+        let mut edges: BTreeMap<Vec<Face>, BTreeMap<Face, Vec<u32>>> = BTreeMap::new();
+        for t in m.verts.chunks(3) {
+            let face = face_of(t);
+            for q in t {
+                let at_h: Vec<(usize, bool)> = (0..3)
+                    .filter(|&a| q.pos[a].abs() == H[a])
+                    .map(|a| (a, q.pos[a] > 0.0))
+                    .collect();
+                // On every edge whose two coordinates it has at ±h (a corner: three).
+                for x in 0..at_h.len() {
+                    for y in x + 1..at_h.len() {
+                        let edge = vec![at_h[x], at_h[y]];
+                        if !edge.contains(&face) {
+                            continue; // a face meeting the edge only at its end
+                        }
+                        let free = 3 - at_h[x].0 - at_h[y].0;
+                        let on = edges.entry(edge).or_default().entry(face).or_default();
+                        on.push(q.pos[free].to_bits());
+                    }
+                }
+            }
+        }
+        assert_eq!(edges.len(), 12);
+        for (edge, faces) in edges {
+            let mut sets: Vec<Vec<u32>> = faces.into_values().collect();
+            for s in &mut sets {
+                s.sort();
+                s.dedup();
+            }
+            assert_eq!(sets.len(), 2, "edge {edge:?}");
+            assert_eq!(sets[0], sets[1], "T-junction along edge {edge:?}");
+        }
+    }
 }
