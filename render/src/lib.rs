@@ -140,7 +140,7 @@ impl Default for RenderOptions {
             full_height: 360,
             full_fps: 30,
             encode: EncodeSettings {
-                preset: "veryfast".into(),
+                preset: "superfast".into(),
                 crf: 20,
                 threads: 1,
                 bframes: 0,

@@ -210,7 +210,7 @@ fn default_full_fps() -> u32 {
     30
 }
 fn default_preset() -> String {
-    "veryfast".into()
+    "superfast".into()
 }
 fn default_crf() -> u32 {
     20
