@@ -593,7 +593,7 @@ true physics), or its mass is ≥ {heavy} kg, or its impact momentum is ≥ {mom
 * **danger_present** (rule v5: danger is harm): in a counterfactual simulation with the \
 observer's body as fixed colliders — the articulated humanoid the executor moves \
 (`rh-score --execute`), standing at its pose with the palms at rest: pelvis, torso, head, \
-upper arms, forearms, palms, thighs and shanks (capsules and boxes, SPEC §2 proportions, \
+upper arms, forearms, palms, thighs and shanks (capsules and boxes with Unitree G1 proportions, \
 {height} m tall; the legs are two capsules 0.18 m apart, so a small ball can pass between \
 them) — the standing body would be **harmed**. Each touch is placed in a body region of \
 ISO/TS 15066:2016 Annex A (the link, and for the head and torso where on it: the head's \

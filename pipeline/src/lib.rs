@@ -4,7 +4,7 @@
 //! itself is done by the libraries: `rh-scenes` (scenes and labels), `rh-physics`,
 //! `rh-render` (feature `render`, default) and `rh-dataset` (files). Without `render`
 //! the program is label-only and links neither Vulkan nor FFmpeg. ARCHITECTURE.md has
-//! the crate and module graphs.
+//! the crate graph.
 
 pub mod build;
 pub mod cli;

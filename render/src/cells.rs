@@ -1,5 +1,6 @@
 //! Grids of marked cells as rectangles: the redraw and post-process regions
-//! (`regions`, `tiles`) and the cells FXAA filters again (`fxaa::apply_changed`).
+//! (`regions`, `tiles`) and the cells FXAA filters again (`fxaa::apply_changed`), and
+//! the rectangle arithmetic they share.
 
 /// Rectangles (pixels) covering the marked tiles (`cols` × `rows`, row-major, side
 /// `tile`): each tile row's runs, runs with the same span in consecutive rows stacked
@@ -51,4 +52,24 @@ pub(crate) fn runs_to_rects(
             [x0, y0, x1 - x0, y1 - y0]
         })
         .collect()
+}
+
+/// The area of a rectangle (x, y, width, height) in pixels.
+pub(crate) fn rect_area(r: [u32; 4]) -> u64 {
+    r[2] as u64 * r[3] as u64
+}
+
+/// The bounding rectangle of two (x, y, width, height).
+pub(crate) fn rect_union(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
+    let (x0, y0) = (a[0].min(b[0]), a[1].min(b[1]));
+    let (x1, y1) = (
+        (a[0] + a[2]).max(b[0] + b[2]),
+        (a[1] + a[3]).max(b[1] + b[3]),
+    );
+    [x0, y0, x1 - x0, y1 - y0]
+}
+
+/// Whether two rectangles (x, y, width, height) share a pixel.
+pub(crate) fn rects_meet(a: [u32; 4], b: [u32; 4]) -> bool {
+    a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3]
 }

@@ -1,7 +1,7 @@
 //! Shadow-tile rectangle maths: where on screen a moving body's shadow can change static
 //! pixels (`shadow_regions`), as few tile-snapped rectangles.
 
-use super::cells::runs_to_rects;
+use super::cells::{rect_area, rect_union, runs_to_rects};
 use super::gpu;
 use super::mesh::Vertex;
 use rh_physics::spec::{CameraSpec, Vec3};
@@ -77,24 +77,6 @@ pub(super) fn merge_rects(rects: &mut Vec<[u32; 4]>, max: usize) {
             _ => return,
         }
     }
-}
-
-pub(super) fn rect_area(r: [u32; 4]) -> u64 {
-    r[2] as u64 * r[3] as u64
-}
-
-/// The bounding rectangle of two (x, y, width, height).
-pub(super) fn rect_union(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
-    let (x0, y0) = (a[0].min(b[0]), a[1].min(b[1]));
-    let (x1, y1) = (
-        (a[0] + a[2]).max(b[0] + b[2]),
-        (a[1] + a[3]).max(b[1] + b[3]),
-    );
-    [x0, y0, x1 - x0, y1 - y0]
-}
-
-pub(super) fn rects_meet(a: [u32; 4], b: [u32; 4]) -> bool {
-    a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3]
 }
 
 /// Pixel rectangles (x, y, width, height) where moving geometry with bounds `[lo, hi]`

@@ -1,4 +1,4 @@
-//! House rule (ARCHITECTURE.md, "Module graph"): no non-test source file over 800 lines
+//! House rule (ARCHITECTURE.md, "Invariants"): no non-test source file over 800 lines
 //! and no function over 150 lines. Test code (`tests/`, `benches/`, `tests.rs`, and a
 //! file's trailing `#[cfg(test)]` module) is exempt.
 

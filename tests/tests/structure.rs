@@ -1,5 +1,5 @@
-//! The house rules of the code's structure (ARCHITECTURE.md, "Crates" and "Module
-//! graphs"), checked from the sources themselves:
+//! The house rules of the code's structure (ARCHITECTURE.md, "Crate graph" and
+//! "Invariants"), checked from the sources themselves:
 //!
 //! * no import circle between the files of a crate, nor between its top-level modules
 //!   (a folder counts as one module): `crate::…` and `super::…` paths are the edges;
@@ -76,7 +76,7 @@ fn code_of(text: &str) -> String {
 
 /// Paths a file names inside its crate: `crate::a::b…` and `super::…` (resolved against
 /// the file's module), as module-path segments.
-fn referenced_paths(code: &str, module: &[String], is_mod_file: bool) -> Vec<Vec<String>> {
+fn referenced_paths(code: &str, module: &[String]) -> Vec<Vec<String>> {
     let mut found = Vec::new();
     let bytes = code.as_bytes();
     for start in ["crate::", "super::"] {
@@ -100,16 +100,13 @@ fn referenced_paths(code: &str, module: &[String], is_mod_file: bool) -> Vec<Vec
             if segs[0] == "crate" {
                 segs.remove(0);
             } else {
-                // `super` of a `mod.rs` file is its folder's parent.
+                // Each `super` is the parent of the file's module. A folder's `mod.rs`
+                // is the folder's own module (`gpu/mod.rs` is `gpu`), so its `super` is
+                // the folder's parent, as for any other file.
                 base = module.to_vec();
-                if !is_mod_file {
-                    base.pop();
-                }
                 while segs.first().is_some_and(|s| s == "super") {
                     segs.remove(0);
-                    if segs.first().is_some_and(|s| s == "super") {
-                        base.pop();
-                    }
+                    base.pop();
                 }
             }
             base.extend(segs);
@@ -125,11 +122,8 @@ fn file_graph(src: &Path) -> BTreeMap<Vec<String>, BTreeSet<Vec<String>>> {
     let mut graph: BTreeMap<Vec<String>, BTreeSet<Vec<String>>> = BTreeMap::new();
     for (m, path) in &mods {
         let text = std::fs::read_to_string(path).unwrap();
-        let is_mod_file = path
-            .file_name()
-            .is_some_and(|n| n == "mod.rs" || n == "lib.rs");
         let edges = graph.entry(m.clone()).or_default();
-        for p in referenced_paths(&code_of(&text), m, is_mod_file) {
+        for p in referenced_paths(&code_of(&text), m) {
             // The longest module prefix of the path is the file it names.
             let target = (0..=p.len())
                 .rev()
@@ -242,6 +236,31 @@ fn the_circle_check_finds_a_circle() {
     // body -> a makes a file circle (a -> exec::body -> a).
     std::fs::write(src.join("exec/body.rs"), "fn g() { crate::a::f(); }\n").unwrap();
     assert!(find_cycle(&file_graph(src)).is_some());
+}
+
+#[test]
+fn super_in_a_mod_file_names_a_sibling_of_its_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path();
+    std::fs::create_dir_all(src.join("gpu")).unwrap();
+    std::fs::write(src.join("lib.rs"), "mod gpu;\nmod regions;\n").unwrap();
+    std::fs::write(src.join("gpu/mod.rs"), "use super::regions::area;\n").unwrap();
+    std::fs::write(src.join("regions.rs"), "fn f() {}\n").unwrap();
+    let files = file_graph(src);
+    let edge = |a: &[&str], b: &[&str]| {
+        let (a, b): (Vec<String>, Vec<String>) = (
+            a.iter().map(|s| s.to_string()).collect(),
+            b.iter().map(|s| s.to_string()).collect(),
+        );
+        files.get(&a).is_some_and(|e| e.contains(&b))
+    };
+    assert!(edge(&["gpu"], &["regions"]), "{files:?}");
+    assert!(find_cycle(&files).is_none(), "{files:?}");
+    // regions -> gpu closes the circle gpu -> regions -> gpu through `super::` in a mod.rs.
+    std::fs::write(src.join("regions.rs"), "use super::gpu::MAX;\n").unwrap();
+    let files = file_graph(src);
+    assert!(find_cycle(&files).is_some(), "{files:?}");
+    assert!(find_cycle(&folder_graph(&files)).is_some());
 }
 
 /// Runs cargo (the one running the tests) in the workspace root; its stdout.

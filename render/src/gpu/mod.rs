@@ -10,7 +10,7 @@ mod ids;
 mod moving;
 
 use super::mesh::Vertex;
-use super::regions::{rect_area, rect_union, rects_meet};
+use super::cells::{rect_area, rect_union, rects_meet};
 use super::RenderError;
 pub use ids::{IdImage, IdPass, IdView};
 use readback::Finish;
