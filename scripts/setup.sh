@@ -17,9 +17,11 @@ apt_packages=(
 # maturin, numpy, gymnasium and pytest; its wheel's own dependencies are numpy, pyarrow
 # and gymnasium. jsonschema validates results files in tests/tests/results_leaderboard.rs.
 python_packages=(pyarrow datasets maturin numpy gymnasium pytest jsonschema)
-# Modules whose pip package has another name (module:package): Pillow decodes the
-# `datasets` Image columns of rendered builds (`<cam>_frames`).
-python_renamed=(PIL:pillow)
+# Modules whose pip package has another name or a version floor (module:package): Pillow
+# decodes the `datasets` Image columns of rendered builds (`<cam>_frames`); pyyaml and
+# bibtexparser 2 parse the dataset card's front matter and citations
+# (tests/tests/dataset_build.rs).
+python_renamed=(PIL:pillow yaml:pyyaml "bibtexparser:bibtexparser>=2")
 
 missing=()
 for pkg in "${apt_packages[@]}"; do

@@ -333,6 +333,8 @@ pub fn text(input: &CardInput) -> String {
     v.insert("family_table", family_table(input, &counts, total_eval));
 
     v.insert("features_table", features_table());
+    v.insert("teaser", crate::card_teaser::teaser(input.rows));
+    v.insert("frame_size", crate::card_teaser::frame_size(m));
 
     v.insert("label_rule", label_rule(m, &labels));
 
@@ -529,7 +531,7 @@ fn features_table() -> String {
     for field in schema.fields() {
         let _ = writeln!(
             features,
-            "| `{}` | {}{} | {} |",
+            "| `{}` | `{}`{} | {} |",
             field.name(),
             type_name(field.data_type()),
             if field.is_nullable() {

@@ -17,6 +17,8 @@ pub mod table;
 #[cfg(feature = "write")]
 pub mod card;
 #[cfg(feature = "write")]
+pub mod card_teaser;
+#[cfg(feature = "write")]
 pub mod finalize;
 #[cfg(feature = "write")]
 pub mod integrity;

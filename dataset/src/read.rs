@@ -5,7 +5,7 @@
 
 use arrow::array::{
     Array, ArrayRef, BooleanArray, FixedSizeListArray, Float64Array, ListArray, RecordBatch,
-    StringArray, UInt64Array,
+    StringArray, UInt32Array, UInt64Array,
 };
 use arrow::datatypes::DataType;
 use parquet::arrow::arrow_reader::{ParquetRecordBatchReader, ParquetRecordBatchReaderBuilder};
@@ -141,6 +141,33 @@ pub fn bools(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<bool>, 
 /// A UInt64 column without nulls.
 pub fn u64s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<u64>, String> {
     non_null(batch, file, name, "UInt64", |a: &UInt64Array, i| a.value(i))
+}
+
+/// A List<UInt32> column, nulls as `None` (the measured-visibility columns).
+pub fn u32_lists(
+    batch: &RecordBatch,
+    file: &Path,
+    name: &str,
+) -> Result<Vec<Option<Vec<u32>>>, String> {
+    let col = column(batch, file, name)?;
+    let wrong = || {
+        bad(
+            file,
+            name,
+            format!("has type {}, expected List<UInt32>", col.data_type()),
+        )
+    };
+    let arr = col.as_any().downcast_ref::<ListArray>().ok_or_else(wrong)?;
+    (0..arr.len())
+        .map(|i| {
+            if arr.is_null(i) {
+                return Ok(None);
+            }
+            let v = arr.value(i);
+            let v = v.as_any().downcast_ref::<UInt32Array>().ok_or_else(wrong)?;
+            Ok(Some(v.values().to_vec()))
+        })
+        .collect()
 }
 
 /// A column of 3-vectors: FixedSizeList<Float64, 3> (or List<Float64> of length 3).

@@ -9,3 +9,5 @@
 pub mod build;
 pub mod cli;
 pub mod llm_plan;
+#[cfg(feature = "render")]
+pub mod sheet;

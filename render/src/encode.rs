@@ -143,6 +143,14 @@ impl Mp4Writer {
         enc.set_width(width);
         enc.set_height(height);
         enc.set_format(ff::format::Pixel::YUV420P);
+        // What the samples are, written into the stream so that players and ffprobe
+        // need not guess: the renderer's sRGB pixels (BT.709 primaries, the sRGB
+        // transfer curve) converted by `to_yuv420` with the BT.601 matrix (SMPTE 170M)
+        // into limited range.
+        enc.set_colorspace(ff::color::Space::SMPTE170M);
+        enc.set_color_range(ff::color::Range::MPEG);
+        enc.set_color_primaries(ff::color::Primaries::BT709);
+        enc.set_color_transfer_characteristic(ff::color::TransferCharacteristic::IEC61966_2_1);
         enc.set_time_base(enc_tb);
         enc.set_frame_rate(Some(ff::Rational::new(fps as i32, 1)));
         enc.set_gop(fps.max(1) * 2);

@@ -74,7 +74,7 @@ pub use measure::Observed;
 pub use renderer::{release_thread_renderer, render_stage, with_thread_renderer, Renderer};
 pub use rh_contract::layout::{frame_file_name, frame_path};
 pub use rh_contract::{CAMERAS, FRAME_TIMES, FULL_EVENT};
-pub use sheet::{contact_sheet, ContactSheet};
+pub use sheet::{contact_sheet, ContactSheet, SheetTile};
 
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {

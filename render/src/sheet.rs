@@ -1,11 +1,23 @@
-//! The contact sheet (`rh-pipeline sheet`): one frame per family, tiled and labelled.
+//! The contact sheet (`rh-pipeline sheet`): frames tiled with their captions. Which
+//! scene, camera and time each tile shows is the caller's choice (`rh-pipeline sheet`
+//! picks one ego frame per family, with the object and the ground truth, from the scene
+//! table); this module only draws.
 
 use super::font;
 use super::RenderError;
-use rh_contract::layout::frame_path;
-use rh_physics::spec::SceneSpec;
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+
+/// One tile of a contact sheet: a frame and two caption lines.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SheetTile {
+    pub family: String,
+    pub scene_id: String,
+    /// The frame (a PNG written by a build).
+    pub frame: PathBuf,
+    /// Caption lines drawn above the frame (lowercase letters, digits, `_ - . / :`
+    /// and spaces; longer lines are cut to the tile's width).
+    pub lines: [String; 2],
+}
 
 /// What `contact_sheet` drew.
 #[derive(Debug, Clone, PartialEq)]
@@ -16,89 +28,53 @@ pub struct ContactSheet {
     pub height: u32,
 }
 
-/// Tiles one frame per family (the close-up frame at t = 0.30 s of the family's first
-/// scene by index; the ego frame when there is no close-up) with a label, so a person can
-/// eyeball every family at once. Reads `DIR/specs/*.json` and `DIR/frames/`.
-pub fn contact_sheet(dataset_dir: &Path, out_png: &Path) -> Result<ContactSheet, RenderError> {
-    let specs_dir = dataset_dir.join("specs");
-    let entries = std::fs::read_dir(&specs_dir)
-        .map_err(|e| RenderError::Io(format!("{}: {e}", specs_dir.display())))?;
-    let mut first: BTreeMap<String, (u64, String, PathBuf)> = BTreeMap::new();
-    for entry in entries {
-        let path = entry.map_err(|e| RenderError::Io(e.to_string()))?.path();
-        if path.extension().and_then(|e| e.to_str()) != Some("json") {
-            continue;
-        }
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| RenderError::Io(format!("{}: {e}", path.display())))?;
-        let spec = SceneSpec::from_json(&text)
-            .map_err(|e| RenderError::Io(format!("{}: {e}", path.display())))?;
-        // The close-up frame at 0.30 s, or the ego one when there is no close-up.
-        let Some(frame) = ["closeup", "ego"]
-            .into_iter()
-            .map(|cam| dataset_dir.join(frame_path(&spec.scene_id, cam, 0.30)))
-            .find(|p| p.exists())
-        else {
-            continue;
-        };
-        let e =
-            first
-                .entry(spec.family.clone())
-                .or_insert((u64::MAX, String::new(), PathBuf::new()));
-        if spec.scene_index < e.0 {
-            *e = (spec.scene_index, spec.scene_id.clone(), frame);
-        }
-    }
-    if first.is_empty() {
+/// Tile size (16:9, as the frames) and the caption font's scale.
+const TILE_W: u32 = 448;
+const TILE_H: u32 = 252;
+const SCALE: u32 = 2;
+
+/// Draws `tiles` in rows of 3 to 5 under a title line, each frame with its caption,
+/// and writes the PNG atomically.
+pub fn contact_sheet(
+    title: &str,
+    tiles: &[SheetTile],
+    out_png: &Path,
+) -> Result<ContactSheet, RenderError> {
+    if tiles.is_empty() {
         return Err(RenderError::Io(format!(
-            "{}: no rendered scenes (specs with frames/<id>/closeup_t0.300.png)",
-            dataset_dir.display()
+            "{}: nothing to draw (no rendered scene with frames)",
+            out_png.display()
         )));
     }
-    // Canonical family order, then any others.
-    let mut order: Vec<String> = rh_contract::FAMILIES
-        .iter()
-        .filter(|f| first.contains_key(**f))
-        .map(|f| f.to_string())
-        .collect();
-    for f in first.keys() {
-        if !order.contains(f) {
-            order.push(f.clone());
-        }
-    }
-    // Label strip: 4 px, the 9-row font at scale 2 (descenders included), 4 px.
-    let (tw, th, label) = (384u32, 216u32, 8 + 2 * font::ROWS);
-    let n = order.len() as u32;
+    let line_h = font::ROWS * SCALE + 4;
+    let (title_h, caption_h) = (line_h + 8, 2 * line_h + 6);
+    let n = tiles.len() as u32;
     let cols = sheet_columns(n);
     let rows = n.div_ceil(cols);
-    let (w, h) = (cols * tw, rows * (th + label));
+    let (w, h) = (cols * TILE_W, title_h + rows * (TILE_H + caption_h));
     let mut sheet = image::RgbImage::from_pixel(w, h, image::Rgb([24, 24, 28]));
-    let mut tiles = Vec::new();
-    for (i, family) in order.iter().enumerate() {
-        let (_, id, path) = &first[family];
-        let img = image::open(path)
-            .map_err(|e| RenderError::Io(format!("{}: {e}", path.display())))?
+    font::draw_text(&mut sheet, 8, 6, &fit(title, w - 16), SCALE, [255, 255, 255]);
+    for (i, tile) in tiles.iter().enumerate() {
+        let img = image::open(&tile.frame)
+            .map_err(|e| RenderError::Io(format!("{}: {e}", tile.frame.display())))?
             .to_rgb8();
-        let tile = image::imageops::resize(&img, tw, th, image::imageops::FilterType::Triangle);
+        let frame = image::imageops::resize(
+            &img,
+            TILE_W,
+            TILE_H,
+            image::imageops::FilterType::Triangle,
+        );
         // A short last row is centred rather than leaving empty tiles at its end.
         let (row, col) = (i as u32 / cols, i as u32 % cols);
-        let in_row = if row + 1 == rows {
-            n - row * cols
-        } else {
-            cols
-        };
-        let x = col * tw + (cols - in_row) * tw / 2;
-        let y = row * (th + label);
-        image::imageops::replace(&mut sheet, &tile, x as i64, (y + label) as i64);
-        font::draw_text(
-            &mut sheet,
-            x + 6,
-            y + 4,
-            &format!("{family} {id}"),
-            2,
-            [235, 235, 235],
-        );
-        tiles.push((family.clone(), id.clone()));
+        let in_row = if row + 1 == rows { n - row * cols } else { cols };
+        let x = col * TILE_W + (cols - in_row) * TILE_W / 2;
+        let y = title_h + row * (TILE_H + caption_h);
+        image::imageops::replace(&mut sheet, &frame, x as i64, (y + caption_h) as i64);
+        let colours = [[235, 235, 235], [190, 200, 215]];
+        for (k, line) in tile.lines.iter().enumerate() {
+            let ty = y + 3 + k as u32 * line_h;
+            font::draw_text(&mut sheet, x + 6, ty, &fit(line, TILE_W - 12), SCALE, colours[k]);
+        }
     }
     let mut bytes = Vec::new();
     image::DynamicImage::ImageRgb8(sheet)
@@ -110,10 +86,24 @@ pub fn contact_sheet(dataset_dir: &Path, out_png: &Path) -> Result<ContactSheet,
     rh_contract::fsio::write_atomic(out_png, &bytes)
         .map_err(|e| RenderError::Io(format!("{}: {e}", out_png.display())))?;
     Ok(ContactSheet {
-        tiles,
+        tiles: tiles
+            .iter()
+            .map(|t| (t.family.clone(), t.scene_id.clone()))
+            .collect(),
         width: w,
         height: h,
     })
+}
+
+/// `text` cut to what fits in `width` pixels of the caption font (".." marks a cut).
+fn fit(text: &str, width: u32) -> String {
+    let max = (width / (6 * SCALE)) as usize;
+    if text.chars().count() <= max {
+        return text.to_string();
+    }
+    let mut cut: String = text.chars().take(max.saturating_sub(2)).collect();
+    cut.push_str("..");
+    cut
 }
 
 /// Columns of a contact sheet of `n` tiles: 3 to 5 (fewer when there are fewer tiles),
@@ -130,6 +120,15 @@ fn sheet_columns(n: u32) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn captions_are_cut_to_the_tile() {
+        assert_eq!(fit("ego t 0.30 s", 400), "ego t 0.30 s");
+        let long = "a".repeat(60);
+        let cut = fit(&long, TILE_W - 12);
+        assert_eq!(cut.chars().count() as u32, (TILE_W - 12) / 12);
+        assert!(cut.ends_with(".."));
+    }
 
     #[test]
     fn contact_sheet_columns_leave_the_fewest_gaps() {

@@ -8,8 +8,8 @@ use rh_contract::fsio::write_atomic;
 use rh_physics::simulate::{simulate, SimOptions, Simulation};
 use rh_physics::spec::SceneSpec;
 use rh_render::{
-    contact_sheet, frame_file_name, RenderOptions, RenderedScene, Renderer, Shading, CAMERAS,
-    FRAME_TIMES, HAZARD_MASK_RGB,
+    contact_sheet, frame_file_name, RenderOptions, RenderedScene, Renderer, Shading, SheetTile,
+    CAMERAS, FRAME_TIMES, HAZARD_MASK_RGB,
 };
 use rh_scenes::config::Config;
 use rh_scenes::driver::{full_event_simulation, produce_group};
@@ -340,14 +340,33 @@ fn hazard_pixels_agree_with_the_camera_model() {
 }
 
 #[test]
-fn contact_sheet_has_one_tile_per_family() {
+fn contact_sheet_draws_every_tile_with_its_frame() {
     let f = fixture();
     let out = f.dir.join("sheet.png");
-    let sheet = contact_sheet(&f.dir, &out).unwrap();
+    let tiles: Vec<SheetTile> = f
+        .scenes
+        .iter()
+        .map(|(spec, _, _)| SheetTile {
+            family: spec.family.clone(),
+            scene_id: spec.scene_id.clone(),
+            frame: f.dir.join(rh_contract::layout::frame_path(&spec.scene_id, "ego", 0.30)),
+            lines: [spec.family.clone(), "ego t 0.30 s".into()],
+        })
+        .collect();
+    let sheet = contact_sheet("ego frames", &tiles, &out).unwrap();
     let families: Vec<&str> = sheet.tiles.iter().map(|t| t.0.as_str()).collect();
     assert_eq!(families, FAMILIES.to_vec());
-    let img = image::open(&out).unwrap();
+    let img = image::open(&out).unwrap().to_rgb8();
     assert_eq!((img.width(), img.height()), (sheet.width, sheet.height));
+    // The frames are drawn (the sheet is far from its dark background: 24, 24, 28).
+    let mean = |img: &image::RgbImage| {
+        let sum: u64 = img.pixels().flat_map(|p| p.0).map(|c| c as u64).sum();
+        sum / (img.width() as u64 * img.height() as u64)
+    };
+    assert!(mean(&img) > 76 + 40, "sheet mean {} (background 76)", mean(&img));
+    // Nothing to draw is an error naming the output.
+    let err = contact_sheet("none", &[], &out).unwrap_err().to_string();
+    assert!(err.contains("sheet.png"), "{err}");
 }
 
 /// Writes PNG previews (ego, closeup, overhead, full-event view at t = 0.30 s) of one

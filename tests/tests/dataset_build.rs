@@ -92,7 +92,7 @@ fn dataset_build_layout_card_and_manifest() {
         "config_name: eval",
         "path: eval/test-*.parquet",
         "n<1K",
-        "| `impact_point` | float64[3], nullable |",
+        "| `impact_point` | `float64[3]`, nullable |",
         "Label rule `v5`",
         "the articulated humanoid the executor moves",
         "where the hands can hold it",
@@ -103,7 +103,12 @@ fn dataset_build_layout_card_and_manifest() {
         "≤ 7 m/s",
         "≤ 30 J",
         "| object_drop |",
-        "@inproceedings{li2027reacthuman",
+        "@misc{li2027reacthuman",
+        "## Limitations",
+        "## What the model sees",
+        "### Predictions",
+        "### Metrics",
+        "**SAA**",
         "Bang",
         "| build seed | 11 |",
         "takes up to 18 valid scenes per family",
@@ -435,10 +440,63 @@ fn the_card_parses_as_commonmark_without_indented_code() {
         "{fenced:?}"
     );
     assert!(fenced.iter().any(|l| l == "python"), "{fenced:?}");
+    // Nothing is HTML (a bare `list<string>` would be read as a tag and vanish): every
+    // feature type is visible text of the rendered table.
+    let opts = pulldown_cmark::Options::ENABLE_TABLES;
+    let html: Vec<String> = Parser::new_ext(body, opts)
+        .filter_map(|e| match e {
+            Event::Html(h) | Event::InlineHtml(h) => Some(h.to_string()),
+            _ => None,
+        })
+        .collect();
+    assert!(html.is_empty(), "raw HTML in the card: {html:?}");
+    let code: Vec<String> = Parser::new_ext(body, opts)
+        .filter_map(|e| match e {
+            Event::Code(c) => Some(c.to_string()),
+            _ => None,
+        })
+        .collect();
+    for t in ["list<string>", "float64[3]", "bool", "string"] {
+        assert!(code.iter().any(|c| c == t), "the rendered card shows no `{t}`");
+    }
+    assert!(Parser::new("| a | list<string> |").any(|e| matches!(e, Event::InlineHtml(_))));
     // Counter-check that the test can fail: the same text with one paragraph indented.
     let broken = format!("Intro.\n\n    **Segmentation and depth.** prose\n");
     assert!(Parser::new(&broken)
         .any(|e| matches!(e, Event::Start(Tag::CodeBlock(CodeBlockKind::Indented)))));
+}
+
+/// The card's YAML front matter parses (the Hub's metadata: licence, configs) and its
+/// BibTeX entries parse, each with a title and a year.
+#[test]
+fn the_card_front_matter_and_citations_parse() {
+    let (_dir, out) = single();
+    let script = format!(
+        r#"
+import json, yaml, bibtexparser
+card = open({card:?}).read()
+front = yaml.safe_load(card.split("---\n")[1])
+bib = card.split("```bibtex\n")[1].split("```")[0]
+lib = bibtexparser.parse_string(bib)
+print(json.dumps({{
+  "license": front["license"],
+  "configs": [c["config_name"] for c in front["configs"]],
+  "entries": [[e.entry_type, e.key, "title" in e.fields_dict, "year" in e.fields_dict] for e in lib.entries],
+  "failed": len(lib.failed_blocks),
+}}))
+"#,
+        card = out.join("README.md").display().to_string()
+    );
+    let v: serde_json::Value = serde_json::from_str(rh_e2e::python(&script).trim()).unwrap();
+    assert_eq!(v["license"], "cc-by-4.0", "{v}");
+    assert_eq!(v["configs"], serde_json::json!(["default", "eval"]), "{v}");
+    assert_eq!(v["failed"], 0, "{v}");
+    let entries = v["entries"].as_array().unwrap();
+    assert_eq!(entries.len(), 2, "{v}");
+    for e in entries {
+        assert_eq!(e[0], "misc", "{v}");
+        assert!(e[2].as_bool().unwrap() && e[3].as_bool().unwrap(), "{v}");
+    }
 }
 
 /// A build whose stderr is a log (not a terminal) prints a progress line every

@@ -71,6 +71,27 @@ fn probe(path: &Path) -> (String, String, u64, u64, String, u64) {
     )
 }
 
+/// The colour tags of a video's first stream as ffprobe reads them:
+/// `[color_space, color_primaries, color_transfer, color_range]` ("" when absent).
+fn colour_tags(path: &Path) -> [String; 4] {
+    let out = Command::new("ffprobe")
+        .args(["-v", "error", "-select_streams", "v:0", "-show_entries"])
+        .arg("stream=color_space,color_primaries,color_transfer,color_range")
+        .args(["-of", "json"])
+        .arg(path)
+        .output()
+        .expect("ffprobe (scripts/setup.sh installs ffmpeg)");
+    assert!(out.status.success(), "ffprobe {}", path.display());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let s = &v["streams"][0];
+    ["color_space", "color_primaries", "color_transfer", "color_range"]
+        .map(|k| s[k].as_str().unwrap_or("").to_string())
+}
+
+/// What every video says of its colour (render/src/encode.rs): sRGB pixels (BT.709
+/// primaries, sRGB transfer) through the BT.601 matrix into limited range.
+const COLOUR_TAGS: [&str; 4] = ["smpte170m", "bt709", "iec61966-2-1", "tv"];
+
 /// Width and height from a PNG's header (and that it is one).
 fn png_size(path: &Path) -> (u32, u32) {
     let bytes = std::fs::read(path).unwrap();
@@ -139,6 +160,7 @@ fn rendered_build_has_probed_videos_frames_columns_and_merges_byte_equal() {
             );
             // The observation window [0, 0.6 s] at 60 fps, both ends included.
             assert_eq!(frames, 37, "{file}");
+            assert_eq!(colour_tags(&single.join(file)), COLOUR_TAGS, "{file}");
             for t in ["0.000", "0.150", "0.300", "0.450", "0.600"] {
                 let png = single.join(format!("frames/{id}/{cam}_t{t}.png"));
                 assert_eq!(png_size(&png), (W, H), "{}", png.display());
@@ -150,6 +172,7 @@ fn rendered_build_has_probed_videos_frames_columns_and_merges_byte_equal() {
             (codec.as_str(), pix.as_str(), w, h, rate.as_str()),
             ("h264", "yuv420p", W as u64, H as u64, "30/1")
         );
+        assert_eq!(colour_tags(&single.join(f[5])), COLOUR_TAGS, "{}", f[5]);
         // The full-event run (steps at 240 Hz) at 30 fps, both ends included. It is the
         // counterfactual run (the standing body as fixed colliders), which is step for step
         // the plain run — `sim_steps` long — while nothing touches the body (no strike
@@ -259,6 +282,48 @@ print(json.dumps({{"checked": checked, "unrendered": unrendered, "bad": bad,
         .map(|t| t["family"].as_str().unwrap())
         .collect();
     assert_eq!(families, ["object_drop", "rolling_ball"]);
+    // What the model sees: ego frames, captioned with the object, ground truth and time.
+    assert_eq!(v["camera"], "ego");
+    for t in v["tiles"].as_array().unwrap() {
+        let frame = t["frame"].as_str().unwrap();
+        let id = t["scene_id"].as_str().unwrap();
+        assert!(frame.starts_with(&format!("frames/{id}/ego_t")), "{t}");
+        assert!(single.join(frame).is_file(), "{frame}");
+        let caption = t["caption"][1].as_str().unwrap();
+        assert!(
+            ["gt catch", "gt dodge", "gt no_action"]
+                .iter()
+                .any(|g| caption.starts_with(g)),
+            "{caption}"
+        );
+        let time = &frame[frame.len() - 9..frame.len() - 4];
+        assert!(caption.contains(&format!("ego t {} s", &time[..4])), "{caption} / {frame}");
+    }
+    let plain = run_ok(
+        "rh-pipeline",
+        &["sheet", single.to_str().unwrap(), "--out", sheet.to_str().unwrap()],
+    );
+    assert!(plain.contains("ego frames"), "{plain}");
+    let other = run_ok(
+        "rh-pipeline",
+        &[
+            "sheet",
+            single.to_str().unwrap(),
+            "--out",
+            sheet.to_str().unwrap(),
+            "--camera",
+            "closeup",
+            "--json",
+        ],
+    );
+    let o: serde_json::Value = serde_json::from_str(&other).unwrap();
+    assert!(o["tiles"][0]["frame"].as_str().unwrap().contains("/closeup_t"), "{o}");
+    let bad = run(
+        "rh-pipeline",
+        &["sheet", single.to_str().unwrap(), "--out", sheet.to_str().unwrap(), "--camera", "top"],
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--camera top"));
     let (w, h) = png_size(&sheet);
     assert_eq!(
         (w as u64, h as u64),

@@ -88,6 +88,9 @@ pub enum Command {
         /// The PNG to write.
         #[arg(long, value_name = "PNG")]
         out: PathBuf,
+        /// The camera whose frames are shown: ego (what the model sees), closeup or overhead.
+        #[arg(long, value_name = "CAM", default_value = "ego")]
+        camera: String,
         /// Print the tiles (family, scene id) as JSON on stdout.
         #[arg(long)]
         json: bool,

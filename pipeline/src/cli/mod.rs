@@ -41,7 +41,12 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
     // Commands that need neither the catalog nor the configuration.
     match &cli.command {
         Command::Merge { out, shards, json } => return merge_command::run(out, shards, *json),
-        Command::Sheet { dir, out, json } => return sheet_command::run(dir, out, *json),
+        Command::Sheet {
+            dir,
+            out,
+            camera,
+            json,
+        } => return sheet_command::run(dir, out, camera, *json),
         Command::Download {
             repo,
             revision,
