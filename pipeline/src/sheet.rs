@@ -66,7 +66,7 @@ pub fn sheet_tiles(dir: &Path, camera: &str) -> Result<Vec<SheetTile>, String> {
             lines: [
                 format!("{family}: {}", row.object.to_lowercase()),
                 format!(
-                    "gt {} - {camera} t {t:.2} s - {}",
+                    "gt {}  {camera} t {t:.2} s  {}",
                     row.gt.to_lowercase(),
                     row.id
                 ),
