@@ -1,8 +1,8 @@
 //! `rh-pipeline sheet`: the contact sheet of a rendered dataset (feature `render`).
 
-#[cfg(feature = "render")]
-use super::failure::print_json;
 use super::failure::{input, Failure};
+#[cfg(feature = "render")]
+use super::failure::{print_json, println};
 use std::path::Path;
 
 /// `rh-pipeline sheet`: the contact sheet of a rendered dataset.
@@ -32,15 +32,15 @@ pub fn run(dir: &Path, out: &Path, json: bool) -> Result<(), Failure> {
             "width": sheet.width,
             "height": sheet.height,
             "tiles": tiles,
-        }));
+        }))?;
     } else {
-        println!(
+        println(&format!(
             "contact sheet of {} families ({}x{}) written to {}",
             sheet.tiles.len(),
             sheet.width,
             sheet.height,
             out.display()
-        );
+        ))?;
     }
     Ok(())
 }
