@@ -17,6 +17,7 @@ by its PID. Requests to POST .../chat/completions are answered by the next entry
   drop                    close the connection without answering
   malformed               HTTP 200 with a body that is not JSON
   empty                   HTTP 200 with "choices": []
+  huge:<MB>               the prose answer followed by MB megabytes of padding text
 
 --delay adds that many seconds before every answer (the benchmark's 200 ms server).
 --log FILE appends one JSON line per request: n, time, behaviour, authorization header,
@@ -133,6 +134,13 @@ def make_handler(state, args):
                         "id": "chatcmpl-%d" % n, "object": "chat.completion", "model": req.get("model"),
                         "choices": [{"index": 0, "finish_reason": "stop",
                                      "message": {"role": "assistant", "content": answer_text(kind)}}],
+                        "usage": usage,
+                    })
+                elif kind.startswith("huge:"):
+                    pad = "word " * (int(float(kind[len("huge:"):]) * 1_000_000) // 5)
+                    self.send_json(200, {
+                        "choices": [{"index": 0, "finish_reason": "length",
+                                     "message": {"role": "assistant", "content": answer_text("prose") + " " + pad}}],
                         "usage": usage,
                     })
                 elif kind.startswith("select:"):

@@ -7,7 +7,8 @@
 //! * [`action`] — the three action primitives;
 //! * [`layout`] — where files live in a dataset directory (specs, videos, frames, data);
 //! * [`digest`] — SHA-256 and hex, for fingerprints, file sums and cache keys;
-//! * [`fsio`] — atomic file writing; [`progress`] — progress lines for logs (both programs).
+//! * [`fsio`] — atomic file writing and the "cannot write" exit status; [`stdout`] —
+//!   printing that never panics; [`progress`] — progress lines for logs (both programs).
 //!
 //! With the `arrow` feature, [`arrow_schema`] gives the Arrow schema of the scene table.
 //! The crate has no heavy dependencies (serde; Arrow only behind the feature), so both
@@ -24,6 +25,7 @@ pub mod layout;
 #[cfg(feature = "png")]
 pub mod png;
 pub mod progress;
+pub mod stdout;
 
 #[cfg(feature = "arrow")]
 pub mod arrow_schema;

@@ -245,6 +245,68 @@ impl Manifest {
     }
 }
 
+/// What keeps `dir` from being a finished build (`None`: it is one, or it has no
+/// `build.json` and so is not a build of `rh-pipeline` at all): `build.json` records no
+/// file checksums (the build stopped before it finished: killed, out of disk), or files
+/// it records are missing. The message names what is missing and the command that
+/// finishes the build (`build` with the same arguments resumes). Only looks whether the
+/// files are there; `rh-pipeline verify` checks their content.
+pub fn unfinished(dir: &Path) -> Result<Option<String>, String> {
+    let Some(m) = Manifest::read(dir)? else {
+        return Ok(None);
+    };
+    let missing = match &m.files {
+        None => format!(
+            "its {MANIFEST_FILE} records no file checksums, so the build stopped before it finished (killed, or out of disk)"
+        ),
+        Some(sums) => {
+            let gone: Vec<&String> = sums.keys().filter(|f| !dir.join(f).is_file()).collect();
+            if gone.is_empty() {
+                return Ok(None);
+            }
+            let shown: Vec<&str> = gone.iter().take(3).map(|s| s.as_str()).collect();
+            format!(
+                "{} file(s) its {MANIFEST_FILE} records are missing ({}{})",
+                gone.len(),
+                shown.join(", "),
+                if gone.len() > 3 { ", …" } else { "" }
+            )
+        }
+    };
+    Ok(Some(format!(
+        "{} is not a finished build: {missing}. Finish it with the command that made it, which resumes where it stopped: {}",
+        dir.display(),
+        m.build_command(dir)
+    )))
+}
+
+impl Manifest {
+    /// The `rh-pipeline build` command line of this build (its recorded arguments; a
+    /// `--config`, `--catalog` or `--descriptions` it was given is named, not spelled out).
+    pub fn build_command(&self, dir: &Path) -> String {
+        let mut cmd = format!(
+            "rh-pipeline build --n {} --seed {} --out {}",
+            self.n,
+            self.seed,
+            dir.display()
+        );
+        if !self.render {
+            cmd.push_str(" --no-render");
+        }
+        if self.masks {
+            cmd.push_str(" --masks");
+        }
+        if self.shard[1] > 1 {
+            cmd.push_str(&format!(" --shard {}/{}", self.shard[0], self.shard[1]));
+        }
+        if self.selections.is_some() {
+            cmd.push_str(" --descriptions FILE");
+        }
+        cmd.push_str(" (with the same --config, --catalog and --families, if it had them)");
+        cmd
+    }
+}
+
 #[cfg(all(test, feature = "write"))]
 mod tests {
     use super::*;

@@ -80,6 +80,12 @@ pub struct BuildSummary {
     pub rejections: Option<BTreeMap<String, FamilyRejections>>,
 }
 
+/// The most scenes one build makes (`--n`; docs/reliability.md, "Bounds").
+pub const MAX_SCENES: u64 = 1_000_000;
+/// The most worker threads (`--jobs`) and shards (`--shard i/N`).
+pub const MAX_JOBS: usize = 1024;
+pub const MAX_SHARDS: u64 = 10_000;
+
 /// Checks the options against the catalog and configuration before any work.
 pub fn check_options(
     opts: &BuildOptions,
@@ -89,8 +95,26 @@ pub fn check_options(
     if opts.n == 0 {
         return Err(BuildError::Input("--n must be at least 1".into()));
     }
+    if opts.n > MAX_SCENES {
+        return Err(BuildError::Input(format!(
+            "--n {}: at most {MAX_SCENES} scenes in one build (shard a larger one with --shard i/N, then merge)",
+            opts.n
+        )));
+    }
     if opts.jobs == 0 {
         return Err(BuildError::Input("--jobs must be at least 1".into()));
+    }
+    if opts.jobs > MAX_JOBS {
+        return Err(BuildError::Input(format!(
+            "--jobs {}: at most {MAX_JOBS}",
+            opts.jobs
+        )));
+    }
+    if opts.shard.1 > MAX_SHARDS {
+        return Err(BuildError::Input(format!(
+            "--shard {}/{}: at most {MAX_SHARDS} shards",
+            opts.shard.0, opts.shard.1
+        )));
     }
     if opts.shard.1 == 0 || opts.shard.0 >= opts.shard.1 {
         return Err(BuildError::Input(format!(
@@ -308,8 +332,11 @@ pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError
         BuildError::Input(format!("cannot write to --out {}: {e}", out.display()))
     };
     std::fs::create_dir_all(out).map_err(fail)?;
+    // A build.json without file checksums is a build that stopped before it finished.
+    let mut sums_recorded = false;
     match Manifest::read(out).map_err(BuildError::Input)? {
         Some(existing) => {
+            sums_recorded = existing.files.is_some();
             let diff = existing.differences(manifest);
             if !diff.is_empty() {
                 return Err(BuildError::Input(format!(
@@ -347,7 +374,10 @@ pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError
         manifest.shard[0] as usize,
         manifest.shard[1] as usize,
     ));
-    Ok(!out.join(WORK_DIR).exists() && data.exists() && out.join("README.md").exists())
+    Ok(sums_recorded
+        && !out.join(WORK_DIR).exists()
+        && data.exists()
+        && out.join("README.md").exists())
 }
 
 /// Fails before any work when rendering is requested but impossible: no GPU, no

@@ -90,11 +90,15 @@ class Dataset:
     ``specs/``, optionally ``frames/`` and ``eval/``), or a Hugging Face Hub dataset id
     ``owner/name[@revision]`` (downloaded once into the HF cache).
 
-    Raises ``FileNotFoundError`` when the directory does not exist or has no ``data/``.
+    Raises ``FileNotFoundError`` when the directory does not exist or has no ``data/``, and
+    ``ValueError`` for a build that did not finish (its ``build.json`` records no file
+    checksums, or files it records are missing) unless ``allow_incomplete=True``.
     """
 
-    def __init__(self, path_or_repo: PathLike) -> None:
-        self._native = _native.NativeDataset(os.fspath(path_or_repo))
+    def __init__(self, path_or_repo: PathLike, *, allow_incomplete: bool = False) -> None:
+        self._native = _native.NativeDataset(
+            os.fspath(path_or_repo), allow_incomplete=allow_incomplete
+        )
         self.path: str = self._native.dir
         self._ids = self._native.scene_ids()
         self._index = {s: i for i, s in enumerate(self._ids)}

@@ -150,10 +150,14 @@ impl NativeDataset {
 
 #[pymethods]
 impl NativeDataset {
+    /// `allow_incomplete`: use a build that did not finish (refused otherwise with
+    /// `ValueError`, naming what is missing and the command that finishes it).
     #[new]
-    fn new(py: Python<'_>, path: &str) -> PyResult<Self> {
+    #[pyo3(signature = (path, allow_incomplete = false))]
+    fn new(py: Python<'_>, path: &str, allow_incomplete: bool) -> PyResult<Self> {
         run(py, || {
             let dir = resolve(path)?;
+            rh_score::dataset::check_finished(&dir, allow_incomplete)?;
             Ok(NativeDataset {
                 ds: Dataset::load(&dir)?,
                 cfg: Config::default(),

@@ -5,7 +5,7 @@
 
 use super::font;
 use super::RenderError;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// One tile of a contact sheet: a frame and two caption lines.
 #[derive(Debug, Clone, PartialEq)]
@@ -19,13 +19,15 @@ pub struct SheetTile {
     pub lines: [String; 2],
 }
 
-/// What `contact_sheet` drew.
+/// What `contact_sheet` drew: the PNG's bytes (the caller writes them, through the one
+/// atomic writer) and its tiles.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactSheet {
     /// Family and scene id per tile, in tile order.
     pub tiles: Vec<(String, String)>,
     pub width: u32,
     pub height: u32,
+    pub png: Vec<u8>,
 }
 
 /// Tile size (16:9, as the frames) and the caption font's scale.
@@ -33,18 +35,13 @@ const TILE_W: u32 = 448;
 const TILE_H: u32 = 252;
 const SCALE: u32 = 2;
 
-/// Draws `tiles` in rows of 3 to 5 under a title line, each frame with its caption,
-/// and writes the PNG atomically.
-pub fn contact_sheet(
-    title: &str,
-    tiles: &[SheetTile],
-    out_png: &Path,
-) -> Result<ContactSheet, RenderError> {
+/// Draws `tiles` in rows of 3 to 5 under a title line, each frame with its caption, as a
+/// PNG.
+pub fn contact_sheet(title: &str, tiles: &[SheetTile]) -> Result<ContactSheet, RenderError> {
     if tiles.is_empty() {
-        return Err(RenderError::Io(format!(
-            "{}: nothing to draw (no rendered scene with frames)",
-            out_png.display()
-        )));
+        return Err(RenderError::Io(
+            "nothing to draw (no rendered scene with frames)".into(),
+        ));
     }
     let line_h = font::ROWS * SCALE + 4;
     let (title_h, caption_h) = (line_h + 8, 2 * line_h + 6);
@@ -76,15 +73,10 @@ pub fn contact_sheet(
             font::draw_text(&mut sheet, x + 6, ty, &fit(line, TILE_W - 12), SCALE, colours[k]);
         }
     }
-    let mut bytes = Vec::new();
+    let mut png = Vec::new();
     image::DynamicImage::ImageRgb8(sheet)
-        .write_to(
-            &mut std::io::Cursor::new(&mut bytes),
-            image::ImageFormat::Png,
-        )
-        .map_err(|e| RenderError::Io(format!("{}: {e}", out_png.display())))?;
-    rh_contract::fsio::write_atomic(out_png, &bytes)
-        .map_err(|e| RenderError::Io(format!("{}: {e}", out_png.display())))?;
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .map_err(|e| RenderError::Io(format!("encoding the contact sheet: {e}")))?;
     Ok(ContactSheet {
         tiles: tiles
             .iter()
@@ -92,6 +84,7 @@ pub fn contact_sheet(
             .collect(),
         width: w,
         height: h,
+        png,
     })
 }
 

@@ -333,7 +333,9 @@ fn count_subset(balance: &mut FamilyBalance, scenes: &[PoolScene], chosen: &[usi
 
 /// The balance as a plain-text table: label counts, then the group attempts made and
 /// the share of them each validator rejected (`reaction`: the reaction-time rule of
-/// label rule v2; `other`: any other validator).
+/// label rule v2, a share of the attempts); `other n`: how many rejections the other
+/// validators made, a count (one attempt can fail several of them, so no share of the
+/// attempts).
 pub fn format_table(rows: &[FamilyBalance]) -> String {
     let header = format!(
         "{:<16} {:>6} {:>6} {:>9}   {:>15} {:>7} {:>8} {:>9} {:>7}\n",
@@ -345,7 +347,7 @@ pub fn format_table(rows: &[FamilyBalance]) -> String {
         "invalid",
         "attempts",
         "reaction",
-        "other"
+        "other n"
     );
     let mut s = header;
     let reaction = crate::validate::VALIDATOR_COLUMNS
@@ -388,7 +390,7 @@ pub fn format_table(rows: &[FamilyBalance]) -> String {
             r.invalid,
             r.attempts,
             pct(r.rejected_by[reaction]),
-            pct(other)
+            other
         )
     };
     for r in rows {

@@ -277,7 +277,7 @@ impl Config {
     pub fn embedded() -> Result<Config, ConfigError> {
         let raw: RawConfig = parse("configs/default.toml", DEFAULT_TOML)?;
         let labels: LabelConfig = parse("configs/labels.toml", LABELS_TOML)?;
-        Config::assemble("configs/default.toml", raw, labels)
+        Config::assemble("configs/default.toml", "configs/labels.toml", raw, labels)
     }
 
     /// Loads a configuration file and the labels file it names.
@@ -287,11 +287,19 @@ impl Config {
         let raw: RawConfig = parse(&name, &text)?;
         let labels_path = path.parent().unwrap_or(Path::new(".")).join(&raw.labels);
         let labels_text = read(&labels_path)?;
-        let labels: LabelConfig = parse(&labels_path.display().to_string(), &labels_text)?;
-        Config::assemble(&name, raw, labels)
+        let labels_name = labels_path.display().to_string();
+        let labels: LabelConfig = parse(&labels_name, &labels_text)?;
+        Config::assemble(&name, &labels_name, raw, labels)
     }
 
-    fn assemble(name: &str, raw: RawConfig, labels: LabelConfig) -> Result<Config, ConfigError> {
+    /// The configuration of `name` with the label thresholds of `labels_name` (each named
+    /// in the errors of its own fields).
+    fn assemble(
+        name: &str,
+        labels_name: &str,
+        raw: RawConfig,
+        labels: LabelConfig,
+    ) -> Result<Config, ConfigError> {
         let config = Config {
             build: raw.build,
             physics: raw.physics,
@@ -307,14 +315,15 @@ impl Config {
             aimed_as: None,
             source: name.to_string(),
         };
-        config.validate(name)?;
+        config.validate(name, labels_name)?;
         Ok(config)
     }
 
-    fn validate(&self, name: &str) -> Result<(), ConfigError> {
+    fn validate(&self, name: &str, labels_name: &str) -> Result<(), ConfigError> {
         let fail = |field: &str, message: String| field_error(name, field, message);
         let positive = |field: &str, v: f64| positive_field(name, field, v);
         positive("physics.dt", self.physics.dt)?;
+        self.validate_bounds(name, labels_name)?;
         self.validate_aim(name)?;
         if self.eval.per_family == 0 {
             return Err(fail("eval.per_family", "must be at least 1".into()));
@@ -335,7 +344,7 @@ impl Config {
         positive("physics.horizon_s", self.physics.horizon_s)?;
         positive("physics.min_duration_s", self.physics.min_duration_s)?;
         positive("observation.window_s", self.observation.window_s)?;
-        self.validate_labels(name)?;
+        self.validate_labels(labels_name)?;
         if self.physics.horizon_s < self.physics.min_duration_s {
             return Err(fail(
                 "physics.horizon_s",
@@ -372,7 +381,8 @@ impl Config {
             return Err(fail("validators.max_attempts", "must be at least 1".into()));
         }
         if self.labels.reach_radius > self.labels.closest_approach_max {
-            return Err(fail(
+            return Err(field_error(
+                labels_name,
                 "labels.reach_radius",
                 "must not exceed labels.closest_approach_max (a reachable hazard needs an impact point)".into(),
             ));
@@ -424,6 +434,74 @@ impl Config {
             }
         }
         Ok(())
+    }
+
+    /// The upper bounds of the numbers that set how much work or memory a build takes
+    /// (docs/reliability.md, "Bounds"), checked before any work starts: no configuration
+    /// reaches an allocation failure.
+    fn validate_bounds(&self, name: &str, labels_name: &str) -> Result<(), ConfigError> {
+        let p = &self.physics;
+        let r = &self.render;
+        let within = |file: &str, field: &str, v: f64, lo: f64, hi: f64| {
+            if v.is_finite() && (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err(field_error(
+                    file,
+                    field,
+                    format!("must be within [{lo}, {hi}] (got {v})"),
+                ))
+            }
+        };
+        within(name, "physics.dt", p.dt, 1e-4, 0.1)?;
+        within(name, "physics.horizon_s", p.horizon_s, 0.0, 60.0)?;
+        within(name, "physics.settle_time_s", p.settle_time_s, 0.0, 60.0)?;
+        let counts = [
+            (
+                "physics.solver_iterations",
+                p.solver_iterations as f64,
+                1.0,
+                64.0,
+            ),
+            (
+                "validators.max_attempts",
+                self.validators.max_attempts as f64,
+                1.0,
+                1000.0,
+            ),
+            (
+                "eval.per_family",
+                self.eval.per_family as f64,
+                1.0,
+                100_000.0,
+            ),
+            ("render.width", r.width as f64, 1.0, 7680.0),
+            ("render.height", r.height as f64, 1.0, 4320.0),
+            ("render.fps", r.fps as f64, 1.0, 240.0),
+            ("render.full_width", r.full_width as f64, 1.0, 7680.0),
+            ("render.full_height", r.full_height as f64, 1.0, 4320.0),
+            ("render.full_fps", r.full_fps as f64, 1.0, 240.0),
+            (
+                "render.encoder_threads",
+                r.encoder_threads as f64,
+                0.0,
+                64.0,
+            ),
+            ("render.crf", r.crf as f64, 0.0, 51.0),
+            ("render.msaa", r.msaa as f64, 1.0, 16.0),
+            ("render.msaa_cpu", r.msaa_cpu as f64, 1.0, 16.0),
+        ];
+        for (field, v, lo, hi) in counts {
+            within(name, field, v, lo, hi)?;
+        }
+        let directions = self.labels.escape_directions as f64;
+        within(
+            labels_name,
+            "labels.escape_directions",
+            directions,
+            1.0,
+            360.0,
+        )
     }
 
     fn validate_aim(&self, name: &str) -> Result<(), ConfigError> {

@@ -9,6 +9,9 @@ use std::path::Path;
 /// The embedded default configuration (`configs/scoring.toml`).
 pub const DEFAULT_CONFIG_TOML: &str = include_str!("../../configs/scoring.toml");
 
+/// The longest prediction line any configuration may allow (`sanity.max_line_bytes`).
+pub const MAX_LINE_BYTES: usize = 256 << 20;
+
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Config {
@@ -177,11 +180,21 @@ impl Config {
         if self.statistics.bootstrap_resamples < 100 || self.statistics.max_bootstrap_draws < 1000 {
             bail!("config fields statistics.bootstrap_resamples must be >= 100 and statistics.max_bootstrap_draws >= 1000");
         }
-        if self.sanity.max_line_bytes < 1024 {
-            bail!("config field sanity.max_line_bytes must be at least 1024");
+        if self.statistics.bootstrap_resamples > 1_000_000
+            || self.statistics.max_bootstrap_draws > 100_000_000_000
+        {
+            bail!("config fields statistics.bootstrap_resamples must be <= 1000000 and statistics.max_bootstrap_draws <= 100000000000");
         }
-        if self.sanity.max_keyframes == 0 || self.sanity.max_nesting < 4 {
-            bail!("config fields sanity.max_keyframes must be >= 1 and sanity.max_nesting >= 4");
+        if !(1024..=MAX_LINE_BYTES).contains(&self.sanity.max_line_bytes) {
+            bail!(
+                "config field sanity.max_line_bytes must be within [1024, {MAX_LINE_BYTES}] (got {})",
+                self.sanity.max_line_bytes
+            );
+        }
+        if !(1..=1_000_000).contains(&self.sanity.max_keyframes)
+            || !(4..=128).contains(&self.sanity.max_nesting)
+        {
+            bail!("config fields sanity.max_keyframes must be within [1, 1000000] and sanity.max_nesting within [4, 128]");
         }
         for (name, list) in [
             ("aia.catch", &self.aia.catch),

@@ -147,23 +147,28 @@ impl Unanswered {
     }
 }
 
-/// What a skipped-line kind means, for the "nothing scored" error.
+/// What lines of a skipped kind are, for the "nothing scored" error: a phrase that
+/// follows "N line(s) " ("without a `model` field").
 pub(crate) fn skip_reason(kind: &str, ds: &Dataset) -> String {
     match kind {
         "unknown_scene_id" => format!(
-            "scene ids that are not in the dataset {} (predictions for another dataset?)",
+            "with scene ids that are not in the dataset {} (predictions for another dataset?)",
             ds.dir.display()
         ),
-        "missing_model" => "lines without a `model` field".into(),
-        "missing_scene_id" => "lines without a `scene_id`".into(),
-        "json_array" => "a JSON array, not JSON Lines (one prediction object per line; \
+        "missing_model" => "without a `model` field".into(),
+        "bad_model" => "whose `model` is not a non-empty string (e.g. a number)".into(),
+        "missing_scene_id" => "without a `scene_id`".into(),
+        "json_array" => "of a JSON array, not JSON Lines (one prediction object per line; \
                          convert with `jq -c '.[]' FILE`)"
             .into(),
-        "outside_subset" => "scenes outside the eval subset (score them with --subset all)".into(),
-        "invalid_scene" => "scenes the dataset marks invalid (never scored)".into(),
-        "malformed_json" => "lines that are not JSON".into(),
-        "not_an_object" => "lines that are not JSON objects".into(),
-        other => format!("skipped lines ({other})"),
+        "outside_subset" => {
+            "on scenes outside the eval subset (score them with --subset all)".into()
+        }
+        "invalid_scene" => "on scenes the dataset marks invalid (never scored)".into(),
+        "malformed_json" => "that are not JSON".into(),
+        "not_an_object" => "that are not JSON objects".into(),
+        "line_too_long" => "longer than sanity.max_line_bytes".into(),
+        other => format!("skipped ({other})"),
     }
 }
 

@@ -416,6 +416,24 @@ pub fn eval_scene_ids(dir: &Path) -> Result<Option<BTreeSet<String>>> {
     Ok(Some(ids))
 }
 
+/// Refuses (exit 2) a directory whose `build.json` does not record a finished build
+/// (`rh_dataset::manifest::unfinished`: no file checksums, or recorded files missing),
+/// naming what is missing and the command that finishes it; with `allow_incomplete`
+/// (`--allow-incomplete`) it is used as it is, with a warning on stderr.
+pub fn check_finished(dir: &Path, allow_incomplete: bool) -> Result<()> {
+    match rh_dataset::manifest::unfinished(dir).map_err(InputError)? {
+        None => Ok(()),
+        Some(why) if allow_incomplete => {
+            eprintln!("rh-score: warning: {why}. Used as it is (--allow-incomplete).");
+            Ok(())
+        }
+        Some(why) => Err(InputError(format!(
+            "{why}; or pass --allow-incomplete to use it as it is"
+        ))
+        .into()),
+    }
+}
+
 /// The dataset directory of `--dataset` (also the Python package's `Dataset(...)`): an
 /// existing directory, else a Hugging Face Hub dataset id `owner/name[@revision]`
 /// downloaded once into the HF cache; `None`: `$RH_DATASET`, else the released dataset.

@@ -56,7 +56,8 @@ PREDICTIONS (preds.jsonl, SPEC §9)
   * Unparseable plan or response, or neither present → R1 (scored: SAA 0, unsafe, AIA 0,
     distances missing).
   * Skipped lines, each counted as a warning with its first line numbers: malformed_json,
-    not_an_object, missing_scene_id, missing_model, unknown_scene_id, invalid_utf8,
+    not_an_object, missing_scene_id, missing_model, bad_model (`model` not a non-empty
+    string), unknown_scene_id, invalid_utf8,
     plan_too_large (a line the fast reader cannot take apart, e.g. with duplicate keys,
     that is over the size caps below),
     line_too_long (> {ml} bytes; never held in memory), invalid_scene (the dataset marks

@@ -474,25 +474,41 @@ fn percent_label(v: &f64) -> String {
 macro_rules! both {
     ($dir:expr, $name:literal, $size:expr, $f:ident, $r:expr, $out:expr) => {{
         let svg = $dir.join(concat!($name, ".svg"));
+        let mut text = String::new();
         {
-            let root = SVGBackend::new(&svg, $size).into_drawing_area();
+            let root = SVGBackend::with_string(&mut text, $size).into_drawing_area();
             $f(&root, $r)?;
         }
+        rh_contract::fsio::write_file(&svg, "a figure", text.as_bytes())?;
         let png = $dir.join(concat!($name, ".png"));
+        let (w, h) = $size;
+        let mut pixels = vec![0u8; w as usize * h as usize * 3];
         {
-            let root = BitMapBackend::new(&png, $size).into_drawing_area();
+            let root = BitMapBackend::with_buffer(&mut pixels, $size).into_drawing_area();
             $f(&root, $r)?;
         }
+        rh_contract::fsio::write_file(&png, "a figure", &png_bytes(&pixels, w, h)?)?;
         $out.push(svg);
         $out.push(png);
     }};
 }
 
-/// Writes every figure into `dir` (created if needed); returns the files written.
+/// The PNG of an RGB bitmap, encoded as `image` saves one (its default PNG settings).
+fn png_bytes(pixels: &[u8], w: u32, h: u32) -> Result<Vec<u8>> {
+    use image::ImageEncoder;
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(pixels, w, h, image::ExtendedColorType::Rgb8)
+        .map_err(|e| anyhow!("encoding a figure as PNG: {e}"))?;
+    Ok(bytes)
+}
+
+/// Writes every figure into `dir` (created if needed), each file whole or not at all
+/// (`rh_contract::fsio`); returns the files written.
 pub fn write_figures(r: &Report, dir: &Path) -> Result<Vec<std::path::PathBuf>> {
     register_font();
     std::fs::create_dir_all(dir)
-        .map_err(|err| anyhow!("cannot create figures directory {}: {err}", dir.display()))?;
+        .map_err(|e| rh_contract::fsio::CannotWrite::new("the figures directory", dir, e))?;
     let mut out = Vec::new();
     let fam_h = (140
         + r.dataset.families.len().max(4) as u32 * (14 + 10 * r.models.len().clamp(1, 8) as u32))

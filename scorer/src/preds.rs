@@ -21,6 +21,9 @@ pub enum RawLine {
 }
 
 /// Reads lines with a cap on their length, never holding more than `max` bytes of one.
+/// The UTF-8 byte-order mark, skipped at the start of a predictions file.
+pub const UTF8_BOM: &[u8] = b"\xEF\xBB\xBF";
+
 pub struct LineReader<R: BufRead> {
     r: R,
     max: usize,
@@ -75,6 +78,10 @@ impl<R: BufRead> LineReader<R> {
         }
         if buf.last() == Some(&b'\r') {
             buf.pop();
+        }
+        // A UTF-8 byte-order mark (editors on Windows write one) opens the file, not a line.
+        if self.line_no == 1 && buf.starts_with(UTF8_BOM) {
+            buf.drain(..UTF8_BOM.len());
         }
         Ok(Some((self.line_no, RawLine::Line(buf))))
     }
@@ -215,7 +222,8 @@ pub fn process_line(raw: &RawLine, ds: &Dataset, cfg: &Config, aia: &AiaMatcher)
         };
         let model = match raw_present(line.model).map(serde_json::from_str::<Value>) {
             Some(Ok(Value::String(s))) if !s.trim().is_empty() => s.trim().to_string(),
-            _ => return skip("missing_model"),
+            None => return skip("missing_model"),
+            Some(_) => return skip("bad_model"),
         };
         let error = line
             .error
@@ -251,7 +259,8 @@ pub fn process_line(raw: &RawLine, ds: &Dataset, cfg: &Config, aia: &AiaMatcher)
     };
     let model = match obj.get("model") {
         Some(Value::String(s)) if !s.trim().is_empty() => s.trim().to_string(),
-        _ => return skip("missing_model"),
+        None | Some(Value::Null) => return skip("missing_model"),
+        Some(_) => return skip("bad_model"),
     };
     let error = obj.get("error").is_some_and(is_error_value);
     let version = obj
@@ -356,5 +365,20 @@ mod tests {
                 (4, "last-no-newline".to_string())
             ]
         );
+    }
+
+    #[test]
+    fn a_byte_order_mark_opens_the_file_not_its_first_line() {
+        let input = b"\xEF\xBB\xBF{\"a\":1}\n\xEF\xBB\xBFsecond\n".to_vec();
+        let mut r = LineReader::new(io::BufReader::with_capacity(2, Cursor::new(input)), 1024);
+        let Some((1, RawLine::Line(first))) = r.next_line().unwrap() else {
+            panic!("a first line");
+        };
+        assert_eq!(first, b"{\"a\":1}");
+        // Only the file's first bytes are a BOM; later ones are content.
+        let Some((2, RawLine::Line(second))) = r.next_line().unwrap() else {
+            panic!("a second line");
+        };
+        assert_eq!(second, b"\xEF\xBB\xBFsecond");
     }
 }

@@ -48,7 +48,7 @@ pub fn check_scored(scoring: &Scoring, file: &str) -> Result<()> {
             (
                 w.count,
                 format!(
-                    "{} line(s) with {} (first at line {first}{eg})",
+                    "{} line(s) {} (first at line {first}{eg})",
                     w.count,
                     skip_reason(k, scoring.ds)
                 ),

@@ -187,6 +187,14 @@ impl<'a> Scoring<'a> {
         }
         self.score_reader(BufReader::with_capacity(1 << 20, f))
             .map_err(|e| match e.downcast::<std::io::Error>() {
+                // The decision lines' writer failing is not a reading error.
+                Ok(io)
+                    if io
+                        .get_ref()
+                        .is_some_and(|i| i.is::<rh_contract::fsio::CannotWrite>()) =>
+                {
+                    io.into()
+                }
                 Ok(io) => InputError(format!("error reading {}: {io}", path.display())).into(),
                 Err(e) => e,
             })

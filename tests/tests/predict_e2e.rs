@@ -829,3 +829,54 @@ fn unpriced_budget_dead_endpoint_and_progress_lines() {
         "{err}"
     );
 }
+
+/// Issue 48: `predict` and the scorer share one line-length limit. A 20 MB answer is
+/// stored cut to fit `sanity.max_line_bytes` (16 MiB), marked `truncated`, with the plan
+/// parsed from the whole answer: the decision is scored, not lost as `line_too_long`.
+#[test]
+fn a_20_mb_answer_is_stored_within_the_line_limit_and_scored() {
+    let FirstRun {
+        dir, out, lines, ..
+    } = first_run("huge:20", "bare", &["--limit", "2"]);
+    let limit = 16 * 1024 * 1024;
+    let text = std::fs::read(&out).unwrap();
+    for line in text.split(|&b| b == b'\n').filter(|l| !l.is_empty()) {
+        assert!(line.len() < limit, "a line of {} bytes", line.len());
+    }
+    let huge: Vec<&Value> = lines.iter().filter(|l| !l["truncated"].is_null()).collect();
+    assert_eq!(huge.len(), 1, "one answer was over the limit");
+    let t = &huge[0]["truncated"];
+    assert_eq!(t["field"], "response");
+    assert!(t["bytes"].as_u64().unwrap() > 20_000_000, "{t}");
+    assert_eq!(
+        t["kept"].as_u64().unwrap(),
+        huge[0]["response"].as_str().unwrap().len() as u64
+    );
+    assert!(
+        huge[0]["plan"].is_object(),
+        "the plan of the whole answer is kept"
+    );
+    let report = dir.path().join("report.json");
+    let o = run(
+        "rh-score",
+        &[
+            out.to_str().unwrap(),
+            "--dataset",
+            dataset().to_str().unwrap(),
+            "--subset",
+            "all",
+            "--json",
+            report.to_str().unwrap(),
+            "--quiet",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(
+        r["models"][0]["coverage"]["answered"], 2,
+        "{}",
+        r["models"][0]["coverage"]
+    );
+    let warnings = r["input"]["warnings"].to_string();
+    assert!(!warnings.contains("line_too_long"), "{warnings}");
+}

@@ -184,6 +184,7 @@ fn garbage_truncated_and_huge_lines_never_stop_the_run() {
                 "not_an_object",
                 "missing_scene_id",
                 "missing_model",
+                "bad_model",
                 "unknown_scene_id",
                 "invalid_utf8",
                 "line_too_long",

@@ -10,7 +10,7 @@ use std::path::PathBuf;
     name = "rh-pipeline",
     version,
     about = "Builds the ReactHuman dataset: bit-for-bit reproducible physics scenes with exact ground truth",
-    after_help = "Exit status: 0 success, 2 bad input or usage, 1 internal failure."
+    after_help = "Exit status: 0 success, 2 bad input or usage, 3 an output that cannot be written (full disk, read-only directory, /dev/full; the file is named), 1 internal failure, 130 interrupted."
 )]
 pub struct Cli {
     /// Build configuration (TOML); defaults to the embedded configs/default.toml.

@@ -1,6 +1,6 @@
 //! `rh-pipeline balance`: label counts per family, built in memory.
 
-use super::failure::{input, print_json, Failure};
+use super::failure::{input, print, print_json, Failure};
 use rh_catalog::Catalog;
 use rh_scenes::config::Config;
 
@@ -19,6 +19,15 @@ pub fn run(
     }
     if pool == 0 {
         return Err(input("--pool must be at least 1"));
+    }
+    if per_family > 100_000 {
+        return Err(input(format!("--per-family {per_family}: at most 100000")));
+    }
+    if pool > crate::build::MAX_SCENES {
+        return Err(input(format!(
+            "--pool {pool}: at most {} scenes (the bound of one build)",
+            crate::build::MAX_SCENES
+        )));
     }
     let families = families.unwrap_or_default();
     for f in &families {
@@ -39,9 +48,9 @@ pub fn run(
     if json {
         print_json(&rh_scenes::balance::Balance::of(
             catalog, seed, pool, per_family, rows,
-        ));
+        ))?;
     } else {
-        print!("{}", rh_scenes::balance::format_table(&rows));
+        print(&rh_scenes::balance::format_table(&rows))?;
     }
     Ok(())
 }

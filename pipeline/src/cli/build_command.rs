@@ -2,7 +2,7 @@
 //! ([`crate::build::build`]) and its summary.
 
 use super::args::{parse_shard, BuildArgs, PlannerKind};
-use super::failure::{build_failure, input, print_json, Failure};
+use super::failure::{build_failure, input, print_json, println, Failure};
 use super::llm_planner::llm_planner;
 use crate::build::{build, BuildOptions};
 use rh_catalog::Catalog;
@@ -28,9 +28,16 @@ pub fn run(args: BuildArgs, catalog: &Catalog, config: &Config) -> Result<(), Fa
         quiet,
         progress_every,
     } = args;
-    if !(progress_every.is_finite() && progress_every > 0.0) {
+    if !(progress_every.is_finite() && progress_every > 0.0 && progress_every <= 86_400.0) {
         return Err(input(format!(
-            "--progress-every {progress_every}: must be a positive number of seconds"
+            "--progress-every {progress_every}: must be a positive number of seconds, at most 86400"
+        )));
+    }
+    // The bounds of the numbers are checked before anything is planned or written.
+    if let Some(n) = n.filter(|&n| n > crate::build::MAX_SCENES) {
+        return Err(input(format!(
+            "--n {n}: at most {} scenes in one build (shard a larger one with --shard i/N, then merge)",
+            crate::build::MAX_SCENES
         )));
     }
     let seed = seed.unwrap_or(config.build.seed);
@@ -132,9 +139,9 @@ fn build_and_print(
 ) -> Result<(), Failure> {
     let summary = build(opts, catalog, config).map_err(build_failure)?;
     if json {
-        print_json(&summary);
+        print_json(&summary)?;
     } else {
-        println!(
+        println(&format!(
             "built {} scenes ({} valid) into {} — {}{}",
             summary.scenes,
             summary.valid,
@@ -145,13 +152,13 @@ fn build_and_print(
             } else {
                 String::new()
             }
-        );
+        ))?;
         let actions: Vec<String> = summary
             .per_action
             .iter()
             .map(|(a, c)| format!("{a} {c}"))
             .collect();
-        println!("labels: {}", actions.join(", "));
+        println(&format!("labels: {}", actions.join(", ")))?;
         if let Some(rejections) = &summary.rejections {
             let attempts: u32 = rejections.values().map(|f| f.attempts).sum();
             let by_family: Vec<String> = rejections
@@ -161,7 +168,7 @@ fn build_and_print(
                     (n > 0).then(|| format!("{family} {n}/{}", f.attempts))
                 })
                 .collect();
-            println!(
+            println(&format!(
                 "visibility rejected {} of {attempts} group attempts{}",
                 rejections
                     .values()
@@ -172,14 +179,14 @@ fn build_and_print(
                 } else {
                     format!(" ({})", by_family.join(", "))
                 }
-            );
+            ))?;
         }
         if !summary.invalid_scene_ids.is_empty() {
-            println!(
+            println(&format!(
                 "warning: {} scene(s) failed validation after every attempt: {}",
                 summary.invalid_scene_ids.len(),
                 summary.invalid_scene_ids.join(", ")
-            );
+            ))?;
         }
     }
     Ok(())

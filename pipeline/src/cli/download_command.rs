@@ -1,6 +1,6 @@
 //! `rh-pipeline download`: a dataset from the Hub (or the cache), checked.
 
-use super::failure::Failure;
+use super::failure::{println, Failure};
 use std::path::Path;
 
 /// `download`: the dataset from the Hub (or a complete cached copy), checked; prints
@@ -24,6 +24,6 @@ pub fn run(repo: &str, revision: Option<&str>, out: Option<&Path>) -> Result<(),
         }
         None => snapshot.path,
     };
-    println!("{}", path.display());
+    println(&path.display().to_string())?;
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! The `rh-pipeline` command line (SPEC §14): the arguments ([`args`]) and one module per
 //! command, each with one entry point `run`. Exit status: 0 success, 2 bad input or usage
-//! (with a message naming what is wrong), 1 internal failure ([`failure`]).
+//! (with a message naming what is wrong), 3 an output that cannot be written (the file
+//! named), 1 internal failure ([`failure`]).
 
 pub mod args;
 pub mod balance_command;
@@ -79,11 +80,12 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
 
 /// Entry point of the binary.
 pub fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let args = rh_contract::stdout::help_help_as_help(std::env::args_os().collect());
+    let cli = match Cli::try_parse_from(args) {
         Ok(cli) => cli,
         Err(e) => {
-            let code = if e.use_stderr() { 2 } else { 0 };
-            let _ = e.print();
+            let code =
+                rh_contract::stdout::parser_print_status(e.exit_code(), e.print(), "rh-pipeline");
             return ExitCode::from(code);
         }
     };

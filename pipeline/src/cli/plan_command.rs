@@ -23,6 +23,6 @@ pub fn run(
     .map_err(|e| input(e.to_string()))?;
     let matches = lexicon.matches(description);
     let out = serde_json::json!({ "selection": selection, "matched": matches });
-    print_json(&out);
+    print_json(&out)?;
     Ok(())
 }

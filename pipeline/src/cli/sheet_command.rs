@@ -1,8 +1,8 @@
 //! `rh-pipeline sheet`: the contact sheet of a rendered dataset (feature `render`).
 
-#[cfg(feature = "render")]
-use super::failure::print_json;
 use super::failure::{input, Failure};
+#[cfg(feature = "render")]
+use super::failure::{print_json, println};
 use std::path::Path;
 
 /// `rh-pipeline sheet`: the contact sheet of a rendered dataset.
@@ -25,13 +25,14 @@ pub fn run(dir: &Path, out: &Path, camera: &str, json: bool) -> Result<(), Failu
         "{camera} frames{}: per family the first valid scene, at the time the hazard shows most",
         if camera == "ego" { " - what the model sees" } else { "" }
     );
-    let sheet = rh_render::contact_sheet(&title, &tiles, out).map_err(|e| match e {
+    let sheet = rh_render::contact_sheet(&title, &tiles).map_err(|e| match e {
         rh_render::RenderError::Io(m) => input(m),
         other => Failure {
             code: 1,
             message: other.to_string(),
         },
     })?;
+    rh_contract::fsio::write_file(out, "the contact sheet", &sheet.png)?;
     if json {
         let tiles: Vec<serde_json::Value> = tiles
             .iter()
@@ -51,15 +52,15 @@ pub fn run(dir: &Path, out: &Path, camera: &str, json: bool) -> Result<(), Failu
             "width": sheet.width,
             "height": sheet.height,
             "tiles": tiles,
-        }));
+        }))?;
     } else {
-        println!(
+        println(&format!(
             "contact sheet of {} families ({camera} frames, {}x{}) written to {}",
             sheet.tiles.len(),
             sheet.width,
             sheet.height,
             out.display()
-        );
+        ))?;
     }
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! `rh-pipeline verify`: the dataset checked end to end (or `--fast`), and the report.
 
-use super::failure::{input, print_json, Failure};
+use super::failure::{input, print_json, println, Failure};
 use rh_catalog::Catalog;
 use rh_dataset::verify::{verify, verify_fast};
 use std::path::Path;
@@ -19,33 +19,33 @@ pub fn run(dir: &Path, catalog: &Catalog, fast: bool, json: bool) -> Result<(), 
         for line in &adapter {
             eprintln!("{line}");
         }
-        print_json(&report);
+        print_json(&report)?;
     } else {
         for line in &adapter {
-            println!("{line}");
+            println(line)?;
         }
         for p in &report.file_problems {
-            println!("FILE {}: {}", p.file, p.problem);
+            println(&format!("FILE {}: {}", p.file, p.problem))?;
         }
         for m in &report.mismatches {
-            println!("MISMATCH {}: {}", m.scene_id, m.problem);
+            println(&format!("MISMATCH {}: {}", m.scene_id, m.problem))?;
         }
         if report.mode == "full" {
-            println!(
+            println(&format!(
                 "verified {} files against build.json: {} problem(s); {} scenes derived again: {} match, {} differ",
                 report.files_checked,
                 report.file_problems.len(),
                 report.scenes,
                 report.matched,
                 report.scenes - report.matched
-            );
+            ))?;
         } else {
-            println!(
+            println(&format!(
                 "verified {} scenes: {} match, {} mismatch",
                 report.scenes,
                 report.matched,
                 report.mismatches.len()
-            );
+            ))?;
         }
     }
     if report.ok() {

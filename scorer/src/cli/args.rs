@@ -16,7 +16,9 @@ use std::path::PathBuf;
         (R1-R4), d_end, AIA and HDE, aggregates them per model, family, speed band, \
         ground-truth action and adversarial flag, and reproduces the paper's analyses. \
         `rh-score --explain` prints every definition.\n\n\
-        Exit status: 0 success, 2 bad input or usage, 1 internal error.",
+        Exit status: 0 success, 2 bad input or usage, 3 an output that cannot be written \
+        (full disk, read-only directory, /dev/full; the file is named and any previous \
+        one left unchanged), 1 internal error.",
     args_conflicts_with_subcommands = true
 )]
 pub struct Cli {
@@ -32,6 +34,11 @@ pub struct Cli {
     /// Default: $RH_DATASET, else the released dataset (Alan123/reacthuman-benchmark-scaled).
     #[arg(long, value_name = "DIR|owner/name")]
     pub dataset: Option<String>,
+
+    /// Use a dataset whose build did not finish (its build.json records no file
+    /// checksums, or files it records are missing); refused otherwise (exit 2).
+    #[arg(long)]
+    pub allow_incomplete: bool,
 
     /// Write the full report as JSON ("-" for stdout, which replaces the table).
     #[arg(long, value_name = "FILE")]
@@ -140,6 +147,10 @@ pub enum Cmd {
         /// else the released dataset.
         #[arg(long, value_name = "DIR|owner/name")]
         dataset: Option<String>,
+        /// Use a dataset whose build did not finish (its build.json records no file
+        /// checksums, or files it records are missing); refused otherwise (exit 2).
+        #[arg(long)]
+        allow_incomplete: bool,
         /// Seed of the random baseline.
         #[arg(long, default_value_t = 0)]
         seed: u64,
@@ -204,6 +215,10 @@ pub struct PredictArgs {
     /// Default: $RH_DATASET, else the released dataset.
     #[arg(long, value_name = "DIR|owner/name")]
     pub dataset: Option<String>,
+    /// Use a dataset whose build did not finish (its build.json records no file
+    /// checksums, or files it records are missing); refused otherwise (exit 2).
+    #[arg(long)]
+    pub allow_incomplete: bool,
     /// Model id as the server knows it (e.g. gpt-4o, Qwen/Qwen2.5-VL-7B-Instruct).
     #[arg(long)]
     pub model: String,
@@ -288,6 +303,10 @@ pub struct ExportArgs {
     /// owner/name[@revision]. Default: $RH_DATASET, else the released dataset.
     #[arg(long, value_name = "DIR|owner/name")]
     pub dataset: Option<String>,
+    /// Use a dataset whose build did not finish (its build.json records no file
+    /// checksums, or files it records are missing); refused otherwise (exit 2).
+    #[arg(long)]
+    pub allow_incomplete: bool,
     /// Output directory (new or empty): data/train-00000-of-00001.parquet, README.md,
     /// export.json.
     #[arg(long, value_name = "DIR")]

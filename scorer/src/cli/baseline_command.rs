@@ -1,6 +1,5 @@
 //! `rh-score baseline KIND`: reference predictions for every scene, on stdout.
 
-use super::dataset_arg::resolve_dataset;
 use super::output::load_config;
 use crate::baseline::{write_baseline, BaselineKind};
 use crate::Dataset;
@@ -11,26 +10,37 @@ use std::path::Path;
 /// the dataset to stdout; a reader that went away (`| head`) is not an error.
 pub fn run(
     kind: BaselineKind,
-    dataset: Option<String>,
+    dataset: &Path,
     seed: u64,
     model: Option<String>,
     config: Option<&Path>,
 ) -> Result<()> {
     let cfg = load_config(config)?;
-    let ds = Dataset::load(&resolve_dataset(dataset)?)?;
+    let ds = Dataset::load(dataset)?;
     let model = model.unwrap_or_else(|| format!("baseline-{}", kind.name()));
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
     match write_baseline(kind, &ds, seed, &model, &cfg, &mut out) {
-        Err(e)
-            if e.downcast_ref::<std::io::Error>()
-                .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
-                || e.downcast_ref::<serde_json::Error>()
-                    .and_then(|j| j.io_error_kind())
-                    == Some(std::io::ErrorKind::BrokenPipe) =>
-        {
-            Ok(())
+        Err(e) => {
+            let kind = e
+                .downcast_ref::<std::io::Error>()
+                .map(std::io::Error::kind)
+                .or_else(|| {
+                    e.downcast_ref::<serde_json::Error>()
+                        .and_then(|j| j.io_error_kind())
+                });
+            match kind {
+                Some(std::io::ErrorKind::BrokenPipe) => Ok(()),
+                // A full stdout (`> /dev/full`) is an output that cannot be written (exit 3).
+                Some(k) => Err(rh_contract::fsio::CannotWrite::new(
+                    "",
+                    Path::new("stdout"),
+                    std::io::Error::new(k, format!("{e}")),
+                )
+                .into()),
+                None => Err(e),
+            }
         }
-        r => r,
+        Ok(()) => Ok(()),
     }
 }

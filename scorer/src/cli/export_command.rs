@@ -2,7 +2,7 @@
 
 use super::args::ExportArgs;
 use super::dataset_arg::resolve_dataset;
-use super::output::load_config;
+use super::output::{load_config, print_out};
 use crate::export::{run as export, ExportOptions};
 use crate::predict::config::PromptConfig;
 use anyhow::Result;
@@ -10,7 +10,7 @@ use anyhow::Result;
 /// Writes the export and prints its summary (a line, or JSON with `--json`).
 pub fn run(a: ExportArgs) -> Result<()> {
     let opts = ExportOptions {
-        dataset: resolve_dataset(a.dataset)?,
+        dataset: resolve_dataset(a.dataset, a.allow_incomplete)?,
         out: a.out,
         format: a.format,
         split: a.split,
@@ -20,10 +20,10 @@ pub fn run(a: ExportArgs) -> Result<()> {
     };
     let summary = export(&opts)?;
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        print_out(&(serde_json::to_string_pretty(&summary)? + "\n"))?;
     } else {
-        println!(
-            "wrote {} {} rows ({} scenes, {}) to {}",
+        print_out(&format!(
+            "wrote {} {} rows ({} scenes, {}) to {}\n",
             summary.rows,
             summary.format,
             summary.split,
@@ -33,7 +33,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
                 "text-only"
             },
             opts.out.join(&summary.file).display()
-        );
+        ))?;
         if summary.no_eval_subset && summary.split == "train" {
             eprintln!(
                 "rh-score: note: {} has no eval/ subset, so --split train took every valid scene",

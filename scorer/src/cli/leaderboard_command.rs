@@ -2,7 +2,6 @@
 //! ([`crate::leaderboard::merge`]), printed and written in the forms asked for.
 
 use super::output::print_out;
-use crate::error::InputError;
 use crate::leaderboard::{merge, render};
 use anyhow::Result;
 use std::path::{Path, PathBuf};
@@ -23,8 +22,11 @@ pub fn run(
         );
     }
     if let Some(p) = markdown {
-        rh_contract::fsio::write_atomic(p, render::markdown(&board).as_bytes())
-            .map_err(|e| InputError(format!("--markdown: cannot write {}: {e}", p.display())))?;
+        rh_contract::fsio::write_file(
+            p,
+            "the Markdown board",
+            render::markdown(&board).as_bytes(),
+        )?;
     }
     if json {
         print_out(&(serde_json::to_string_pretty(&board)? + "\n"))

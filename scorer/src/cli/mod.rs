@@ -1,7 +1,7 @@
 //! `rh-score`'s command line: the arguments ([`args`]) and one module per command, each
 //! with one entry point `run` over the parsed arguments; [`main`] is the binary.
-//! Exit status: 0 success, 2 bad input or usage ([`crate::error::InputError`]), 1
-//! internal error.
+//! Exit status: 0 success, 2 bad input or usage ([`crate::error::InputError`]), 3 an
+//! output that cannot be written ([`rh_contract::fsio::CannotWrite`]), 1 internal error.
 
 pub mod args;
 pub mod baseline_command;
@@ -14,7 +14,7 @@ pub mod output;
 pub mod predict_command;
 pub mod score_command;
 
-use crate::error::is_input_error;
+use crate::error::{is_cannot_write, is_input_error};
 use anyhow::Result;
 use args::{Cli, Cmd};
 use clap::Parser;
@@ -27,10 +27,14 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Cmd::Baseline {
             kind,
             dataset,
+            allow_incomplete,
             seed,
             model,
             config,
-        }) => baseline_command::run(kind, dataset, seed, model, config.as_deref()),
+        }) => {
+            let dataset = dataset_arg::resolve_dataset(dataset, allow_incomplete)?;
+            baseline_command::run(kind, &dataset, seed, model, config.as_deref())
+        }
         Some(Cmd::Leaderboard {
             files,
             html,
@@ -43,11 +47,16 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Cmd::Export(a)) => export_command::run(*a),
         #[cfg(feature = "synthetic")]
         Some(Cmd::MakeFixture { out, n, seed, drop }) => {
+            if !(1..=1_000_000).contains(&n) {
+                return Err(crate::error::InputError(format!("--n {n}: must be 1-1000000")).into());
+            }
             let rows = crate::synthetic::synth_rows(n, seed);
             let drop: Vec<&str> = drop.iter().map(String::as_str).collect();
             crate::synthetic::write_dataset(&out, &rows, &drop)?;
-            println!("wrote {n} synthetic scenes to {}", out.display());
-            Ok(())
+            output::print_out(&format!(
+                "wrote {n} synthetic scenes to {}\n",
+                out.display()
+            ))
         }
     }
 }
@@ -55,12 +64,22 @@ pub fn run(cli: Cli) -> Result<()> {
 /// The `rh-score` binary: parses the arguments, runs the command, maps an error to its
 /// exit status.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let args = rh_contract::stdout::help_help_as_help(std::env::args_os().collect());
+    let cli = match Cli::try_parse_from(args) {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code =
+                rh_contract::stdout::parser_print_status(e.exit_code(), e.print(), "rh-score");
+            return ExitCode::from(code);
+        }
+    };
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("rh-score: error: {e:#}");
-            if is_input_error(&e) {
+            if is_cannot_write(&e) {
+                ExitCode::from(rh_contract::fsio::EXIT_CANNOT_WRITE)
+            } else if is_input_error(&e) {
                 ExitCode::from(2)
             } else {
                 ExitCode::from(1)

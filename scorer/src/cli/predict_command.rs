@@ -33,7 +33,21 @@ pub fn run(a: PredictArgs) -> Result<()> {
     if let Some(r) = a.max_retries {
         client.max_retries = r;
     }
-    if a.max_cost.is_some_and(|c| !(c >= 0.0)) {
+    crate::predict::config::check_client(&client, "--concurrency/--timeout/--max-retries:")?;
+    let generation = Generation {
+        temperature: a.temperature.unwrap_or(cfg.generation.temperature),
+        max_tokens: a.max_tokens.unwrap_or(cfg.generation.max_tokens),
+    };
+    crate::predict::config::check_generation(&generation, "--temperature/--max-tokens:")?;
+    for (flag, v) in [("--price-in", a.price_in), ("--price-out", a.price_out)] {
+        if v.is_some_and(|p| !(p.is_finite() && p >= 0.0)) {
+            return Err(InputError(format!(
+                "{flag} must be a non-negative number of USD per million tokens"
+            ))
+            .into());
+        }
+    }
+    if a.max_cost.is_some_and(|c| !(c.is_finite() && c >= 0.0)) {
         return Err(InputError("--max-cost must be a non-negative number of USD".into()).into());
     }
     let table = cfg.price(&a.model);
@@ -51,7 +65,7 @@ pub fn run(a: PredictArgs) -> Result<()> {
             a.model
         );
     }
-    let dataset = resolve_dataset(a.dataset.clone())?;
+    let dataset = resolve_dataset(a.dataset.clone(), a.allow_incomplete)?;
     let ds = Dataset::load(&dataset)?;
     let scenes = crate::predict::select_scenes(&ds, a.subset, a.limit)?;
     let opts = crate::predict::PredictOptions {
@@ -61,10 +75,7 @@ pub fn run(a: PredictArgs) -> Result<()> {
         subset: a.subset,
         limit: a.limit,
         client,
-        generation: Generation {
-            temperature: a.temperature.unwrap_or(cfg.generation.temperature),
-            max_tokens: a.max_tokens.unwrap_or(cfg.generation.max_tokens),
-        },
+        generation,
         price,
         max_cost: a.max_cost,
         retry_errors: a.retry_errors,

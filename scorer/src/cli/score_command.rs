@@ -4,7 +4,7 @@
 
 use super::args::Cli;
 use super::dataset_arg::resolve_dataset;
-use super::output::{load_config, print_out, write_file};
+use super::output::{load_config, print_out, write_file, SharedFile};
 use crate::error::InputError;
 use crate::{Dataset, Report, Scoring};
 use anyhow::{Context, Result};
@@ -14,7 +14,7 @@ use std::path::Path;
 pub fn run(cli: Cli) -> Result<()> {
     let cfg = load_config(cli.config.as_deref())?;
     if cli.explain {
-        print!("{}", crate::explain::explain(&cfg));
+        print_out(&crate::explain::explain(&cfg))?;
         if cli.preds.is_none() {
             return Ok(());
         }
@@ -43,13 +43,16 @@ pub fn run(cli: Cli) -> Result<()> {
         )
         .into());
     }
-    let ds = Dataset::load(&resolve_dataset(cli.dataset.clone())?)?;
+    let ds = Dataset::load(&resolve_dataset(cli.dataset.clone(), cli.allow_incomplete)?)?;
     let expected = crate::coverage::Expected::resolve(&ds, cli.subset)?;
     let mut scoring = Scoring::new(&ds, &cfg).with_expected(expected);
-    if let Some(p) = &cli.decisions {
-        let f = std::fs::File::create(p)
-            .map_err(|e| InputError(format!("cannot write decisions to {}: {e}", p.display())))?;
-        scoring = scoring.with_decisions_output(Box::new(std::io::BufWriter::new(f)));
+    // Written under a temporary name, renamed into place once every line is in.
+    let decisions = match &cli.decisions {
+        Some(p) => Some(SharedFile::create(p, "the decision lines")?),
+        None => None,
+    };
+    if let Some(d) = &decisions {
+        scoring = scoring.with_decisions_output(Box::new(d.clone()));
     }
     if cli.execute {
         scoring = scoring.with_execution();
@@ -60,6 +63,10 @@ pub fn run(cli: Cli) -> Result<()> {
         scoring.score_path(&preds)?;
     }
     crate::refusal::check_scored(&scoring, &preds.display().to_string())?;
+    if cli.results.is_some() {
+        // A clash of results file names is found before any output is written.
+        crate::results::check_file_names(scoring.models.iter().map(|m| m.name.as_str()))?;
+    }
     let mut report = Report::build_with(&scoring, &preds.display().to_string(), cli.answered_only);
     if let Some(pair) = &cli.compare {
         let c = crate::compare::compare(&scoring, &pair[0], &pair[1])?;
@@ -93,6 +100,9 @@ pub fn run(cli: Cli) -> Result<()> {
         None => None,
     };
     drop(scoring);
+    if let Some(d) = &decisions {
+        d.commit()?;
+    }
     if let (Some(dir), Some(identity)) = (&cli.results, &identity) {
         let scoring_id = crate::results::ScoringIdentity::of(&cfg, cli.answered_only);
         let files = crate::results::results_files(&report, identity, &scoring_id);

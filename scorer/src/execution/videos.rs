@@ -224,8 +224,7 @@ pub fn write_videos(
     bar.finish_and_clear();
     let text = serde_json::to_string_pretty(&index)? + "\n";
     let path = req.dir.join("index.json");
-    rh_contract::fsio::write_atomic(&path, text.as_bytes())
-        .map_err(|e| anyhow!("cannot write {}: {e}", path.display()))?;
+    rh_contract::fsio::write_file(&path, "the video index", text.as_bytes())?;
     Ok(index)
 }
 

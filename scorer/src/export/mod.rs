@@ -98,8 +98,16 @@ fn read_batch_rows(images: bool) -> usize {
     }
 }
 
-/// Refuses an output directory that exists and is not empty (nothing is overwritten).
+/// Refuses an output directory that exists and is not empty (nothing is overwritten), or
+/// a file.
 fn check_out(out: &Path) -> Result<()> {
+    if out.exists() && !out.is_dir() {
+        return Err(InputError(format!(
+            "--out {}: is a file; give a directory (new or empty) for the exported dataset",
+            out.display()
+        ))
+        .into());
+    }
     if out.exists() {
         let empty = out.is_dir()
             && std::fs::read_dir(out)
@@ -139,8 +147,35 @@ fn data_files(dir: &Path) -> Result<Vec<PathBuf>> {
 
 /// Writes the export of `opts.dataset` into `opts.out`: `data/train-00000-of-00001.parquet`,
 /// `README.md` (the dataset card) and `export.json` (what was exported, from which build).
+/// Whole or not at all: everything goes into a temporary sibling directory renamed onto
+/// `opts.out` at the end, so a failed export (a full disk) leaves no `out/` behind.
 pub fn run(opts: &ExportOptions) -> Result<Summary> {
     check_out(&opts.out)?;
+    let staged = ExportOptions {
+        out: rh_contract::fsio::temp_sibling(&opts.out),
+        ..opts.clone()
+    };
+    let result = write_export(&staged, &opts.out).and_then(|summary| {
+        let cannot = |e| rh_contract::fsio::CannotWrite::new("the export", &opts.out, e);
+        if opts.out.is_dir() {
+            std::fs::remove_dir(&opts.out).map_err(cannot)?;
+        }
+        std::fs::rename(&staged.out, &opts.out).map_err(cannot)?;
+        Ok(summary)
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_dir_all(&staged.out);
+    }
+    result
+}
+
+/// An output failure of the export (a message naming the file) as a `CannotWrite` of `out`.
+fn cannot_write(out: &Path, message: String) -> anyhow::Error {
+    rh_contract::fsio::CannotWrite::new("the export", out, std::io::Error::other(message)).into()
+}
+
+/// The export written into `opts.out` (the staging directory), `out` being where it goes.
+fn write_export(opts: &ExportOptions, out: &Path) -> Result<Summary> {
     let files = data_files(&opts.dataset)?;
     let eval = eval_scene_ids(&opts.dataset)?;
     if opts.split == Split::Eval && eval.is_none() {
@@ -167,7 +202,7 @@ pub fn run(opts: &ExportOptions) -> Result<Summary> {
         preference: opts.format == Format::Preference,
         images: !opts.text_only && has_frames(opts, &first),
     };
-    let mut sink = Sink::create(&opts.out.join(FILE), shape).map_err(anyhow::Error::msg)?;
+    let mut sink = Sink::create(&opts.out.join(FILE), shape).map_err(|e| cannot_write(out, e))?;
     let aia = AiaMatcher::new(&opts.config.aia);
     let mut full_precision = 0;
     for data in &files {
@@ -176,15 +211,15 @@ pub fn run(opts: &ExportOptions) -> Result<Summary> {
             let examples = examples_of_batch(opts, &batch, data, eval.as_ref(), shape, &aia)?;
             full_precision += examples.iter().filter(|e| e.full_precision).count();
             if !examples.is_empty() {
-                sink.write(&examples).map_err(anyhow::Error::msg)?;
+                sink.write(&examples).map_err(|e| cannot_write(out, e))?;
             }
         }
     }
     let shape = sink.shape;
     let rows = sink.rows;
-    sink.finish().map_err(anyhow::Error::msg)?;
+    sink.finish().map_err(|e| cannot_write(out, e))?;
     let summary = Summary {
-        out: opts.out.display().to_string(),
+        out: out.display().to_string(),
         file: FILE.into(),
         format: match opts.format {
             Format::Sft => "sft",
@@ -196,7 +231,7 @@ pub fn run(opts: &ExportOptions) -> Result<Summary> {
         full_precision_plans: full_precision,
         no_eval_subset: eval.is_none(),
     };
-    card::write(opts, &summary).map_err(|e| anyhow::anyhow!("{}: {e}", opts.out.display()))?;
+    card::write(opts, &summary).map_err(|e| cannot_write(out, e))?;
     Ok(summary)
 }
 

@@ -144,10 +144,12 @@ pub fn write_site(
 }
 
 fn write(path: &Path, text: &str) -> Result<()> {
+    // Into the site's temporary directory, renamed whole into place at the end.
+    let cannot = |e| rh_contract::fsio::CannotWrite::new("the site", path, e);
     if let Some(p) = path.parent() {
-        std::fs::create_dir_all(p).with_context(|| format!("creating {}", p.display()))?;
+        std::fs::create_dir_all(p).map_err(cannot)?;
     }
-    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+    Ok(std::fs::write(path, text).map_err(cannot)?)
 }
 
 /// JSON safe inside a `<script>` element.

@@ -144,14 +144,11 @@ pub fn write_html(b: &Board, dir: &Path) -> Result<()> {
     );
     let put = |rel: &str, text: &str| -> Result<()> {
         let path = dir.join(rel);
-        if let Some(p) = path.parent() {
-            std::fs::create_dir_all(p).map_err(|e| {
-                crate::error::InputError(format!("--html: cannot create {}: {e}", p.display()))
-            })?;
-        }
-        rh_contract::fsio::write_atomic(&path, text.as_bytes()).map_err(|e| {
-            crate::error::InputError(format!("--html: cannot write {}: {e}", path.display())).into()
-        })
+        Ok(rh_contract::fsio::write_file(
+            &path,
+            "the leaderboard site",
+            text.as_bytes(),
+        )?)
     };
     put("assets/site.css", crate::html::CSS)?;
     put("assets/site.js", crate::html::JS)?;

@@ -114,8 +114,8 @@ impl PromptConfig {
                 "[images] chroma_subsampling must be \"4:2:0\" or \"4:4:4\"".into(),
             ));
         }
-        if cfg.images.max_side < 16 {
-            return Err(bad("[images] max_side must be at least 16".into()));
+        if !(16..=8192).contains(&cfg.images.max_side) {
+            return Err(bad("[images] max_side must be 16-8192".into()));
         }
         if !["low", "high", "auto"].contains(&cfg.images.detail.as_str()) {
             return Err(bad(
@@ -128,6 +128,60 @@ impl PromptConfig {
         Ok(cfg)
     }
 }
+
+/// The bounds of the client's numbers (docs/reliability.md, "Bounds"), from the file or
+/// the flags that override it (`origin` says which): checked before any request.
+pub fn check_client(c: &rh_llm::ClientConfig, origin: &str) -> Result<()> {
+    let bad = |m: String| -> anyhow::Error { InputError(format!("{origin} {m}")).into() };
+    if !(1..=MAX_CONCURRENCY).contains(&c.concurrency) {
+        return Err(bad(format!(
+            "concurrency {}: must be 1-{MAX_CONCURRENCY}",
+            c.concurrency
+        )));
+    }
+    for (name, v) in [
+        ("timeout_s", c.timeout_s),
+        ("backoff_base_s", c.backoff_base_s),
+        ("backoff_max_s", c.backoff_max_s),
+        ("max_retry_after_s", c.max_retry_after_s),
+    ] {
+        if !(v.is_finite() && v >= 0.0 && v <= 86_400.0) || (name == "timeout_s" && v <= 0.0) {
+            return Err(bad(format!(
+                "{name} {v}: must be a number of seconds in (0, 86400]"
+            )));
+        }
+    }
+    if c.max_retries > 100 || c.max_rate_limit_retries > 1000 {
+        return Err(bad(format!(
+            "max_retries {} / max_rate_limit_retries {}: at most 100 / 1000",
+            c.max_retries, c.max_rate_limit_retries
+        )));
+    }
+    Ok(())
+}
+
+/// The bounds of the generation settings: temperature in [0, 2] (the OpenAI API's range),
+/// max_tokens 1-1,000,000.
+pub fn check_generation(g: &Generation, origin: &str) -> Result<()> {
+    if !(g.temperature.is_finite() && (0.0..=2.0).contains(&g.temperature)) {
+        return Err(InputError(format!(
+            "{origin} temperature {}: must be within [0, 2]",
+            g.temperature
+        ))
+        .into());
+    }
+    if !(1..=1_000_000).contains(&g.max_tokens) {
+        return Err(InputError(format!(
+            "{origin} max_tokens {}: must be 1-1000000",
+            g.max_tokens
+        ))
+        .into());
+    }
+    Ok(())
+}
+
+/// The most requests in flight (`--concurrency`, `[client] concurrency`).
+pub const MAX_CONCURRENCY: usize = 1024;
 
 impl PredictConfig {
     pub fn load(path: Option<&Path>) -> Result<PredictConfig> {
@@ -142,12 +196,15 @@ impl PredictConfig {
             )
             .into());
         }
-        if cfg.client.concurrency == 0 || cfg.client.timeout_s <= 0.0 {
+        if cfg.run.abort_after_failures > 100_000 || cfg.run.progress_every_s > 86_400.0 {
             return Err(InputError(
-                "predict config: [client] concurrency and timeout_s must be positive".into(),
+                "predict config: [run] abort_after_failures must be at most 100000 and progress_every_s at most 86400".into(),
             )
             .into());
         }
+        let origin = path.map_or("configs/predict.toml".into(), |p| p.display().to_string());
+        check_client(&cfg.client, &format!("{origin}: [client]"))?;
+        check_generation(&cfg.generation, &format!("{origin}: [generation]"))?;
         Ok(cfg)
     }
 

@@ -66,6 +66,10 @@ pub fn prepare(path: &Path, model: &str, retry_errors: bool) -> Result<Existing>
     }
     let mut keep: Vec<&[u8]> = Vec::new();
     for (i, line) in bytes[..complete].split(|&b| b == b'\n').enumerate() {
+        let line = match i {
+            0 => line.strip_prefix(crate::preds::UTF8_BOM).unwrap_or(line),
+            _ => line,
+        };
         if line.iter().all(u8::is_ascii_whitespace) {
             continue;
         }
@@ -121,19 +125,64 @@ fn rewrite(path: &Path, lines: &[&[u8]]) -> Result<()> {
         text.extend_from_slice(l);
         text.push(b'\n');
     }
-    rh_contract::fsio::write_atomic(path, &text)
-        .map_err(|e| InputError(format!("cannot rewrite {}: {e}", path.display())))?;
+    rh_contract::fsio::write_file(path, "the predictions without their error lines", &text)?;
     Ok(())
 }
 
-/// Appends lines, one `write` each.
+/// Appends lines, one `write` each, none longer than the scorer reads
+/// (`sanity.max_line_bytes`, [`fit_line`]).
 pub struct Appender {
     file: std::fs::File,
     path: PathBuf,
+    max_line_bytes: usize,
+}
+
+/// Makes a prediction line fit in `max` bytes with its newline, the scorer's limit on a
+/// line (`sanity.max_line_bytes`), so that every decision `predict` writes is scored:
+/// an over-long `response` (else `error`) text is cut at a character boundary, keeping
+/// its start, and the line says so in `truncated` (`field`, original `bytes`, `kept`).
+/// The parsed `plan` beside it was taken from the whole response. Returns the line's
+/// bytes.
+pub fn fit_line(line: &Value, max: usize) -> Result<Vec<u8>> {
+    let mut bytes = serde_json::to_vec(line)?;
+    if bytes.len() < max {
+        return Ok(bytes);
+    }
+    let mut line = line.clone();
+    let field = match line.get("response") {
+        Some(Value::String(_)) => "response",
+        _ => "error",
+    };
+    let original = line.get(field).and_then(Value::as_str).map_or(0, str::len);
+    // The marker's own bytes, and a margin: cutting k bytes of text removes at least k
+    // bytes of JSON (escapes only make it more).
+    let mut kept = original;
+    for _ in 0..8 {
+        let excess = (bytes.len() + 1).saturating_sub(max) + 128;
+        kept = kept.saturating_sub(excess);
+        let Some(Value::String(text)) = line.get_mut(field) else {
+            break;
+        };
+        let mut cut = kept.min(text.len());
+        while !text.is_char_boundary(cut) {
+            cut -= 1;
+        }
+        text.truncate(cut);
+        kept = cut;
+        line["truncated"] = serde_json::json!({"field": field, "bytes": original, "kept": kept});
+        bytes = serde_json::to_vec(&line)?;
+        if bytes.len() < max {
+            return Ok(bytes);
+        }
+    }
+    anyhow::bail!(
+        "a prediction line of {} bytes does not fit the scorer's {max}-byte line limit even without its {field}",
+        bytes.len()
+    )
 }
 
 impl Appender {
-    pub fn open(path: &Path) -> Result<Appender> {
+    pub fn open(path: &Path, max_line_bytes: usize) -> Result<Appender> {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .map_err(|e| InputError(format!("cannot create {}: {e}", dir.display())))?;
@@ -146,16 +195,21 @@ impl Appender {
         Ok(Appender {
             file,
             path: path.to_path_buf(),
+            max_line_bytes,
         })
     }
 
+    /// Appends `line` ([`fit_line`] first); a failed write is a `CannotWrite` naming the
+    /// file (the lines before it stay whole; a torn last line is dropped on the next run).
     pub fn write(&mut self, line: &Value) -> Result<()> {
-        let mut bytes = serde_json::to_vec(line)?;
+        let mut bytes = fit_line(line, self.max_line_bytes)?;
         bytes.push(b'\n');
         self.file
             .write_all(&bytes)
             .and_then(|_| self.file.flush())
-            .map_err(|e| anyhow::anyhow!("cannot append to {}: {e}", self.path.display()))
+            .map_err(|e| {
+                rh_contract::fsio::CannotWrite::new("a prediction line", &self.path, e).into()
+            })
     }
 }
 

@@ -95,6 +95,8 @@ struct Done {
 enum Stop {
     Input(String),
     Fatal(String),
+    /// The output file could not be written (exit 3).
+    Write(anyhow::Error),
     /// The first requests all failed: (how many, the last error).
     Dead(usize, String),
 }
@@ -257,7 +259,7 @@ pub fn run(opts: &PredictOptions, scenes: &[String]) -> Result<Summary> {
     let cache = opts.cache_dir.clone().map(rh_llm::cache::Cache::new);
     let client = Client::new(opts.client.clone(), cache).map_err(anyhow::Error::msg)?;
     let scoring = Config::default();
-    let mut out = Appender::open(&opts.out)?;
+    let mut out = Appender::open(&opts.out, scoring.sanity.max_line_bytes)?;
     let bar = progress_bar(opts.progress, scenes.len(), already_done);
     let mut s = Summary {
         model: opts.model.clone(),
@@ -331,6 +333,10 @@ pub fn run(opts: &PredictOptions, scenes: &[String]) -> Result<Summary> {
     match result {
         Ok(()) => Ok(s),
         Err(Stop::Input(m)) => Err(InputError(m).into()),
+        Err(Stop::Write(e)) => Err(e.context(format!(
+            "stopped after {} new lines (they are kept; run again to resume)",
+            s.written
+        ))),
         Err(Stop::Fatal(m)) => Err(InputError(format!(
             "stopped after {} new lines: the server refused the request ({m}); check \
              --base-url, --model and the API key variable",
@@ -472,8 +478,7 @@ fn record(
     budget: &mut Budget,
     client: &Client,
 ) -> Result<(), Stop> {
-    out.write(&done.line)
-        .map_err(|e| Stop::Fatal(format!("{e:#}")))?;
+    out.write(&done.line).map_err(Stop::Write)?;
     s.written += 1;
     s.remaining -= 1;
     s.encode_cpu_s += done.encode_cpu_s;

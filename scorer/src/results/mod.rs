@@ -155,24 +155,35 @@ pub fn file_stem(model: &str) -> String {
     s
 }
 
-/// Writes each file as `DIR/<model>.json` (atomically); returns the paths. Two models
-/// whose names map to the same file name are an input error.
-pub fn write_results(dir: &Path, files: &[ResultsFile]) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| InputError(format!("--results: cannot create {}: {e}", dir.display())))?;
-    let mut paths: Vec<PathBuf> = Vec::new();
-    for f in files {
-        let path = dir.join(format!("{}.json", file_stem(&f.model)));
-        if paths.contains(&path) {
+/// Refuses (exit 2) models whose results files would clash: names that map to one file
+/// name (`a/b` and `a_b`), compared without case too (one file on a case-insensitive
+/// file system). Checked before any output is written.
+pub fn check_file_names<'a>(models: impl IntoIterator<Item = &'a str>) -> Result<()> {
+    let mut seen: std::collections::BTreeMap<String, &str> = Default::default();
+    for m in models {
+        let name = format!("{}.json", file_stem(m));
+        if let Some(other) = seen.insert(name.to_lowercase(), m) {
             return Err(InputError(format!(
-                "--results: two models map to the file name {}; rename one",
-                path.display()
+                "--results: models {other:?} and {m:?} would both be written to {name}; rename one (nothing was written)"
             ))
             .into());
         }
+    }
+    Ok(())
+}
+
+/// Writes each file as `DIR/<model>.json` (atomically); returns the paths. Two models
+/// whose names map to the same file name are an input error, found before any file is
+/// written ([`check_file_names`]).
+pub fn write_results(dir: &Path, files: &[ResultsFile]) -> Result<Vec<PathBuf>> {
+    check_file_names(files.iter().map(|f| f.model.as_str()))?;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| rh_contract::fsio::CannotWrite::new("the results directory", dir, e))?;
+    let mut paths: Vec<PathBuf> = Vec::new();
+    for f in files {
+        let path = dir.join(format!("{}.json", file_stem(&f.model)));
         let text = serde_json::to_string_pretty(f)? + "\n";
-        rh_contract::fsio::write_atomic(&path, text.as_bytes())
-            .map_err(|e| InputError(format!("--results: cannot write {}: {e}", path.display())))?;
+        rh_contract::fsio::write_file(&path, "the results file", text.as_bytes())?;
         paths.push(path);
     }
     Ok(paths)
