@@ -334,7 +334,10 @@ pub fn text(input: &CardInput) -> String {
 
     v.insert("features_table", features_table());
 
-    v.insert("label_rule", label_rule(m, &labels));
+    v.insert(
+        "label_rule",
+        label_rule(m, &labels) + &crate::camera_columns::card_note(&m.config),
+    );
 
     insert_provenance(input, &mut v);
     fill(TEMPLATE, &v)

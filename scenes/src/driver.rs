@@ -33,6 +33,12 @@ pub struct SceneResult {
     /// The hazard's centre of mass at each video frame: `[t, x, y, z]` until the scene ends.
     pub trajectory: Vec<[f32; 4]>,
     pub steps: u32,
+    /// How far the event moves in the ego image between t = 0 and Δ (`ego::motion_px`;
+    /// None without cameras).
+    pub ego_motion_px: Option<f64>,
+    /// The model-input frames (indices into `FRAME_TIMES`) before the hazard reaches the
+    /// observer, where the renderer's measured ego pixels are checked (`ego::check_measured`).
+    pub ego_checked_frames: Vec<usize>,
     /// What the render stage wrote (`None` until rendered, and for unrendered scenes).
     pub media: Option<SceneMedia>,
 }
@@ -111,10 +117,27 @@ pub fn run_group(
     if let Some(render) = render {
         results.par_iter_mut().try_for_each(|r| {
             r.media = render(r).map_err(GroupError::Render)?;
-            Ok(())
+            check_rendered(r, config).map_err(GroupError::Render)
         })?;
     }
     Ok((results, rejections))
+}
+
+/// A rendered valid scene's measured ego pixels against `validators.visible_px_min`
+/// (`ego::check_measured`): an error, not a silent pass, when the renderer shows less.
+fn check_rendered(r: &SceneResult, config: &Config) -> Result<(), String> {
+    let Some(ego) = r.media.as_ref().and_then(|m| m.visibility.get("ego")) else {
+        return Ok(());
+    };
+    if !r.verdicts.all() || config.validators.visible_px_safety <= 0.0 {
+        return Ok(());
+    }
+    crate::ego::check_measured(
+        &r.spec,
+        &r.ego_checked_frames,
+        &ego.visible_px,
+        config.validators.visible_px_min,
+    )
 }
 
 /// Plans group `g` and produces its scenes: selections planned from descriptions
@@ -370,7 +393,13 @@ pub fn label_scene(spec: SceneSpec, sim: Simulation, config: &Config) -> SceneRe
     let family = families::get(&spec.family).expect("randomize only emits implemented families");
     let labels = counterfactual_labels(&spec, &sim);
     let verdicts = validate(&spec, &sim, family, &config.validators, &labels);
-    scene_result(spec, sim, labels, verdicts)
+    scene_result(
+        spec,
+        sim,
+        labels,
+        verdicts,
+        config.validators.frame_check_until_within,
+    )
 }
 
 /// The labels of a simulated spec: the counterfactual run where the hazard may touch
@@ -386,9 +415,12 @@ fn scene_result(
     sim: Simulation,
     labels: Labels,
     verdicts: Verdicts,
+    until_within: f64,
 ) -> SceneResult {
     let trajectory = hazard_trajectory(&spec, &sim);
     SceneResult {
+        ego_motion_px: crate::ego::ego_motion_px(&spec, &sim),
+        ego_checked_frames: crate::ego::model_input_frames(&spec, &sim, until_within),
         state_hash: sim.state_hash.clone(),
         decision_state_hash: sim.state_hash_through(spec.decision_step()),
         steps: sim.steps(),
@@ -490,7 +522,15 @@ fn label_group_counting(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> 
     }
     labelled
         .into_iter()
-        .map(|(spec, sim, labels, verdicts)| scene_result(spec, sim, labels, verdicts))
+        .map(|(spec, sim, labels, verdicts)| {
+            scene_result(
+                spec,
+                sim,
+                labels,
+                verdicts,
+                config.validators.frame_check_until_within,
+            )
+        })
         .collect()
 }
 
@@ -531,7 +571,15 @@ fn label_group_if_valid(
     Some(
         labelled
             .into_iter()
-            .map(|(spec, sim, labels, verdicts)| scene_result(spec, sim, labels, verdicts))
+            .map(|(spec, sim, labels, verdicts)| {
+                scene_result(
+                    spec,
+                    sim,
+                    labels,
+                    verdicts,
+                    config.validators.frame_check_until_within,
+                )
+            })
             .collect(),
     )
 }
