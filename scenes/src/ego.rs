@@ -9,9 +9,10 @@
 //!   pixel centres over the hazard's screen box are cast at its collision shapes shrunk
 //!   to `px_inset` of their size; a ray that meets them with no fixed body, no other
 //!   moving body and (for a camera outside it) not the observer's capsule in front
-//!   counts for its cell's pixels. The estimate must reach `ego_px_min`
-//!   (`visible_px_min` × `visible_px_safety`): shrinking and the factor keep it below
-//!   what the renderer draws (its meshes fill the collision shapes' bounds).
+//!   counts for its cell's pixels (for a camera inside the room only where it meets them
+//!   inside the room's shell: walls, floor and ceiling hide what lies beyond). The
+//!   estimate must reach `ego_px_min` (`visible_px_min` × `visible_px_safety`):
+//!   shrinking and the factor keep it below what the renderer draws.
 //! * [`motion_px`] (column `ego_motion_px`, validator `valid_motion`): the largest image
 //!   displacement between t = 0 and Δ of a point sampled on the hazard's or a moving
 //!   prop's (a chain's trigger, a neighbour) collision shapes.
@@ -180,6 +181,9 @@ pub fn visible_px(
     }
     let stride = ((x1 - x0) * (y1 - y0) / MAX_SAMPLES).sqrt().ceil().max(1.0);
     let occluders = occluders(spec, sim, camera, k, rules);
+    // The room's walls, floor and ceiling hide what lies beyond them from a camera inside
+    // the room (the renderer leaves out a surface only for a camera outside it).
+    let inside = in_room(spec, camera.position);
     let mut count = 0.0;
     let mut y = y0;
     while y < y1 {
@@ -193,7 +197,7 @@ pub fn visible_px(
             let dir = scale(dir, 1.0 / dot(dir, dir).sqrt());
             if let Some(t) = hazard.first_hit(camera.position, dir, 100.0) {
                 let hit = add(camera.position, scale(dir, t));
-                if !occluders.blocks(camera.position, hit) {
+                if !(inside && !in_room(spec, hit)) && !occluders.blocks(camera.position, hit) {
                     count += cw * ch;
                     if count >= enough {
                         return count;
@@ -205,6 +209,14 @@ pub fn visible_px(
         y += stride;
     }
     count
+}
+
+/// Whether `p` lies inside the room's shell (centred on the origin, floor at z = 0).
+fn in_room(spec: &SceneSpec, p: Vec3) -> bool {
+    let [sx, sy] = spec.room.size;
+    p[0].abs() <= sx / 2.0
+        && p[1].abs() <= sy / 2.0
+        && (0.0..=spec.room.ceiling_height).contains(&p[2])
 }
 
 /// What can stand between `camera` and the hazard at step `k`: the fixed bodies, the
@@ -383,6 +395,7 @@ mod tests {
         spec.observer.x = 0.0;
         spec.observer.y = 0.0;
         spec.observer.yaw = 0.0;
+        spec.room.size = [20.0, 20.0];
         let eye = [0.0, 0.0, spec.observer.height - 0.08];
         let camera = CameraSpec {
             name: "ego".into(),
@@ -449,6 +462,13 @@ mod tests {
             open.ego_px_min = 64.0;
             assert!(!ego_pixels_pass(&spec, &sim, &spec.cameras, &open));
         }
+        // Beyond the room's wall: hidden (issue 44: a brick on a ramp poking through the
+        // wall showed 0 px while its shapes projected inside the image).
+        let (mut spec, cam) = scene(ball(0.2, [3.0, 0.0, 1.24]), vec![], fov);
+        let sim = simulate(&spec, SimOptions::default());
+        assert!(visible_px(&spec, &sim, &cam, 0, &rules, f64::MAX) > 1000.0);
+        spec.room.size = [5.0, 20.0];
+        assert_eq!(visible_px(&spec, &sim, &cam, 0, &rules, f64::MAX), 0.0);
         // Out of the picture (behind the observer): nothing.
         let (spec, cam) = scene(ball(0.2, [-3.0, 0.0, 1.24]), vec![], fov);
         let sim = simulate(&spec, SimOptions::default());
