@@ -117,27 +117,14 @@ pub fn run_group(
     if let Some(render) = render {
         results.par_iter_mut().try_for_each(|r| {
             r.media = render(r).map_err(GroupError::Render)?;
-            check_rendered(r, config).map_err(GroupError::Render)
+            let ego = r.media.as_ref().and_then(|m| m.visibility.get("ego"));
+            let px = ego.map(|v| &v.visible_px[..]);
+            let (frames, valid) = (&r.ego_checked_frames, r.verdicts.all());
+            crate::ego::check_rendered(&r.spec, valid, frames, px, &config.validators)
+                .map_err(GroupError::Render)
         })?;
     }
     Ok((results, rejections))
-}
-
-/// A rendered valid scene's measured ego pixels against `validators.visible_px_min`
-/// (`ego::check_measured`): an error, not a silent pass, when the renderer shows less.
-fn check_rendered(r: &SceneResult, config: &Config) -> Result<(), String> {
-    let Some(ego) = r.media.as_ref().and_then(|m| m.visibility.get("ego")) else {
-        return Ok(());
-    };
-    if !r.verdicts.all() || config.validators.visible_px_safety <= 0.0 {
-        return Ok(());
-    }
-    crate::ego::check_measured(
-        &r.spec,
-        &r.ego_checked_frames,
-        &ego.visible_px,
-        config.validators.visible_px_min,
-    )
 }
 
 /// Plans group `g` and produces its scenes: selections planned from descriptions
@@ -393,13 +380,7 @@ pub fn label_scene(spec: SceneSpec, sim: Simulation, config: &Config) -> SceneRe
     let family = families::get(&spec.family).expect("randomize only emits implemented families");
     let labels = counterfactual_labels(&spec, &sim);
     let verdicts = validate(&spec, &sim, family, &config.validators, &labels);
-    scene_result(
-        spec,
-        sim,
-        labels,
-        verdicts,
-        config.validators.frame_check_until_within,
-    )
+    scene_result(spec, sim, labels, verdicts, config)
 }
 
 /// The labels of a simulated spec: the counterfactual run where the hazard may touch
@@ -415,8 +396,9 @@ fn scene_result(
     sim: Simulation,
     labels: Labels,
     verdicts: Verdicts,
-    until_within: f64,
+    config: &Config,
 ) -> SceneResult {
+    let until_within = config.validators.frame_check_until_within;
     let trajectory = hazard_trajectory(&spec, &sim);
     SceneResult {
         ego_motion_px: crate::ego::ego_motion_px(&spec, &sim),
@@ -522,15 +504,7 @@ fn label_group_counting(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> 
     }
     labelled
         .into_iter()
-        .map(|(spec, sim, labels, verdicts)| {
-            scene_result(
-                spec,
-                sim,
-                labels,
-                verdicts,
-                config.validators.frame_check_until_within,
-            )
-        })
+        .map(|(spec, sim, labels, verdicts)| scene_result(spec, sim, labels, verdicts, config))
         .collect()
 }
 
@@ -571,15 +545,7 @@ fn label_group_if_valid(
     Some(
         labelled
             .into_iter()
-            .map(|(spec, sim, labels, verdicts)| {
-                scene_result(
-                    spec,
-                    sim,
-                    labels,
-                    verdicts,
-                    config.validators.frame_check_until_within,
-                )
-            })
+            .map(|(spec, sim, labels, verdicts)| scene_result(spec, sim, labels, verdicts, config))
             .collect(),
     )
 }

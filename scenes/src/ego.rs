@@ -326,6 +326,24 @@ pub fn check_measured(
     Ok(())
 }
 
+/// [`check_measured`] for a rendered scene: only a valid one with measured ego pixels
+/// (`visible_px`), and only where the configuration has the pixel rule
+/// (`visible_px_safety` > 0).
+pub fn check_rendered(
+    spec: &SceneSpec,
+    valid: bool,
+    frames: &[usize],
+    visible_px: Option<&[u32]>,
+    cfg: &crate::config::ValidatorConfig,
+) -> Result<(), String> {
+    match visible_px {
+        Some(px) if valid && cfg.visible_px_safety > 0.0 => {
+            check_measured(spec, frames, px, cfg.visible_px_min)
+        }
+        _ => Ok(()),
+    }
+}
+
 /// The indices (into `FRAME_TIMES`) of the model-input frames before the hazard reaches
 /// the observer ([`model_input_steps`]).
 pub fn model_input_frames(spec: &SceneSpec, sim: &Simulation, until_within: f64) -> Vec<usize> {
