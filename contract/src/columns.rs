@@ -77,6 +77,16 @@ pub mod col {
     pub const HARM_RATIO: &str = "harm_ratio";
     pub const OBJECT_START: &str = "object_start";
     pub const OBSERVER_POSE: &str = "observer_pose";
+    pub const EGO_FOV_Y: &str = "ego_fov_y";
+    pub const EGO_FOV_X: &str = "ego_fov_x";
+    pub const EGO_INTRINSICS: &str = "ego_intrinsics";
+    pub const EGO_POSITION_BODY: &str = "ego_position_body";
+    pub const EGO_YAW_BODY: &str = "ego_yaw_body";
+    pub const EGO_PITCH_BODY: &str = "ego_pitch_body";
+    pub const EGO_ROTATION_BODY: &str = "ego_rotation_body";
+    pub const EGO_POSITION_WORLD: &str = "ego_position_world";
+    pub const EGO_ROTATION_WORLD: &str = "ego_rotation_world";
+    pub const EGO_MOTION_PX: &str = "ego_motion_px";
     pub const LABEL_RULE: &str = "label_rule";
     pub const STATE_HASH: &str = "state_hash";
     pub const DECISION_STATE_HASH: &str = "decision_state_hash";
@@ -90,6 +100,7 @@ pub mod col {
     pub const VALID_INTENDED_EVENT: &str = "valid_intended_event";
     pub const VALID_REACTION_TIME: &str = "valid_reaction_time";
     pub const VALID_ESCAPABLE: &str = "valid_escapable";
+    pub const VALID_MOTION: &str = "valid_motion";
     pub const SPEC_FILE: &str = "spec_file";
     pub const EGO_FILE_NAME: &str = "ego_file_name";
     pub const CLOSEUP_FILE_NAME: &str = "closeup_file_name";
@@ -100,7 +111,7 @@ pub mod col {
 }
 
 /// The validator verdict columns, in column order (each `true` when that check passed).
-pub const VALIDATOR_COLUMNS: [&str; 8] = [
+pub const VALIDATOR_COLUMNS: [&str; 9] = [
     col::VALID_NO_INTERPENETRATION,
     col::VALID_ENERGY,
     col::VALID_NO_TUNNELLING,
@@ -109,6 +120,7 @@ pub const VALIDATOR_COLUMNS: [&str; 8] = [
     col::VALID_INTENDED_EVENT,
     col::VALID_REACTION_TIME,
     col::VALID_ESCAPABLE,
+    col::VALID_MOTION,
 ];
 
 /// The `<cam>_hazard_visible_px` column of a camera (`CAMERAS`).
@@ -401,6 +413,66 @@ pub const COLUMNS: &[Column] = &[
         "Observer on the floor: [x (m), y (m), yaw (rad)]",
     ),
     c(
+        col::EGO_FOV_Y,
+        Float64,
+        true,
+        "Head (`ego`) camera, a pinhole without distortion (the calibration the prompt states): vertical field of view (rad); null when the scene has no cameras",
+    ),
+    c(
+        col::EGO_FOV_X,
+        Float64,
+        true,
+        "Head camera: horizontal field of view (rad), 2·atan(tan(ego_fov_y / 2)·width / height)",
+    ),
+    c(
+        col::EGO_INTRINSICS,
+        Float64List,
+        true,
+        "Head camera intrinsics [fx, fy, cx, cy] (px, at the frames' resolution 2cx × 2cy): pixel u = fx·x/z + cx (right), v = fy·y/z + cy (down, from the top-left corner) of the camera-frame point [x, y, z] (x right, y down, z forward)",
+    ),
+    c(
+        col::EGO_POSITION_BODY,
+        Vec3,
+        true,
+        "Head camera's optical centre in the body frame (origin at the pelvis, x forward, y left, z up; m)",
+    ),
+    c(
+        col::EGO_YAW_BODY,
+        Float64,
+        true,
+        "Head camera's optical axis in the body frame: yaw from the body's forward axis (rad, positive to the left); the camera never rolls",
+    ),
+    c(
+        col::EGO_PITCH_BODY,
+        Float64,
+        true,
+        "Head camera's optical axis: pitch above the horizontal (rad, negative looking down)",
+    ),
+    c(
+        col::EGO_ROTATION_BODY,
+        Float64List,
+        true,
+        "Head camera orientation in the body frame: 3 × 3 row-major matrix R whose columns are the camera's x, y, z axes; a body-frame point p is at Rᵀ(p − ego_position_body) in camera coordinates",
+    ),
+    c(
+        col::EGO_POSITION_WORLD,
+        Vec3,
+        true,
+        "Head camera's optical centre in the world frame (m)",
+    ),
+    c(
+        col::EGO_ROTATION_WORLD,
+        Float64List,
+        true,
+        "Head camera orientation in the world frame: as ego_rotation_body (columns = camera axes), a world point p is at Rᵀ(p − ego_position_world)",
+    ),
+    c(
+        col::EGO_MOTION_PX,
+        Float64,
+        true,
+        "How far the event moves in the head camera's image between t = 0 and Δ (px at the frames' resolution): the largest displacement of a point sampled on the hazard's (or a moving prop's, e.g. a chain's trigger) collision shapes; validator `valid_motion` needs `validators.motion_px_min`; null without cameras",
+    ),
+    c(
         col::LABEL_RULE,
         Utf8,
         false,
@@ -458,7 +530,7 @@ pub const COLUMNS: &[Column] = &[
         col::VALID_VISIBLE,
         Bool,
         false,
-        "Validator: every camera sees enough of the hazard (share of sample points on its collision shapes in the image and in sight, past fixed bodies and the observer's body), large enough in pixels, during the observation window",
+        "Validator: every camera sees enough of the hazard (share of sample points on its collision shapes in the image and in sight, past fixed bodies and the observer's body), large enough in pixels, during the observation window; and every model-input ego frame before the hazard reaches the observer shows it with at least `validators.visible_px_min` pixels times a safety factor (ray-cast estimate over its shrunk shapes; the renderer checks its measured pixels)",
     ),
     c(
         col::VALID_INTENDED_EVENT,
@@ -477,6 +549,12 @@ pub const COLUMNS: &[Column] = &[
         Bool,
         false,
         "Validator: a DODGE scene whose hazard would strike the standing body has an escape walk that physics does not strike (label rule v4)",
+    ),
+    c(
+        col::VALID_MOTION,
+        Bool,
+        false,
+        "Validator: the event is under way in the window: `ego_motion_px` is at least `validators.motion_px_min`",
     ),
     c(
         col::SPEC_FILE,

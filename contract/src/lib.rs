@@ -5,6 +5,7 @@
 //! * [`families`] — the seventeen event families, in canonical order;
 //! * [`columns`] — the scene table's columns, their types, nullability and meaning;
 //! * [`action`] — the three action primitives;
+//! * [`camera`] — the head camera's calibration (intrinsics, pose in world and body frame);
 //! * [`layout`] — where files live in a dataset directory (specs, videos, frames, data);
 //! * [`digest`] — SHA-256 and hex, for fingerprints, file sums and cache keys;
 //! * [`fsio`] — atomic file writing and the "cannot write" exit status; [`stdout`] —
@@ -16,6 +17,7 @@
 
 pub mod action;
 pub mod adapter;
+pub mod camera;
 pub mod columns;
 pub mod digest;
 pub mod execution;

@@ -336,7 +336,10 @@ pub fn text(input: &CardInput) -> String {
     v.insert("teaser", crate::card_teaser::teaser(input.rows));
     v.insert("frame_size", crate::card_teaser::frame_size(m));
 
-    v.insert("label_rule", label_rule(m, &labels));
+    v.insert(
+        "label_rule",
+        label_rule(m, &labels) + &crate::camera_columns::card_note(&m.config),
+    );
 
     insert_provenance(input, &mut v);
     fill(TEMPLATE, &v)

@@ -4,6 +4,7 @@
 //! reading it back; [`stream`] — a Parquet file written row group by row group;
 //! [`manifest`] — reading `build.json` (writing one needs `write`).
 //! With feature `write` (default): [`rows`] (scene rows from scene results),
+//! [`camera_columns`] (the head camera's calibration and motion columns),
 //! [`media_columns`] (the measured-visibility and mask columns), [`integrity`] (SHA-256 sums), [`records`] (finished scene groups of a
 //! running build), [`finalize`] (data, eval subset, card and sums from the rows),
 //! [`card`] (the dataset card), [`merge`] (shards into one dataset) and [`verify`].
@@ -14,6 +15,8 @@ pub mod read;
 pub mod stream;
 pub mod table;
 
+#[cfg(feature = "write")]
+pub mod camera_columns;
 #[cfg(feature = "write")]
 pub mod card;
 #[cfg(feature = "write")]

@@ -121,12 +121,15 @@ pub fn record_batch(results: &[SceneResult], catalog: &Catalog) -> RecordBatch {
         prim!(Float64Builder, |r: &SceneResult| r.labels.harm_ratio),
         vec3s(&|r| Some(r.spec.hazard_body().position)),
         vec3s(&|r| Some([r.spec.observer.x, r.spec.observer.y, r.spec.observer.yaw])),
+    ];
+    columns.extend(crate::camera_columns::columns(results));
+    columns.extend([
         strings!(|r: &SceneResult| Some(r.spec.labels.rule_version.clone())),
         strings!(|r: &SceneResult| Some(r.state_hash.clone())),
         strings!(|r: &SceneResult| Some(r.decision_state_hash.clone())),
         prim!(UInt32Builder, |r: &SceneResult| Some(r.steps)),
         bools(&|r| r.verdicts.all()),
-    ];
+    ]);
     for i in 0..VALIDATOR_COLUMNS.len() {
         columns.push(bools(&|r| r.verdicts.as_array()[i]));
     }

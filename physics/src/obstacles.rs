@@ -2,11 +2,12 @@
 //! envelope), for camera framing and the visibility validator.
 
 use crate::shapes::{posed_parts, rot, v3};
-use crate::spec::{BodyKind, ObserverSpec, SceneSpec};
+use crate::spec::{BodyKind, ObserverSpec, PartSpec, Quat, SceneSpec, Vec3};
 use rapier3d::prelude::*;
 
 /// The spec's fixed bodies (furniture, walls, stairs) as world-posed shapes, for line-of-
 /// sight queries: `Obstacles::blocks` says whether a segment passes through any of them.
+#[derive(Clone)]
 pub struct Obstacles {
     parts: Vec<(Pose, SharedShape)>,
 }
@@ -36,6 +37,34 @@ impl Obstacles {
             SharedShape::capsule_z(half, radius),
         ));
         self
+    }
+
+    /// No shapes (add bodies with [`Obstacles::with_body`]).
+    pub fn none() -> Obstacles {
+        Obstacles { parts: Vec::new() }
+    }
+
+    /// These obstacles and a body's `parts` posed at `position`, `rotation` (a moving body
+    /// at one step: a hazard to cast rays at, or a prop in the way).
+    pub fn with_body(mut self, parts: &[PartSpec], position: Vec3, rotation: Quat) -> Obstacles {
+        let body_pose = Pose::from_parts(v3(position), rot(rotation));
+        self.parts.extend(
+            posed_parts(parts)
+                .into_iter()
+                .map(|(pose, shape)| (body_pose * pose, shape)),
+        );
+        self
+    }
+
+    /// The distance along the ray from `origin` in the unit direction `dir` to the first
+    /// shape it meets within `max`, if any.
+    pub fn first_hit(&self, origin: Vec3, dir: Vec3, max: f64) -> Option<f64> {
+        let ray = rapier3d::parry::query::Ray::new(v3(origin), v3(dir));
+        self.parts
+            .iter()
+            .filter_map(|(pose, shape)| shape.cast_ray(pose, &ray, max as Real, true))
+            .reduce(Real::min)
+            .map(f64::from)
     }
 
     /// Whether `p` lies inside one of the obstacles.

@@ -91,6 +91,7 @@ pub fn frame_group(
         let shows = bands.iter().all(|(spec, sim)| {
             hazard_in_frame(spec, sim, &cameras, rules)
                 && visibility::assess_cameras(spec, sim, &cameras, rules).passes(rules)
+                && crate::ego::ego_pixels_pass(spec, sim, &cameras, rules)
         });
         if shows {
             return Some(cameras);

@@ -105,6 +105,23 @@ pub struct ValidatorConfig {
     /// its path needs.
     #[serde(default = "default_frame_size_px")]
     pub frame_size_px: [f64; 2],
+    /// What the renderer measures, the validator guarantees (`ego`): every model-input ego
+    /// frame before the hazard reaches the observer must show, by a ray-cast estimate over
+    /// the hazard's collision shapes shrunk to `visible_px_inset` of their size, at least
+    /// `visible_px_min` × this many pixels (0, as in older configurations: not checked).
+    #[serde(default)]
+    pub visible_px_safety: f64,
+    #[serde(default = "default_visible_px_inset")]
+    pub visible_px_inset: f64,
+    /// The event is under way in the window (`ego::motion_px`, validator `valid_motion`):
+    /// the least motion (px) of the hazard or a moving prop in the ego image between t = 0
+    /// and Δ (0, as in older configurations: not checked).
+    #[serde(default)]
+    pub motion_px_min: f64,
+}
+
+fn default_visible_px_inset() -> f64 {
+    0.9
 }
 
 fn default_max_fov_y() -> f64 {
@@ -140,6 +157,10 @@ pub struct FramingRules {
     pub observer_margin: f64,
     /// Band of projected hazard sizes (px) that placement aims for.
     pub size_band_px: [f64; 2],
+    /// Least estimated hazard pixels in each model-input ego frame (0: not checked).
+    pub ego_px_min: f64,
+    /// The hazard's shapes are shrunk to this share of their size for that estimate.
+    pub px_inset: f64,
 }
 
 impl ValidatorConfig {
@@ -152,6 +173,8 @@ impl ValidatorConfig {
             min_size_px: self.visible_size_px_min,
             observer_margin: self.visibility_observer_margin,
             size_band_px: self.frame_size_px,
+            ego_px_min: self.visible_px_min as f64 * self.visible_px_safety,
+            px_inset: self.visible_px_inset,
         }
     }
 }
@@ -368,6 +391,18 @@ impl Config {
             return Err(fail(
                 "validators.visibility_observer_margin",
                 "must not be negative".into(),
+            ));
+        }
+        if !(v.visible_px_safety >= 0.0 && v.motion_px_min >= 0.0) {
+            return Err(fail(
+                "validators.visible_px_safety",
+                "visible_px_safety and motion_px_min must not be negative".into(),
+            ));
+        }
+        if !(v.visible_px_inset > 0.0 && v.visible_px_inset <= 1.0) {
+            return Err(fail(
+                "validators.visible_px_inset",
+                "must be within (0, 1]".into(),
             ));
         }
         let [lo, hi] = v.frame_size_px;

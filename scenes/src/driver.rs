@@ -33,6 +33,12 @@ pub struct SceneResult {
     /// The hazard's centre of mass at each video frame: `[t, x, y, z]` until the scene ends.
     pub trajectory: Vec<[f32; 4]>,
     pub steps: u32,
+    /// How far the event moves in the ego image between t = 0 and Δ (`ego::motion_px`;
+    /// None without cameras).
+    pub ego_motion_px: Option<f64>,
+    /// The model-input frames (indices into `FRAME_TIMES`) before the hazard reaches the
+    /// observer, where the renderer's measured ego pixels are checked (`ego::check_measured`).
+    pub ego_checked_frames: Vec<usize>,
     /// What the render stage wrote (`None` until rendered, and for unrendered scenes).
     pub media: Option<SceneMedia>,
 }
@@ -111,7 +117,11 @@ pub fn run_group(
     if let Some(render) = render {
         results.par_iter_mut().try_for_each(|r| {
             r.media = render(r).map_err(GroupError::Render)?;
-            Ok(())
+            let ego = r.media.as_ref().and_then(|m| m.visibility.get("ego"));
+            let px = ego.map(|v| &v.visible_px[..]);
+            let (frames, valid) = (&r.ego_checked_frames, r.verdicts.all());
+            crate::ego::check_rendered(&r.spec, valid, frames, px, &config.validators)
+                .map_err(GroupError::Render)
         })?;
     }
     Ok((results, rejections))
@@ -370,7 +380,7 @@ pub fn label_scene(spec: SceneSpec, sim: Simulation, config: &Config) -> SceneRe
     let family = families::get(&spec.family).expect("randomize only emits implemented families");
     let labels = counterfactual_labels(&spec, &sim);
     let verdicts = validate(&spec, &sim, family, &config.validators, &labels);
-    scene_result(spec, sim, labels, verdicts)
+    scene_result(spec, sim, labels, verdicts, config)
 }
 
 /// The labels of a simulated spec: the counterfactual run where the hazard may touch
@@ -386,9 +396,13 @@ fn scene_result(
     sim: Simulation,
     labels: Labels,
     verdicts: Verdicts,
+    config: &Config,
 ) -> SceneResult {
+    let until_within = config.validators.frame_check_until_within;
     let trajectory = hazard_trajectory(&spec, &sim);
     SceneResult {
+        ego_motion_px: crate::ego::ego_motion_px(&spec, &sim),
+        ego_checked_frames: crate::ego::model_input_frames(&spec, &sim, until_within),
         state_hash: sim.state_hash.clone(),
         decision_state_hash: sim.state_hash_through(spec.decision_step()),
         steps: sim.steps(),
@@ -490,7 +504,7 @@ fn label_group_counting(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> 
     }
     labelled
         .into_iter()
-        .map(|(spec, sim, labels, verdicts)| scene_result(spec, sim, labels, verdicts))
+        .map(|(spec, sim, labels, verdicts)| scene_result(spec, sim, labels, verdicts, config))
         .collect()
 }
 
@@ -531,7 +545,7 @@ fn label_group_if_valid(
     Some(
         labelled
             .into_iter()
-            .map(|(spec, sim, labels, verdicts)| scene_result(spec, sim, labels, verdicts))
+            .map(|(spec, sim, labels, verdicts)| scene_result(spec, sim, labels, verdicts, config))
             .collect(),
     )
 }

@@ -17,6 +17,7 @@ pub mod cameras;
 pub mod config;
 pub mod counterfactual;
 pub mod driver;
+pub mod ego;
 pub mod eval_subset;
 pub mod families;
 pub mod intent;

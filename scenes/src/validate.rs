@@ -24,7 +24,8 @@ pub struct Verdicts {
     /// The hazard stays in all three cameras' frames through the observation window.
     pub in_frame: bool,
     /// Every camera sees enough of the hazard, large enough (`visibility`): no fixed body
-    /// and not the observer's body in the way.
+    /// and not the observer's body in the way; and every model-input ego frame before it
+    /// reaches the observer shows it with enough pixels (`ego::ego_pixels_pass`).
     pub visible: bool,
     /// The family's intended event happened.
     pub intended_event: bool,
@@ -34,6 +35,9 @@ pub struct Verdicts {
     /// Label rule v4: a DODGE scene whose hazard would strike the standing body has an
     /// escape (`execute::escape`): some walk under the robot's limits is not struck.
     pub escapable: bool,
+    /// The event is under way in the window: the hazard (or a moving prop) moves at least
+    /// `validators.motion_px_min` in the ego image between t = 0 and Δ (`ego::motion_px`).
+    pub motion: bool,
 }
 
 impl Verdicts {
@@ -41,7 +45,7 @@ impl Verdicts {
         self.as_array().iter().all(|&v| v)
     }
 
-    pub fn as_array(&self) -> [bool; 8] {
+    pub fn as_array(&self) -> [bool; VALIDATOR_COLUMNS.len()] {
         [
             self.no_interpenetration,
             self.energy,
@@ -51,6 +55,7 @@ impl Verdicts {
             self.intended_event,
             self.reaction_time,
             self.escapable,
+            self.motion,
         ]
     }
 
@@ -103,10 +108,13 @@ pub fn unlabelled(
             .iter()
             .all(|&z| z >= -cfg.tunnel_tolerance),
         in_frame: cameras::hazard_in_frame(spec, sim, &spec.cameras, &framing),
-        visible: visibility::assess(spec, sim, &framing).passes(&framing),
+        visible: visibility::assess(spec, sim, &framing).passes(&framing)
+            && crate::ego::ego_pixels_pass(spec, sim, &spec.cameras, &framing),
         intended_event: family.event_happened(spec, sim),
         reaction_time: true,
         escapable: true,
+        motion: cfg.motion_px_min <= 0.0
+            || crate::ego::ego_motion_px(spec, sim).is_some_and(|m| m >= cfg.motion_px_min),
     }
 }
 

@@ -173,10 +173,12 @@ fn label_only_exports_load_and_score() {
     assert_eq!(summary["rows"].as_u64(), Some(rows.len() as u64));
     // Text-only: the canonical prompt's texts, no image parts, no images.
     let texts = rows[0]["user_texts"][0].as_str().unwrap();
+    // Prompt v5: the scene's head camera first, then the frames' texts.
     assert!(
-        texts.starts_with("Observation frames of the event"),
+        texts.starts_with("THE HEAD CAMERA IN THIS SCENE") && texts.contains("vertical"),
         "{texts}"
     );
+    assert!(texts.contains("Observation frames of the event"), "{texts}");
     assert!(texts.contains("t = 0.60 s (ego camera)"));
     assert!(rows[0]["system"]
         .as_str()

@@ -287,7 +287,7 @@ fn answers_resume_cache_report_and_no_key_anywhere() {
         assert!(l["error"].is_null());
         // 1000 prompt tokens at $10/M + 100 completion tokens at $100/M.
         assert!((l["usage"]["cost"].as_f64().unwrap() - 0.02).abs() < 1e-12);
-        assert_eq!(l["prompt_version"], "rh-prompt-v4");
+        assert_eq!(l["prompt_version"], "rh-prompt-v5");
         assert_eq!(l["prompt_hash"].as_str().unwrap().len(), 64);
         assert!(l["latency_s"].as_f64().unwrap() >= 0.0);
     }
@@ -317,7 +317,7 @@ fn answers_resume_cache_report_and_no_key_anywhere() {
         ],
     );
     let rep: Value = serde_json::from_str(&rep).unwrap();
-    assert_eq!(rep["models"][0]["prompt_version"], "rh-prompt-v4");
+    assert_eq!(rep["models"][0]["prompt_version"], "rh-prompt-v5");
     assert_eq!(rep["models"][0]["lost"], 0);
     assert_eq!(rep["models"][0]["overall"]["first_rule"]["R1"], 1);
     let table = run_ok(
@@ -328,7 +328,7 @@ fn answers_resume_cache_report_and_no_key_anywhere() {
             dataset().to_str().unwrap(),
         ],
     );
-    assert!(table.contains("rh-prompt-v4"), "{table}");
+    assert!(table.contains("rh-prompt-v5"), "{table}");
     assert_no_key_under(d);
 }
 
@@ -560,7 +560,26 @@ fn dry_run_prints_the_request_and_paper_layout_is_refused() {
         .iter()
         .all(|u| u.contains("base64 characters elided")));
     assert!(user.iter().any(|p| p["text"] == "t = 0.60 s (ego camera)"));
-    assert_eq!(v["prompt_version"], "rh-prompt-v4");
+    assert_eq!(v["prompt_version"], "rh-prompt-v5");
+    // Prompt v5 states the scene's head camera: its field of view (the spec's) and pose.
+    let camera = user[0]["text"].as_str().unwrap();
+    let spec: Value = serde_json::from_slice(
+        &std::fs::read(dataset().join(format!("specs/{}.json", v["scene_id"].as_str().unwrap())))
+            .unwrap(),
+    )
+    .unwrap();
+    let ego = spec["cameras"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["name"] == "ego")
+        .unwrap();
+    let fov = ego["fov_y"].as_f64().unwrap().to_degrees();
+    assert!(camera.contains(&format!("{fov:.1}° vertical")), "{camera}");
+    assert!(
+        camera.contains("m in the body frame") && camera.contains("pitch"),
+        "{camera}"
+    );
     assert_eq!(v["body"]["temperature"], 0.0);
     // The estimate covers the whole run: 4 scenes of 5 images each; no price for "m".
     let e = &v["estimate"];

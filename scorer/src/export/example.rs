@@ -110,9 +110,10 @@ fn messages(
     images: bool,
 ) -> Result<(Vec<Message>, Vec<(Vec<u8>, String)>), String> {
     let sub = crate::predict::prompt::subsampling_of(cfg)?;
+    let camera = crate::predict::camera::scene_camera(dir, scene_id)?;
     let mut content = Vec::new();
     let mut frames = Vec::new();
-    for part in user_parts(cfg) {
+    for part in user_parts(cfg, &camera) {
         match part {
             UserPart::Text(t) => content.push(Part::Text(t)),
             UserPart::Frame { camera, t } if images => {

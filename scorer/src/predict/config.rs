@@ -37,6 +37,8 @@ pub struct ImageOptions {
 pub struct PromptText {
     pub system: String,
     pub user_intro: String,
+    /// The scene's head camera calibration (prompt v5; `predict::camera::camera_text`).
+    pub camera: String,
     pub frame_label: String,
     pub user_outro: String,
 }

@@ -7,6 +7,7 @@
 //! scenes, the shared [`rh_llm::Client`] with its cache, retries and adaptive limit, cost
 //! budget, progress).
 
+pub mod camera;
 pub mod config;
 pub mod estimate;
 pub mod output;

@@ -6,6 +6,7 @@
 
 use super::config::{subsampling, PromptConfig};
 use base64::Engine;
+use rh_contract::camera::HeadCamera;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
@@ -224,11 +225,15 @@ pub enum UserPart {
     },
 }
 
-/// The canonical user message's parts: the intro, then per time and camera the frame's
-/// label and the frame, then the outro. [`build`] sends them (frames as JPEG data URLs);
-/// `rh-score export` writes them as training examples (text-only: the texts alone).
-pub fn user_parts(cfg: &PromptConfig) -> Vec<UserPart> {
-    let mut parts = vec![UserPart::Text(fill(&cfg.text.user_intro, cfg))];
+/// The canonical user message's parts: the scene's head camera calibration
+/// (`camera::camera_text`), the intro, then per time and camera the frame's label and the
+/// frame, then the outro. [`build`] sends them (frames as JPEG data URLs); `rh-score
+/// export` writes them as training examples (text-only: the texts alone).
+pub fn user_parts(cfg: &PromptConfig, camera: &HeadCamera) -> Vec<UserPart> {
+    let mut parts = vec![
+        UserPart::Text(super::camera::camera_text(cfg, camera)),
+        UserPart::Text(fill(&cfg.text.user_intro, cfg)),
+    ];
     for &t in &cfg.images.times {
         for cam in &cfg.images.cameras {
             let label = cfg
@@ -274,8 +279,9 @@ pub fn subsampling_of(cfg: &PromptConfig) -> Result<turbojpeg::Subsamp, String> 
 pub fn build(cfg: &PromptConfig, dir: &Path, scene_id: &str) -> Result<BuiltPrompt, String> {
     let cpu0 = thread_cpu_s();
     let sub = subsampling_of(cfg)?;
+    let camera = super::camera::scene_camera(dir, scene_id)?;
     let mut content = Vec::new();
-    for part in user_parts(cfg) {
+    for part in user_parts(cfg, &camera) {
         match part {
             UserPart::Text(text) => content.push(json!({"type": "text", "text": text})),
             UserPart::Frame { camera, t } => {
@@ -366,6 +372,13 @@ mod tests {
         let d = tempfile::tempdir().unwrap();
         let cfg = PromptConfig::load(None).unwrap();
         std::fs::create_dir_all(d.path().join("frames/abcd1234")).unwrap();
+        std::fs::create_dir_all(d.path().join("specs")).unwrap();
+        let spec = serde_json::json!({
+            "cameras": [{"name": "ego", "position": [0.0, 0.0, 1.24],
+                         "look_at": [1.0, 0.0, 1.0], "fov_y": 1.0, "width": 1000, "height": 500}],
+            "observer": {"x": 0.0, "y": 0.0, "yaw": 0.0, "pelvis_z": 0.79}
+        });
+        std::fs::write(d.path().join("specs/abcd1234.json"), spec.to_string()).unwrap();
         for &t in &cfg.images.times {
             let img = image::RgbImage::from_pixel(1000, 500, image::Rgb([200, 10, 10]));
             img.save(d.path().join(frame_rel_path("abcd1234", "ego", t)))
@@ -373,11 +386,16 @@ mod tests {
         }
         let p = build(&cfg, d.path(), "abcd1234").unwrap();
         let user = p.messages[1]["content"].as_array().unwrap();
-        // intro + (label, image) per frame + outro
-        assert_eq!(user.len(), 2 + 2 * cfg.images.times.len());
-        assert_eq!(user[1]["text"], "t = 0.00 s (ego camera)");
-        assert_eq!(user[9]["text"], "t = 0.60 s (ego camera)");
-        let url = user[2]["image_url"]["url"].as_str().unwrap();
+        // camera + intro + (label, image) per frame + outro
+        assert_eq!(user.len(), 3 + 2 * cfg.images.times.len());
+        let camera = user[0]["text"].as_str().unwrap();
+        assert!(
+            camera.contains("768 x 384") && camera.contains("57.3° vertical"),
+            "{camera}"
+        );
+        assert_eq!(user[2]["text"], "t = 0.00 s (ego camera)");
+        assert_eq!(user[10]["text"], "t = 0.60 s (ego camera)");
+        let url = user[3]["image_url"]["url"].as_str().unwrap();
         let jpeg = base64::engine::general_purpose::STANDARD
             .decode(url.strip_prefix("data:image/jpeg;base64,").unwrap())
             .unwrap();
@@ -390,8 +408,15 @@ mod tests {
             .as_str()
             .unwrap()
             .contains("0.60 s"));
+        std::fs::copy(
+            d.path().join("specs/abcd1234.json"),
+            d.path().join("specs/ffffffff.json"),
+        )
+        .unwrap();
         let err = build(&cfg, d.path(), "ffffffff").unwrap_err();
         assert!(err.contains("missing observation frame"), "{err}");
+        let err = build(&cfg, d.path(), "eeeeeeee").unwrap_err();
+        assert!(err.contains("cannot read the scene's spec"), "{err}");
     }
 
     /// [`test_frame`] as `frame.png` in a new temporary directory.
