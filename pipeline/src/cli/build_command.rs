@@ -174,6 +174,10 @@ fn build_and_print(
                 }
             );
         }
+        if let Some(rejections) = &summary.rejections {
+            let replans: u32 = rejections.values().map(|f| f.replans).sum();
+            println!("replans: {replans} group(s) planned afresh to keep every scene valid");
+        }
         if !summary.invalid_scene_ids.is_empty() {
             println!(
                 "warning: {} scene(s) failed validation after every attempt: {}",
