@@ -28,11 +28,6 @@ impl Family for HangingFall {
         }
     }
 
-    /// A push (label rule v6): a faster band's object starts farther up the same board.
-    fn timed(&self) -> bool {
-        true
-    }
-
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
         let object = input.object;
         let room = input.room;
@@ -46,10 +41,7 @@ impl Family for HangingFall {
         };
         let ledge_friction = uniform(rng, 0.15, 0.3);
         let accel = uniform(rng, 0.45, 0.8);
-        let base_to_end = uniform(rng, 0.2, 0.3);
-        let (lead, lead_max) = super::launch::push_leads(input);
-        let com_to_end = base_to_end + lead;
-        let com_max = base_to_end + lead_max;
+        let com_to_end = uniform(rng, 0.2, 0.3);
         let n = heading(site.normal_angle);
         let along = left_of(n);
         let dir = [along[0] * downhill_sign, along[1] * downhill_sign];
@@ -71,10 +63,10 @@ impl Family for HangingFall {
         let (sin_t, cos_t) = tilt.sin_cos();
         let half_len = footprint_half_length(object, 0.0);
         let height = top_offset(object) + bottom_offset(object);
-        let ledge_half_len = (com_max + half_len + 0.05) / 2.0;
+        let ledge_half_len = (com_to_end + half_len + 0.05) / 2.0;
         // The fixture's top stays 10 cm under the ceiling.
         let z_end = bottom_height.min(
-            room.ceiling_height - 0.1 - com_max * sin_t - height * cos_t - half_len * sin_t,
+            room.ceiling_height - 0.1 - com_to_end * sin_t - height * cos_t - half_len * sin_t,
         );
         // The ledge's lower end, its centre line under the fixture's centre.
         let end_xy = ahead(ahead(site.base, n, gap + back), dir, 0.3);
@@ -100,11 +92,7 @@ impl Family for HangingFall {
         };
         let (ledge, hazard) = launch.build(object, input.speed);
         let wall = wall_body(&site, 1.2, room.ceiling_height, 0.5);
-        // Where the fixture starts without the push's lead (the same in every band).
-        let centre = {
-            let p = hazard.position;
-            [p[0] + dir[0] * lead * cos_t, p[1] + dir[1] * lead * cos_t]
-        };
+        let centre = [hazard.position[0], hazard.position[1]];
         // In front of the wall, beyond the ledge's lower end.
         let observer = observer_beyond(
             rng,
