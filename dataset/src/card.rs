@@ -338,7 +338,12 @@ pub fn text(input: &CardInput) -> String {
 
     v.insert(
         "label_rule",
-        label_rule(m, &labels) + &crate::camera_columns::card_note(&m.config),
+        format!(
+            "{}\n{}{}",
+            label_rule(m, &labels),
+            probe_rule(m),
+            crate::camera_columns::card_note(&m.config)
+        ),
     );
 
     insert_provenance(input, &mut v);
@@ -636,7 +641,7 @@ standing body (a knife that stops a metre away: standing still is safe). Rule v4
 every dangerous or too fast reachable hazard `DODGE`, touch or not, and rules v2–v3 every \
 benign reachable one `CATCH`, including balls rolling to the feet, which the executor's \
 humanoid cannot catch (`rh-score --execute`: on a 340-scene build the oracle baseline \
-caught 58 of 146 rule-v3 CATCH labels, 130 of 132 rule-v5 ones; 69 of 72 under rule v4).
+caught 58 of 146 rule-v3 CATCH labels, 134 of 141 rule-v6 ones; 69 of 72 under rule v4).
 * **Escape** (validator `valid_escapable`, rule v4): a `DODGE` scene with danger present whose \
 hazard reaches the observer within {esc_within} s of Δ must be escapable — of {esc_n} walks of {esc_d} m at {esc_v} m/s in evenly spaced directions (the \
 first straight back), hands at rest, executed in physics from Δ by the executor of `rh-score \
@@ -685,6 +690,34 @@ the shins 0.3 s after Δ) is resampled: no decision could matter.",
         harm_table = harm_table(l),
         fast = l.catch_speed_max,
         energy = l.catch_energy_max,
+    )
+}
+
+/// Label rule v6's words on the adversarial probes, with the build's numbers.
+fn probe_rule(m: &Manifest) -> String {
+    let num = |path: &str| m.config.pointer(path).and_then(|x| x.as_f64());
+    let divergence = num("/probes/divergence_min").unwrap_or(0.0);
+    let drag = match (
+        num("/physics/drag/air_density"),
+        num("/physics/drag/terminal_speed_max"),
+    ) {
+        (Some(rho), Some(vt)) => format!(
+            "quadratic air drag F = −½ ρ C_d A(v̂) |v| v (ρ = {rho} kg/m³, C_d {} for spheres and \
+             capsules, {} for boxes and cylinders, A the area projected along the velocity) acts \
+             every step on every body whose terminal speed is below {vt} m/s",
+            num("/physics/drag/sphere_coefficient").unwrap_or(0.0),
+            num("/physics/drag/flat_coefficient").unwrap_or(0.0),
+        ),
+        _ => "no air drag acts".to_string(),
+    };
+    format!(
+        "* **Probes answerable from the window** (rule v6): an adversarial twin pair (the same \
+spec with only the object replaced by its look-alike, `twin_scene_id`) is a probe only where \
+its hazards' centres of mass come at least {divergence} m apart at some physics step of the \
+observation window; other pairs' scenes stay, unpaired (`family_params.twin_divergence_m` \
+records the distance). What reveals the physics: every launch is a push — the spec's \
+velocities are what the push gives a body of `push_mass`, so a lighter twin leaves faster \
+(the same momentum) — and {drag}, so a large light twin falls or swings slower."
     )
 }
 

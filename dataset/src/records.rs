@@ -75,6 +75,9 @@ pub struct GroupRejections {
     pub attempts: u32,
     /// Validator column → attempts it rejected.
     pub rejected_by: BTreeMap<String, u32>,
+    /// Times the group was planned afresh.
+    #[serde(default)]
+    pub replans: u32,
 }
 
 impl GroupRejections {
@@ -87,6 +90,7 @@ impl GroupRejections {
                 .zip(r.rejected_by)
                 .map(|(c, n)| (c.to_string(), n))
                 .collect(),
+            replans: r.replans,
         }
     }
 }
@@ -97,6 +101,8 @@ impl GroupRejections {
 pub struct FamilyRejections {
     pub attempts: u32,
     pub rejected_by: BTreeMap<String, u32>,
+    /// Groups planned afresh (N means N: another object or room of the family).
+    pub replans: u32,
 }
 
 /// Path of group `g`'s attempt counts.
@@ -120,6 +126,7 @@ pub fn gather_rejections(out: &Path, groups: &[u64]) -> Option<BTreeMap<String, 
         let group = read_rejections(out, g)?;
         let family = per_family.entry(group.family).or_default();
         family.attempts += group.attempts;
+        family.replans += group.replans;
         for (column, n) in group.rejected_by {
             *family.rejected_by.entry(column).or_default() += n;
         }

@@ -5,6 +5,7 @@
 //! * [`simulate`] — the deterministic rapier world built from a spec (dt 1/240,
 //!   enhanced determinism) and its per-step state hash;
 //! * [`world`] — the rapier world a spec builds (floor, bodies, joints) and its forks;
+//! * [`drag`] — quadratic air drag on large light bodies (label rule v6);
 //! * [`shapes`] — the spec's shapes and the humanoid's links as rapier shapes;
 //! * [`obstacles`] — line-of-sight queries against the fixed bodies (cameras, visibility);
 //! * [`body`] — the humanoid observer's links (pure geometry);
@@ -15,11 +16,12 @@
 //! * [`seeds`] — the named `rand_chacha` sub-streams.
 //!
 //! Module graph (`A → B`: A uses B): `control → execute → simulate → world, shapes, body,
-//! strike → spec`; `world → shapes`; `obstacles → shapes`;
+//! strike → spec`; `world → drag, shapes`; `drag → shapes`; `obstacles → shapes`;
 //! `seeds` and `spec` use nothing in the crate.
 
 pub mod body;
 pub mod control;
+pub mod drag;
 pub mod execute;
 pub mod obstacles;
 pub mod seeds;

@@ -275,7 +275,7 @@ pub fn resume_step(near: u32) -> u32 {
 fn replay_to(spec: &SceneSpec, steps: u32) -> SceneWorld {
     let mut sw = build_world(spec);
     for _ in 0..steps {
-        sw.world.step();
+        sw.step();
     }
     sw
 }
@@ -327,7 +327,7 @@ fn run(spec: &SceneSpec, options: SimOptions, resume: Option<Resume>) -> Simulat
 
     for step in first_step..=spec.physics.max_steps {
         if step > 0 {
-            sw.world.step();
+            sw.step();
         }
         if keep_at.is_some() && step > 0 && step % SNAPSHOT_STEPS == 0 {
             snapshots.push(fork_world(&sw));

@@ -148,6 +148,12 @@ pub struct BodySpec {
     pub angvel: Vec3,
     /// Continuous collision detection for fast bodies.
     pub ccd: bool,
+    /// The launch is a push (label rule v6): `linvel` and `angvel` are what the push gives
+    /// a body of this mass, so this body starts at them scaled by `push_mass / mass` — the
+    /// same impulse (and, for the same shape, the same angular impulse) on a lighter or
+    /// heavier body. Absent: the body starts at `linvel` and `angvel` as given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub push_mass: Option<f64>,
 }
 
 impl ShapeSpec {
@@ -169,6 +175,17 @@ impl ShapeSpec {
 }
 
 impl BodySpec {
+    /// The factor the push scales the initial velocities by (`push_mass / mass`; 1 without
+    /// a push, for a fixed body, or where the masses agree).
+    pub fn push_scale(&self) -> f64 {
+        match self.push_mass {
+            Some(m) if self.kind == BodyKind::Dynamic && m != self.mass && self.mass > 0.0 => {
+                m / self.mass
+            }
+            _ => 1.0,
+        }
+    }
+
     /// Radius of the smallest sphere around the body's origin holding all its parts.
     pub fn bounding_radius(&self) -> f64 {
         self.parts
@@ -287,6 +304,29 @@ pub struct PhysicsSpec {
     pub max_steps: u32,
     pub settle_speed: f64,
     pub settle_steps: u32,
+    /// Quadratic air drag on large light bodies (label rule v6); absent: none (specs
+    /// before it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drag: Option<DragSpec>,
+}
+
+/// Quadratic air drag, `F = -½ ρ C_d A(v̂) |v| v` through the centre of mass every step,
+/// `A(v̂)` the body's area projected along its velocity (the sum over its parts). Applied
+/// to a dynamic body only when its terminal speed with its largest projected area,
+/// `sqrt(2 m g / (ρ C_d A_max))`, is below `terminal_speed_max`: large light bodies, for
+/// which it decides what the window shows (a foam ceiling panel falls slower than the
+/// real one); for dense bodies it is below the solver's own error over a scene.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DragSpec {
+    /// kg/m³.
+    pub air_density: f64,
+    /// Drag coefficient of spheres and capsules.
+    pub sphere_coefficient: f64,
+    /// Drag coefficient of boxes and cylinders (a flat plate broadside ≈ 1.1).
+    pub flat_coefficient: f64,
+    /// m/s.
+    pub terminal_speed_max: f64,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

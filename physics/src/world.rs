@@ -4,7 +4,7 @@
 //! (`fork_world`), the copies that later runs step on.
 
 use crate::shapes::{collider_for, rot, v3};
-use crate::spec::{BodyKind, JointKind, SceneSpec};
+use crate::spec::{BodyKind, DragSpec, JointKind, PartSpec, SceneSpec};
 use rapier3d::prelude::*;
 
 const FLOOR_HALF_EXTENT: Real = 50.0;
@@ -22,6 +22,21 @@ pub struct SceneWorld {
     pub collider_handles: Vec<ColliderHandle>,
     /// Spec indices of the dynamic bodies, in spec order (the hashed state's order).
     pub dynamic_bodies: Vec<usize>,
+    /// The bodies air drag acts on, in spec order, with their parts (`drag`).
+    pub drag_bodies: Vec<(RigidBodyHandle, Vec<PartSpec>)>,
+    pub drag: Option<DragSpec>,
+}
+
+impl SceneWorld {
+    /// One physics step: the drag forces of this step set, then the solver.
+    pub fn step(&mut self) {
+        if let Some(drag) = &self.drag {
+            for (h, parts) in &self.drag_bodies {
+                crate::drag::apply(&mut self.world.bodies[*h], parts, drag);
+            }
+        }
+        self.world.step();
+    }
 }
 
 /// Builds the spec's world at t0 (no observer). Pure in `spec`.
@@ -48,12 +63,22 @@ pub fn build_world(spec: &SceneSpec) -> SceneWorld {
     let dynamic_bodies: Vec<usize> = (0..spec.bodies.len())
         .filter(|&i| spec.bodies[i].kind == BodyKind::Dynamic)
         .collect();
+    let drag = spec.physics.drag;
+    let gravity = spec.physics.gravity[2].abs();
+    let drag_bodies = drag.map_or_else(Vec::new, |d| {
+        (0..spec.bodies.len())
+            .filter(|&i| crate::drag::feels_drag(&spec.bodies[i], &d, gravity))
+            .map(|i| (body_handles[i], spec.bodies[i].parts.clone()))
+            .collect()
+    });
     SceneWorld {
         world,
         floor,
         body_handles,
         collider_handles,
         dynamic_bodies,
+        drag_bodies,
+        drag,
     }
 }
 
@@ -67,6 +92,8 @@ pub fn fork_world(sw: &SceneWorld) -> SceneWorld {
         body_handles: sw.body_handles.clone(),
         collider_handles: sw.collider_handles.clone(),
         dynamic_bodies: sw.dynamic_bodies.clone(),
+        drag_bodies: sw.drag_bodies.clone(),
+        drag: sw.drag,
     }
 }
 
@@ -94,11 +121,14 @@ fn insert_bodies(
     let mut body_handles = Vec::with_capacity(spec.bodies.len());
     let mut collider_handles = Vec::with_capacity(spec.bodies.len());
     for b in &spec.bodies {
+        // A push gives a body of another mass these velocities (`BodySpec::push_mass`).
+        let scale = b.push_scale();
+        let scaled = |v: [f64; 3]| if scale == 1.0 { v } else { v.map(|c| c * scale) };
         let builder = match b.kind {
             BodyKind::Fixed => RigidBodyBuilder::fixed(),
             BodyKind::Dynamic => RigidBodyBuilder::dynamic()
-                .linvel(v3(b.linvel))
-                .angvel(v3(b.angvel))
+                .linvel(v3(scaled(b.linvel)))
+                .angvel(v3(scaled(b.angvel)))
                 .ccd_enabled(b.ccd)
                 // Never frozen by the sleep heuristic (an object balanced on an edge must
                 // tip); `simulate` stops by its own settle rule instead.

@@ -23,7 +23,7 @@ use serde::Serialize;
 use std::fmt::Write;
 
 /// Counts of ground-truth actions among one family's evaluation subset and pool.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FamilyBalance {
     pub family: String,
     /// The evaluation subset's labels.
@@ -46,6 +46,11 @@ pub struct FamilyBalance {
     pub twin_pairs_differing: usize,
     pub pool_twin_pairs: usize,
     pub pool_twin_pairs_differing: usize,
+    /// Candidate pairs of the pool left unpaired because their hazards did not diverge
+    /// in the window (label rule v6, `[probes] divergence_min`).
+    pub pool_unpaired: usize,
+    /// Every twin pair of the pool (both valid), with its divergence in the window.
+    pub pairs: Vec<PairReport>,
     /// The adversarial objects the pool shows (valid scenes or not).
     pub adversarial_objects: Vec<String>,
 }
@@ -94,6 +99,21 @@ impl Shares {
     }
 }
 
+/// One twin pair of the pool: its scenes, objects and labels, how far apart its hazards
+/// get in the observation window (m, `twins::divergence`), and whether the evaluation
+/// subset holds both scenes.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PairReport {
+    pub probe_scene: u64,
+    pub twin_scene: u64,
+    pub probe_object: String,
+    pub twin_object: String,
+    pub probe_label: String,
+    pub twin_label: String,
+    pub divergence_m: f64,
+    pub in_eval: bool,
+}
+
 /// What `balance --json` prints.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Balance {
@@ -117,6 +137,10 @@ pub struct Balance {
 /// Twin pairs (both scenes valid) and the share whose two labels differ.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct TwinShares {
+    /// Subset pairs whose hazards come at least 0.10 m apart in the window (rule v6).
+    pub eval_diverging: usize,
+    pub eval_share_diverging: f64,
+    pub pool_unpaired: usize,
     pub eval_pairs: usize,
     pub eval_differing: usize,
     pub eval_share_differing: f64,
@@ -141,12 +165,20 @@ impl Balance {
             sum(|f| f.pool_twin_pairs),
             sum(|f| f.pool_twin_pairs_differing),
         );
+        let diverging = families
+            .iter()
+            .flat_map(|f| &f.pairs)
+            .filter(|p| p.in_eval && p.divergence_m >= DIVERGING_M)
+            .count();
         let seen: std::collections::BTreeSet<&String> = families
             .iter()
             .flat_map(|f| &f.adversarial_objects)
             .collect();
         Balance {
             twins: TwinShares {
+                eval_diverging: diverging,
+                eval_share_diverging: share(diverging, pairs),
+                pool_unpaired: sum(|f| f.pool_unpaired),
                 eval_pairs: pairs,
                 eval_differing: differing,
                 eval_share_differing: share(differing, pairs),
@@ -175,6 +207,9 @@ impl Balance {
         }
     }
 }
+
+/// The window divergence a probe pair must show (label rule v6, SPEC §6): 0.10 m.
+pub const DIVERGING_M: f64 = 0.10;
 
 /// Builds the pool of each family in `families` (canonical names; all implemented
 /// families if empty) — the groups a full build of `pool` scenes over all families gives
@@ -232,6 +267,8 @@ pub fn label_balance(
             twin_pairs_differing: 0,
             pool_twin_pairs: 0,
             pool_twin_pairs_differing: 0,
+            pool_unpaired: 0,
+            pairs: Vec::new(),
             adversarial_objects: Vec::new(),
         };
         let mut scenes: Vec<PoolScene> = Vec::new();
@@ -256,12 +293,17 @@ pub fn label_balance(
                 {
                     balance.adversarial_objects.push(object.clone());
                 }
-                scenes.push((
-                    r.spec.scene_index,
-                    r.verdicts.all(),
-                    r.labels.gt_action,
-                    crate::twins::twin_of(&r.spec),
-                ));
+                let divergence = r.spec.family_params.get(crate::twins::DIVERGENCE_PARAM);
+                let twin = crate::twins::twin_of(&r.spec);
+                balance.pool_unpaired += usize::from(divergence.is_some() && twin.is_none());
+                scenes.push(PoolScene {
+                    index: r.spec.scene_index,
+                    valid: r.verdicts.all(),
+                    action: r.labels.gt_action,
+                    twin,
+                    object: object.clone(),
+                    divergence: divergence.copied().unwrap_or(0.0),
+                });
             }
         }
         balance.adversarial_objects.sort();
@@ -274,12 +316,12 @@ pub fn label_balance(
         .flat_map(|(balance, scenes)| {
             scenes
                 .iter()
-                .map(|&(scene_index, valid, action, twin)| EvalRow {
+                .map(|p| EvalRow {
                     family: balance.family.as_str(),
-                    scene_index,
-                    valid,
-                    action: action.as_str(),
-                    twin,
+                    scene_index: p.index,
+                    valid: p.valid,
+                    action: p.action.as_str(),
+                    twin: p.twin,
                 })
         })
         .collect();
@@ -299,13 +341,20 @@ pub fn label_balance(
     Ok(out)
 }
 
-/// A family's pool scenes: (scene index, valid, label, twin's scene index).
-type PoolScene = (u64, bool, Action, Option<u64>);
+/// One pool scene of a family, as the subset and the pair counts need it.
+struct PoolScene {
+    index: u64,
+    valid: bool,
+    action: Action,
+    twin: Option<u64>,
+    object: String,
+    divergence: f64,
+}
 
 /// Counts the labels and twin pairs of a family's chosen scenes (indices into `scenes`).
 fn count_subset(balance: &mut FamilyBalance, scenes: &[PoolScene], chosen: &[usize]) {
     for &i in chosen {
-        match scenes[i].2 {
+        match scenes[i].action {
             Action::Catch => balance.catch += 1,
             Action::Dodge => balance.dodge += 1,
             Action::NoAction => balance.no_action += 1,
@@ -313,21 +362,33 @@ fn count_subset(balance: &mut FamilyBalance, scenes: &[PoolScene], chosen: &[usi
     }
     // Twin pairs, counted once (from the lower index), both scenes valid.
     let at: std::collections::BTreeMap<u64, usize> =
-        scenes.iter().enumerate().map(|(i, s)| (s.0, i)).collect();
-    for (i, &(index, valid, action, twin)) in scenes.iter().enumerate() {
-        let Some(&j) = twin.filter(|&t| t > index).and_then(|t| at.get(&t)) else {
+        scenes.iter().enumerate().map(|(i, s)| (s.index, i)).collect();
+    for (i, p) in scenes.iter().enumerate() {
+        let Some(&j) = p.twin.filter(|&t| t > p.index).and_then(|t| at.get(&t)) else {
             continue;
         };
-        if !(valid && scenes[j].1) {
+        let q = &scenes[j];
+        if !(p.valid && q.valid) {
             continue;
         }
-        let differ = usize::from(action != scenes[j].2);
+        let differ = usize::from(p.action != q.action);
+        let in_eval = chosen.contains(&i) && chosen.contains(&j);
         balance.pool_twin_pairs += 1;
         balance.pool_twin_pairs_differing += differ;
-        if chosen.contains(&i) && chosen.contains(&j) {
+        if in_eval {
             balance.twin_pairs += 1;
             balance.twin_pairs_differing += differ;
         }
+        balance.pairs.push(PairReport {
+            probe_scene: p.index,
+            twin_scene: q.index,
+            probe_object: p.object.clone(),
+            twin_object: q.object.clone(),
+            probe_label: p.action.as_str().to_string(),
+            twin_label: q.action.as_str().to_string(),
+            divergence_m: p.divergence,
+            in_eval,
+        });
     }
 }
 
@@ -369,6 +430,8 @@ pub fn format_table(rows: &[FamilyBalance]) -> String {
         twin_pairs_differing: 0,
         pool_twin_pairs: 0,
         pool_twin_pairs_differing: 0,
+        pool_unpaired: 0,
+        pairs: Vec::new(),
         adversarial_objects: Vec::new(),
     };
     let line = |r: &FamilyBalance| {
@@ -407,6 +470,8 @@ pub fn format_table(rows: &[FamilyBalance]) -> String {
         total.twin_pairs_differing += r.twin_pairs_differing;
         total.pool_twin_pairs += r.pool_twin_pairs;
         total.pool_twin_pairs_differing += r.pool_twin_pairs_differing;
+        total.pool_unpaired += r.pool_unpaired;
+        total.pairs.extend(r.pairs.iter().cloned());
         for (t, n) in total.rejected_by.iter_mut().zip(&r.rejected_by) {
             *t += n;
         }
@@ -431,6 +496,16 @@ pub fn format_table(rows: &[FamilyBalance]) -> String {
         s,
         "adversarial twin pairs: {} in the evaluation subset, {} of them with different labels; {} in the pool, {} differing",
         total.twin_pairs, total.twin_pairs_differing, total.pool_twin_pairs, total.pool_twin_pairs_differing
+    );
+    let diverging = total
+        .pairs
+        .iter()
+        .filter(|p| p.in_eval && p.divergence_m >= DIVERGING_M)
+        .count();
+    let _ = writeln!(
+        s,
+        "twin pairs in the subset whose hazards come >= {DIVERGING_M} m apart in the window: {diverging} of {}; candidate pairs left unpaired (no divergence): {}",
+        total.twin_pairs, total.pool_unpaired / 2
     );
     s
 }

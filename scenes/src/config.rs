@@ -43,6 +43,10 @@ pub struct PhysicsConfig {
     pub settle_speed: f64,
     pub settle_time_s: f64,
     pub solver_iterations: usize,
+    /// `[physics.drag]`: quadratic air drag on large light bodies (label rule v6); absent:
+    /// none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drag: Option<rh_physics::spec::DragSpec>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -74,6 +78,10 @@ pub struct ValidatorConfig {
     /// its family) up to this many times (label rule v5).
     #[serde(default)]
     pub replans: u32,
+    /// N means N: a group still invalid after `replans` is planned afresh again, up to
+    /// this many plans in all beyond its first (0: no more than `replans`).
+    #[serde(default)]
+    pub replans_max: u32,
     pub penetration_tolerance: f64,
     pub energy_gain_relative: f64,
     pub energy_gain_absolute: f64,
@@ -290,6 +298,11 @@ pub struct Config {
     /// member, whichever object they show. Not part of any file.
     #[serde(skip)]
     pub aimed_as: Option<String>,
+    /// Set by the driver for the groups of a twin pair (label rule v6): every launch is the
+    /// push that gives this catalog object (the pair's benign member) the layout's
+    /// velocities, whichever object the group shows. Not part of any file.
+    #[serde(skip)]
+    pub pushed_as: Option<String>,
     /// Where the configuration came from (for messages; not part of its content).
     #[serde(skip)]
     pub source: String,
@@ -336,6 +349,7 @@ impl Config {
             eval: raw.eval,
             probes: raw.probes,
             aimed_as: None,
+            pushed_as: None,
             source: name.to_string(),
         };
         config.validate(name, labels_name)?;
@@ -716,7 +730,7 @@ mod tests {
     fn embedded_config_is_valid() {
         let c = Config::embedded().unwrap();
         assert!((c.physics.dt - 1.0 / 240.0).abs() < 1e-15);
-        assert_eq!(c.labels.rule_version, "v5");
+        assert_eq!(c.labels.rule_version, "v6");
         for f in &c.build.families {
             assert!(
                 c.speed_bands(f).is_some(),

@@ -181,23 +181,24 @@ pub fn produce_planned_group(
         adversarial
     };
     probe_config.aimed_as = Some(benign.id.clone());
-    // A twin group rebuilds its probe group (deterministic) with all four bands.
-    let probe_count = if slot.role == twins::Role::Probe {
-        count
-    } else {
-        4
-    };
+    if slot.pair.twin {
+        probe_config.pushed_as = Some(benign.id.clone());
+    }
+    // Both groups of a pair build the whole pair (deterministic): the probe's four bands
+    // and, for a twin pair, the twins labelled — once per process ([`PROBES`]).
+    let probe_count = if slot.pair.twin { 4 } else { count };
     let produce = || {
         let bands = Bands {
             build_seed: seed,
             first_index: slot.probe_group * 4,
             count: probe_count,
         };
-        probe_group_counted(&selection, bands, catalog, &probe_config).map_err(|e| e.to_string())
+        let (mut probe, rejections) = probe_group_counted(&selection, bands, catalog, &probe_config)
+            .map_err(|e| e.to_string())?;
+        let twins = slot.pair.twin.then(|| pair_twins(&mut probe, &slot, genuine, config));
+        Ok((probe, rejections, twins.flatten()))
     };
-    // The probe group and its twin group both take the probe's four bands: produced once
-    // per process ([`PROBES`]), by whichever of the two comes first.
-    let produced = if slot.pair.twin && probe_count == 4 {
+    let produced = if slot.pair.twin {
         let key = ProbeKey {
             seed,
             probe_group: slot.probe_group,
@@ -209,24 +210,49 @@ pub fn produce_planned_group(
     } else {
         produce()
     };
-    let (mut probe, rejections) = produced.map_err(GroupError::Input)?;
-    let mut twin = Vec::new();
-    for (band, r) in probe.iter_mut().enumerate() {
-        if !slot.pair.twin {
-            break;
-        }
-        let index = slot.twin_group * 4 + band as u64;
-        let spec = twins::twin_spec(&mut r.spec, genuine, index, slot.twin_group);
-        if slot.role == twins::Role::Twin && (band as u64) < count {
-            let spec = SceneSpec::from_json(&spec.to_json()).expect("a spec parses back");
-            let sim = simulate(&spec, SimOptions::default());
-            twin.push(label_scene(spec, sim, config));
-        }
+    let (mut probe, rejections, twins) = produced.map_err(GroupError::Input)?;
+    let valid = |r: &[SceneResult]| r.iter().all(|r| r.verdicts.all());
+    // N means N: a probe (or twin) group that cannot be made valid gives way to a group
+    // planned afresh, unpaired (the pair's other group then names no twin either).
+    let replanned = || replanned_group(catalog, families, seed, g, count, config).map_err(|e| input(&e));
+    if slot.role == twins::Role::Probe {
+        probe.truncate(count as usize);
+        return if valid(&probe) { Ok((probe, rejections)) } else { replanned() };
     }
-    if std::env::var_os("RH_TWIN_DEBUG").is_some() && slot.role == twins::Role::Twin {
+    let Some(mut twin) = twins else {
+        return replanned();
+    };
+    twin.truncate(count as usize);
+    let rejected = Rejections {
+        attempts: 1,
+        ..Rejections::default()
+    };
+    Ok((twin, rejected))
+}
+
+/// The twins of a twin pair's probe bands, labelled (`config`: the build's, not the
+/// probe's), each pair kept only where its hazards diverge in the window
+/// ([`twins::keep_if_divergent`]). `None` — and every probe band unpaired — when a probe
+/// or twin band fails a validator: then the twin group is planned afresh.
+fn pair_twins(
+    probe: &mut [SceneResult],
+    slot: &twins::Slot,
+    genuine: &rh_catalog::Object,
+    config: &Config,
+) -> Option<Vec<SceneResult>> {
+    let mut twin = Vec::with_capacity(probe.len());
+    for (band, r) in probe.iter_mut().enumerate() {
+        let index = slot.twin_group * 4 + band as u64;
+        let mut spec = twins::twin_spec(&mut r.spec, genuine, index, slot.twin_group);
+        spec = SceneSpec::from_json(&spec.to_json()).expect("a spec parses back");
+        twins::keep_if_divergent(&mut r.spec, &mut spec, config.probes.divergence_min);
+        let sim = simulate(&spec, SimOptions::default());
+        twin.push(label_scene(spec, sim, config));
+    }
+    if std::env::var_os("RH_TWIN_DEBUG").is_some() {
         for (p, t) in probe.iter().zip(&twin) {
             eprintln!(
-                "twin {} {} {:?} {}/{} valid {}/{} {:?}",
+                "twin {} {} {:?} {}/{} valid {}/{} {:?} d {:.3}",
                 p.spec.family,
                 p.spec.selection.object_id,
                 crate::intent::Intent::of(&p.spec),
@@ -234,21 +260,20 @@ pub fn produce_planned_group(
                 t.labels.gt_action.as_str(),
                 p.verdicts.all(),
                 t.verdicts.all(),
-                t.verdicts.as_array()
+                t.verdicts.as_array(),
+                t.spec.family_params.get(twins::DIVERGENCE_PARAM).copied().unwrap_or(0.0)
             );
         }
     }
-    if slot.role == twins::Role::Probe {
-        return Ok((probe, rejections));
+    let all_valid = probe.iter().chain(&twin).all(|r| r.verdicts.all());
+    if !all_valid {
+        for r in probe.iter_mut() {
+            r.spec.family_params.remove(twins::TWIN_PARAM);
+            r.spec.family_params.remove(twins::DIVERGENCE_PARAM);
+        }
+        return None;
     }
-    let mut rejected = Rejections {
-        attempts: 1,
-        ..Rejections::default()
-    };
-    for (v, n) in rejected.rejected_by.iter_mut().enumerate() {
-        *n = u32::from(twin.iter().any(|r| !r.verdicts.as_array()[v]));
-    }
-    Ok((twin, rejected))
+    Some(twin)
 }
 
 /// What a probe group's bands are a function of (with the driver's code): the build's
@@ -264,8 +289,12 @@ struct ProbeKey {
 }
 
 /// Probe groups produced for their twin group or by it, until both have taken them.
-static PROBES: crate::shared::Shared<ProbeKey, Result<(Vec<SceneResult>, Rejections), String>> =
+static PROBES: crate::shared::Shared<ProbeKey, Result<ProbePair, String>> =
     crate::shared::Shared::new(64);
+
+/// A probe group's bands, its attempts, and its labelled twins (`None`: no twin pair, or
+/// one that could not be made valid).
+type ProbePair = (Vec<SceneResult>, Rejections, Option<Vec<SceneResult>>);
 
 /// A group the planner deals (no probe pair): a group none of whose attempts passes
 /// every validator (a heavy pillow thrown at the chest that no walk escapes), or whose
@@ -317,6 +346,7 @@ fn replanned_group(
         // While a replan is left for it, a group whose event cannot be aimed is planned
         // afresh.
         let require_aim = replan < aim_replans;
+        total.replans = replan;
         let Some(results) = produce(replan, require_aim, &mut total)? else {
             continue;
         };
@@ -329,6 +359,17 @@ fn replanned_group(
     for replan in 0..aim_replans {
         if let Some(results) = produce(replan, false, &mut total)?.filter(|r| valid(r)) {
             return Ok((results, total));
+        }
+    }
+    // N means N: plans beyond `replans` (attempt-indexed: replan k is a pure function of
+    // the build seed, the group and k) until one passes, up to `replans_max`.
+    for replan in config.validators.replans + 1..=config.validators.replans_max {
+        total.replans = replan;
+        if let Some(results) = produce(replan, false, &mut total)? {
+            if valid(&results) {
+                return Ok((results, total));
+            }
+            last = results;
         }
     }
     Ok((last, total))
@@ -560,6 +601,8 @@ fn label_group_if_valid(
 pub struct Rejections {
     pub attempts: u32,
     pub rejected_by: [u32; VALIDATOR_COLUMNS.len()],
+    /// Times the group was planned afresh (another object or room of its family).
+    pub replans: u32,
 }
 
 /// Produces scenes `first_index .. first_index + count` (one group, `count` ≤ 4 bands).

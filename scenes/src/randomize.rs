@@ -113,7 +113,13 @@ pub fn randomize(
             config.aim.hands_half_length_max,
         ),
     };
-    let layout = family.sample(&input, &mut seeds::stream(seed, key.attempt, "placement"));
+    let mut layout = family.sample(&input, &mut seeds::stream(seed, key.attempt, "placement"));
+    let pushed_as = config
+        .pushed_as
+        .as_deref()
+        .and_then(|id| catalog.object(id))
+        .unwrap_or(object);
+    push_launch(&mut layout.bodies, &object.id, pushed_as.mass);
 
     let mut lighting_rng = seeds::stream(seed, key.attempt, "lighting");
     let elevation: f64 = lighting_rng.random_range(0.6..1.3);
@@ -166,6 +172,7 @@ pub fn randomize(
             max_steps: steps(config.physics.horizon_s),
             settle_speed: config.physics.settle_speed,
             settle_steps: steps(config.physics.settle_time_s).max(1),
+            drag: config.physics.drag,
         },
         bodies: layout.bodies,
         joints: layout.joints,
@@ -192,4 +199,19 @@ pub fn randomize(
         family_params,
         labels: config.labels.clone(),
     })
+}
+
+/// Every launch is a push (label rule v6): each body showing the object that starts
+/// moving gets the push that gives a body of `push_mass` its velocities — the object's own
+/// mass, or for an adversarial twin pair's probe the benign member's (`twins`), so the
+/// pair's twins, which differ only in the object, leave at speeds in the inverse ratio of
+/// their masses.
+fn push_launch(bodies: &mut [rh_physics::spec::BodySpec], object_id: &str, push_mass: f64) {
+    for b in bodies
+        .iter_mut()
+        .filter(|b| b.catalog_id.as_deref() == Some(object_id))
+        .filter(|b| b.linvel != [0.0; 3] || b.angvel != [0.0; 3])
+    {
+        b.push_mass = Some(push_mass);
+    }
 }

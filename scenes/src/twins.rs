@@ -30,12 +30,22 @@ use serde::{Deserialize, Serialize};
 /// The `family_params` key holding the other scene's index of a twin pair.
 pub const TWIN_PARAM: &str = "twin_scene_index";
 
+/// The `family_params` key holding how far apart the pair's hazards get within the
+/// observation window (m, [`divergence`]); kept on both scenes also when the pair is
+/// dropped for showing too little.
+pub const DIVERGENCE_PARAM: &str = "twin_divergence_m";
+
 /// `[probes]` of `configs/default.toml` (absent: no twins, builds before label rule v5).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ProbeConfig {
     #[serde(default)]
     pub pairs: Vec<ProbePair>,
+    /// Label rule v6: a pair is a probe only where its hazards' centres of mass come this
+    /// far apart (m) at some physics step of the observation window [`divergence`];
+    /// otherwise both scenes stay, unpaired. 0: every pair is kept (rule v5).
+    #[serde(default)]
+    pub divergence_min: f64,
 }
 
 /// One probe pair: the disguised object and the family that shows it.
@@ -175,6 +185,46 @@ pub fn twin_spec(
     twin
 }
 
+/// The hazard's centre of mass at every physics step of the observation window
+/// `0..=Δ` of `spec`'s plain run (no observer), stepped exactly as the build's run.
+pub fn window_path(spec: &SceneSpec) -> Vec<[f64; 3]> {
+    let mut sw = rh_physics::world::build_world(spec);
+    let hazard = sw.body_handles[spec.hazard];
+    let com = |sw: &rh_physics::world::SceneWorld| {
+        let c = sw.world.bodies[hazard].center_of_mass();
+        [c.x as f64, c.y as f64, c.z as f64]
+    };
+    let mut path = vec![com(&sw)];
+    for _ in 0..spec.decision_step() {
+        sw.step();
+        path.push(com(&sw));
+    }
+    path
+}
+
+/// Label rule v6: how far apart two scenes' hazards get within the observation window —
+/// the largest distance between their centres of mass at one physics step of `0..=Δ`.
+pub fn divergence(a: &SceneSpec, b: &SceneSpec) -> f64 {
+    window_path(a)
+        .iter()
+        .zip(window_path(b))
+        .map(|(p, q)| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt())
+        .fold(0.0, f64::max)
+}
+
+/// Records a pair's divergence on both scenes and, below `divergence_min`, unpairs them
+/// (neither names the other): the pair's physics does not show in the window.
+pub fn keep_if_divergent(probe: &mut SceneSpec, twin: &mut SceneSpec, divergence_min: f64) -> f64 {
+    let d = divergence(probe, twin);
+    for s in [&mut *probe, &mut *twin] {
+        s.family_params.insert(DIVERGENCE_PARAM.into(), d);
+        if d < divergence_min {
+            s.family_params.remove(TWIN_PARAM);
+        }
+    }
+    d
+}
+
 /// The other scene's index of a twin pair, if `spec` is in one.
 pub fn twin_of(spec: &SceneSpec) -> Option<u64> {
     spec.family_params.get(TWIN_PARAM).map(|&i| i as u64)
@@ -202,6 +252,7 @@ mod tests {
                 pair("y", "b", false),
                 pair("z", "b", true),
             ],
+            divergence_min: 0.1,
         };
         // Family b owns groups 1, 4, 7, 10, 13, 16, …: x takes 1 and 4, y 7, z 10 and 13.
         let roles: Vec<(u64, &str, Role, u64)> = (0..20)

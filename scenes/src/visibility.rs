@@ -321,6 +321,7 @@ mod tests {
             linvel: [0.0; 3],
             angvel: [0.0; 3],
             ccd: false,
+            push_mass: None,
         }
     }
 

@@ -164,7 +164,7 @@ fn dataset_build_layout_card_and_manifest() {
         "a label-only build records no adapter"
     );
     assert_eq!(manifest["shard"], serde_json::json!([0, 1]));
-    assert_eq!(manifest["config"]["labels"]["rule_version"], "v5");
+    assert_eq!(manifest["config"]["labels"]["rule_version"], "v6");
 }
 
 #[test]
@@ -395,7 +395,7 @@ print(json.dumps({{"bad": bad, "rows": len(t), "touched": touched, "dodge": dodg
     );
     let out: serde_json::Value = serde_json::from_str(python(&script).trim()).unwrap();
     assert_eq!(out["bad"], serde_json::json!([]), "{out}");
-    assert_eq!(out["rule"], serde_json::json!(["v5"]), "{out}");
+    assert_eq!(out["rule"], serde_json::json!(["v6"]), "{out}");
     assert!(out["touched"].as_u64().unwrap() >= 5, "{out}");
     assert!(out["dodge"].as_u64().unwrap() >= 3, "{out}");
     eprintln!("{out}");

@@ -105,7 +105,7 @@ pub fn replay(spec: &SceneSpec) -> Replay {
     let mut hasher = Sha256::new();
     world.hash_step(&mut hasher);
     for _ in 0..decision_step {
-        world.world.step();
+        world.step();
         world.hash_step(&mut hasher);
     }
     Replay {

@@ -267,7 +267,7 @@ impl Execution {
         }
         let v_before = sw.world.bodies[self.hazard_b].linvel();
         let w_before = sw.world.bodies[self.hazard_b].angvel();
-        sw.world.step();
+        sw.step();
         self.executed = k + 1;
         sw.hash_step(&mut self.hasher);
         for (b, _) in &self.links {

@@ -181,6 +181,10 @@ fn build_and_print(
                 }
             ))?;
         }
+        if let Some(rejections) = &summary.rejections {
+            let replans: u32 = rejections.values().map(|f| f.replans).sum();
+            println!("replans: {replans} (scene groups planned afresh, another object or room of their family: unaimable or invalid plans)");
+        }
         if !summary.invalid_scene_ids.is_empty() {
             println(&format!(
                 "warning: {} scene(s) failed validation after every attempt: {}",

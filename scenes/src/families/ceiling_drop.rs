@@ -24,6 +24,11 @@ impl Family for CeilingDrop {
         }
     }
 
+    /// A push (label rule v6): a faster band's object starts farther up the same board.
+    fn timed(&self) -> bool {
+        true
+    }
+
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
         let object = input.object;
         let ceiling = input.room.ceiling_height;
@@ -32,7 +37,10 @@ impl Family for CeilingDrop {
         let yaw = uniform(rng, -0.3, 0.3);
         let plate_friction = uniform(rng, 0.25, 0.4);
         let accel = uniform(rng, 0.45, 0.8);
-        let com_to_edge = uniform(rng, 0.18, 0.28);
+        let base_to_edge = uniform(rng, 0.18, 0.28);
+        let (lead, lead_max) = push_leads(input);
+        let com_to_edge = base_to_edge + lead;
+        let com_max = base_to_edge + lead_max;
         let behind = uniform(rng, 0.0, 1.0) < 0.2;
         let origin = event_origin(rng, input.room, dir, 0.5);
 
@@ -42,12 +50,12 @@ impl Family for CeilingDrop {
         let (sin_t, cos_t) = tilt.sin_cos();
         let (_, half_len) = slope_pose_extents(object, lying, yaw);
         let half_wide = footprint_half_length(object, yaw + std::f64::consts::FRAC_PI_2);
-        let plate_half_len = (com_to_edge + half_len + 0.05) / 2.0;
+        let plate_half_len = (com_max + half_len + 0.05) / 2.0;
         // The plate's lower edge as high as the plate's upper end and the fixture's
         // highest corner allow (a few centimetres under the ceiling).
         let height = top_offset(object) + bottom_offset(object);
         let edge_z = (ceiling - 0.03 - 2.0 * plate_half_len * sin_t)
-            .min(ceiling - 0.04 - com_to_edge * sin_t - height * cos_t - half_len * sin_t);
+            .min(ceiling - 0.04 - com_max * sin_t - height * cos_t - half_len * sin_t);
         let launch = TiltedLaunch {
             surface_name: "mount",
             edge: [origin[0], origin[1], edge_z],
@@ -89,7 +97,7 @@ impl Family for CeilingDrop {
             // Behind the mount: the fixture slides and falls away from the observer.
             observer_beyond(
                 rng,
-                ahead(origin, dir, -com_to_edge),
+                ahead(origin, dir, -com_max),
                 [-dir[0], -dir[1]],
                 (1.3, 1.7),
                 (2.2, 2.8),

@@ -68,6 +68,11 @@ impl Family for EdgeCreep {
         }
     }
 
+    /// A push (label rule v6): a faster band's object starts farther up the same board.
+    fn timed(&self) -> bool {
+        true
+    }
+
     fn event_happened(&self, spec: &SceneSpec, sim: &Simulation) -> bool {
         // The object left the board and reached the floor.
         reached_floor(spec, sim)
@@ -88,14 +93,16 @@ impl Family for EdgeCreep {
         let lateral = draw(rng, self.lateral);
         let relative_yaw = draw(rng, self.relative_yaw);
         let accel = draw(rng, self.accel);
-        let com_to_edge = draw(rng, self.com_to_edge);
+        let base_to_edge = draw(rng, self.com_to_edge);
+        let (lead, lead_max) = super::launch::push_leads(input);
+        let com_to_edge = base_to_edge + lead;
         let origin = event_origin(rng, input.room, dir, self.origin_back);
 
         let mu = combined_friction(object.friction, friction);
         let tilt = creep_tilt(object, mu, accel);
         let lying = lies_on_slope(object, tilt);
         let (_, half_len) = slope_pose_extents(object, lying, relative_yaw);
-        let board_half_len = (com_to_edge + half_len + 0.05) / 2.0;
+        let board_half_len = (base_to_edge + lead_max + half_len + 0.05) / 2.0;
         // The board's lower edge: the table's front edge, or the event's origin.
         let edge_xy = match table_half_depth {
             Some(d) => ahead(origin, dir, d),
@@ -115,7 +122,12 @@ impl Family for EdgeCreep {
             lying,
         };
         let (board, hazard) = launch.build(object, input.speed);
-        let start = hazard.position;
+        // Where the object starts without the push's lead (the same in every band).
+        let start = {
+            let p = hazard.position;
+            let run = lead * tilt.cos();
+            [p[0] + dir[0] * run, p[1] + dir[1] * run]
+        };
         let mut bodies = vec![board, hazard];
         if let (Some(t), Some(d)) = (self.table, table_half_depth) {
             let top = height - t.top_below_edge;

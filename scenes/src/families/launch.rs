@@ -145,6 +145,21 @@ pub fn rests_on_a_ball(object: &Object) -> bool {
         .any(|p| p.shape == ShapeKind::Sphere && p.half_extents()[2] - p.offset[2] >= bottom - 1e-9)
 }
 
+/// A creeping launch is a push (label rule v6): the board is longer by the distance the
+/// band's push carries the object in this time (s), so the object a layout is drawn for
+/// reaches the edge about when rule v5's slower nudge brought it there, and a much
+/// heavier look-alike, which the same push barely moves, creeps from rest behind it — at
+/// least `0.6 · v` apart by Δ (0.12 m at the slowest band's 0.2 m/s).
+pub const PUSH_LEAD_S: f64 = 0.6;
+
+/// The push lead of the band at `speed` and of the group's fastest band (m): the board is
+/// as long as the fastest band needs, the same in every band, and a faster band's object
+/// starts farther up it (a timed family, `Family::timed`).
+pub fn push_leads(input: &FamilyInput) -> (f64, f64) {
+    let fastest = input.band_speeds.iter().copied().fold(0.0, f64::max);
+    (input.speed * PUSH_LEAD_S, fastest * PUSH_LEAD_S)
+}
+
 /// Shared layout for "creeps down a tilted board and off its lower edge" (a tray propped
 /// on a table, a sagging shelf board, a bent ceiling mount plate): a thin fixed board
 /// sloping down along `heading_angle` by `tilt`, and the hazard resting on it, its centre

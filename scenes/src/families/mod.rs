@@ -197,6 +197,7 @@ pub fn hazard_body(
         linvel,
         angvel,
         ccd: true,
+        push_mass: None,
     }
 }
 
@@ -227,6 +228,7 @@ pub fn fixed_box(
         linvel: [0.0; 3],
         angvel: [0.0; 3],
         ccd: false,
+        push_mass: None,
     }
 }
 
@@ -489,6 +491,7 @@ pub fn prop_box(
         linvel,
         angvel: [0.0; 3],
         ccd: true,
+        push_mass: None,
     }
 }
 
@@ -580,6 +583,7 @@ mod tests {
                 }
                 let timing = [
                     "com_behind_edge_m",
+                    "com_to_ledge_end_m",
                     "trigger_gap_m",
                     "run_up_m",
                     "slide_distance_m",
