@@ -54,7 +54,7 @@ impl ProgressLog {
                     } else {
                         eta_text(total.saturating_sub(done) as f64 / rate)
                     };
-                    eprintln!(
+                    crate::note!(
                         "{what}: {done}/{total} {unit} · {rate:.3}/s · {:.0} s elapsed · ETA {eta}",
                         secs
                     );

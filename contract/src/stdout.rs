@@ -10,6 +10,25 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 static CLOSED: AtomicBool = AtomicBool::new(false);
 
+/// `eprintln!` that never panics: a message for stderr, dropped when stderr cannot take
+/// it (`2> /dev/full`, a closed pipe) instead of aborting the command.
+#[macro_export]
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        use ::std::io::Write as _;
+        let _ = ::std::writeln!(::std::io::stderr(), $($arg)*);
+    }};
+}
+
+/// `eprint!` that never panics (see [`note!`]).
+#[macro_export]
+macro_rules! note_part {
+    ($($arg:tt)*) => {{
+        use ::std::io::Write as _;
+        let _ = ::std::write!(::std::io::stderr(), $($arg)*);
+    }};
+}
+
 /// Writes `text` to stdout and flushes it.
 pub fn print(text: &str) -> Result<(), CannotWrite> {
     write_to(&mut std::io::stdout().lock(), text.as_bytes())
@@ -65,7 +84,7 @@ pub fn help_help_as_help(args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsStrin
 pub fn parser_print_status(code: i32, print: std::io::Result<()>, program: &str) -> u8 {
     match print {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            eprintln!("{program}: cannot write stdout: {e}");
+            crate::note!("{program}: cannot write stdout: {e}");
             crate::fsio::EXIT_CANNOT_WRITE
         }
         _ => u8::try_from(code).unwrap_or(2),

@@ -361,7 +361,7 @@ fn remove_stale_staging(parent: &Path, out_name: &str) {
         };
         let alive = pid != std::process::id() && Path::new(&format!("/proc/{pid}")).exists();
         if !alive {
-            eprintln!(
+            rh_contract::note!(
                 "removing {} (left by a merge that was stopped)",
                 e.path().display()
             );

@@ -171,7 +171,7 @@ pub fn load_record(out: &Path, manifest: &Manifest, g: u64) -> Option<RecordBatc
     }
     let problems = integrity::check(out, &sums);
     if !problems.is_empty() {
-        eprintln!(
+        rh_contract::note!(
             "group {g}: {}; computing it again",
             integrity::describe(&problems, 3)
         );

@@ -324,9 +324,10 @@ impl Remote {
                 blob.exists() && crate::cache::content_matches(&blob, &e.blob).unwrap_or(false);
             if !good {
                 if blob.exists() {
-                    eprintln!(
+                    rh_contract::note!(
                         "{}: cached blob {} does not match its hash; fetching it again",
-                        e.path, e.blob
+                        e.path,
+                        e.blob
                     );
                     let _ = std::fs::remove_file(&blob);
                 }
@@ -348,7 +349,7 @@ impl Remote {
             }
             done += 1;
             if total >= 50 && (done * 10 / total) != ((done - 1) * 10 / total) {
-                eprintln!("downloaded {done}/{total} files");
+                rh_contract::note!("downloaded {done}/{total} files");
             }
         }
         drop(stream);

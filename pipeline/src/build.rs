@@ -435,7 +435,7 @@ fn finished_build(
         .unwrap_or_else(|| manifest.clone());
     let problems = reopen_if_damaged(out, &on_disk).map_err(BuildError::Internal)?;
     if !problems.is_empty() {
-        eprintln!(
+        rh_contract::note!(
             "{} holds this build, but {} file(s) are not what its {MANIFEST_FILE} records ({}); rebuilding the groups they belong to",
             out.display(),
             problems.len(),
@@ -444,7 +444,7 @@ fn finished_build(
         return Ok(None);
     }
     if progress {
-        eprintln!(
+        rh_contract::note!(
             "{} already holds this build, complete; nothing to do",
             out.display()
         );
@@ -503,7 +503,7 @@ pub fn build(
         .copied()
         .partition(|&g| load_record(out, &manifest, g).is_some());
     if !done.is_empty() && opts.progress {
-        eprintln!(
+        rh_contract::note!(
             "resumed {} groups from {} (finished before the last run stopped)",
             done.len(),
             out.join(WORK_DIR).display()
@@ -530,7 +530,7 @@ pub fn build(
 
     let scenes_todo: u64 = todo.iter().map(|&g| manifest.group_size(g)).sum();
     if let (Some(banner), true) = (&render_banner, opts.progress && scenes_todo > 0) {
-        eprintln!("{banner}");
+        rh_contract::note!("{banner}");
     }
     let progress = Progress::new(scenes_todo, opts.progress, opts.progress_every_s);
     let pool = rayon::ThreadPoolBuilder::new()

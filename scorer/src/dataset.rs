@@ -424,7 +424,7 @@ pub fn check_finished(dir: &Path, allow_incomplete: bool) -> Result<()> {
     match rh_dataset::manifest::unfinished(dir).map_err(InputError)? {
         None => Ok(()),
         Some(why) if allow_incomplete => {
-            eprintln!("rh-score: warning: {why}. Used as it is (--allow-incomplete).");
+            rh_contract::note!("rh-score: warning: {why}. Used as it is (--allow-incomplete).");
             Ok(())
         }
         Some(why) => Err(InputError(format!(
@@ -463,7 +463,7 @@ pub fn resolve_dir(arg: Option<String>) -> Result<PathBuf> {
     match rh_hub::fetch(repo, revision) {
         Ok(snapshot) => {
             if let Some(note) = snapshot.cache_note(repo) {
-                eprintln!("rh-score: {note}");
+                rh_contract::note!("rh-score: {note}");
             }
             Ok(snapshot.path)
         }

@@ -98,7 +98,7 @@ fn write_videos(
     )?;
     let decisions: usize = index.scenes.iter().map(|s| s.decisions.len()).sum();
     let secs = started.elapsed().as_secs_f64();
-    eprintln!(
+    rh_contract::note!(
         "rh-score: execution videos of {decisions} decisions in {} scenes ({:.2} s per decision) in {}; see {}",
         index.scenes.len(),
         secs / decisions.max(1) as f64,

@@ -652,6 +652,30 @@ fn a_closed_pipe_ends_quietly_and_a_full_stdout_is_exit_3() {
         !std::fs::metadata("/dev/full").unwrap().is_file(),
         "/dev/full replaced"
     );
+    // A full stderr drops the message, never panics: the exit status still says why.
+    for (name, args, code) in [
+        (
+            "rh-score",
+            vec![s(&f.oracle), "--dataset", "/nonexistent"],
+            2,
+        ),
+        (
+            "rh-pipeline",
+            vec!["build", "--n", "0", "--out", "/nonexistent"],
+            2,
+        ),
+    ] {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let o = Command::new(bin(name))
+            .args(&args)
+            .stderr(Stdio::from(full))
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(code), "{name} {args:?} 2> /dev/full");
+    }
 }
 
 fn refused(o: &Output, needles: &[&str], what: &str) {

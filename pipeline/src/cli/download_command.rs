@@ -11,7 +11,7 @@ pub fn run(repo: &str, revision: Option<&str>, out: Option<&Path>) -> Result<(),
         message: e.to_string(),
     })?;
     if let Some(note) = snapshot.cache_note(repo) {
-        eprintln!("{note}");
+        rh_contract::note!("{note}");
     }
     let path = match out {
         Some(dir) => {
@@ -19,7 +19,7 @@ pub fn run(repo: &str, revision: Option<&str>, out: Option<&Path>) -> Result<(),
                 code: 1,
                 message: format!("cannot copy {repo} into {}: {e}", dir.display()),
             })?;
-            eprintln!("copied {files} files into {}", dir.display());
+            rh_contract::note!("copied {files} files into {}", dir.display());
             dir.to_path_buf()
         }
         None => snapshot.path,

@@ -92,7 +92,7 @@ pub fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(f) => {
-            eprintln!("rh-pipeline: {}", f.message);
+            rh_contract::note!("rh-pipeline: {}", f.message);
             ExitCode::from(f.code)
         }
     }

@@ -17,7 +17,7 @@ pub fn run(dir: &Path, catalog: &Catalog, fast: bool, json: bool) -> Result<(), 
     if json {
         // The report on stdout stays one JSON object; the adapter lines go to stderr.
         for line in &adapter {
-            eprintln!("{line}");
+            rh_contract::note!("{line}");
         }
         print_json(&report)?;
     } else {

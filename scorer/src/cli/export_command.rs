@@ -35,7 +35,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
             opts.out.join(&summary.file).display()
         ))?;
         if summary.no_eval_subset && summary.split == "train" {
-            eprintln!(
+            rh_contract::note!(
                 "rh-score: note: {} has no eval/ subset, so --split train took every valid scene",
                 opts.dataset.display()
             );

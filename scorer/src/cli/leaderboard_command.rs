@@ -16,7 +16,7 @@ pub fn run(
     let board = merge(files)?;
     if let Some(dir) = html {
         render::write_html(&board, dir)?;
-        eprintln!(
+        rh_contract::note!(
             "rh-score: leaderboard site in {}",
             dir.join("index.html").display()
         );

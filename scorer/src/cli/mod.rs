@@ -76,7 +76,7 @@ pub fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("rh-score: error: {e:#}");
+            rh_contract::note!("rh-score: error: {e:#}");
             if is_cannot_write(&e) {
                 ExitCode::from(rh_contract::fsio::EXIT_CANNOT_WRITE)
             } else if is_input_error(&e) {

@@ -60,7 +60,7 @@ pub fn run(a: PredictArgs) -> Result<()> {
     };
     crate::predict::check_price(&a.model, a.max_cost, price)?;
     if price.is_none() && !a.dry_run {
-        eprintln!(
+        rh_contract::note!(
             "rh-score predict: no price for model {:?} in the price table: its cost counts as $0 (give --price-in/--price-out for a real figure)",
             a.model
         );
@@ -93,7 +93,7 @@ pub fn run(a: PredictArgs) -> Result<()> {
     if a.dry_run {
         let req = crate::predict::dry_run(&opts, &scenes)?;
         let e = &req["estimate"];
-        eprintln!(
+        rh_contract::note!(
             "rh-score predict --dry-run: {} scenes ≈ {} input tokens ({} a scene) + at most {} output tokens; cost {}",
             e["scenes"],
             e["input_tokens"],
@@ -110,7 +110,7 @@ pub fn run(a: PredictArgs) -> Result<()> {
     if a.json {
         print_out(&(serde_json::to_string_pretty(&s)? + "\n"))?;
     } else {
-        eprintln!(
+        rh_contract::note!(
             "rh-score predict: {} of {} scenes in {} ({} already there, {} new: {} answered, \
              {} lost as error lines, {} refusals, {} without a parseable plan); {} requests, \
              {} retries, {} rate-limited, {} from the cache; cost ${:.4} (file total ${:.4}); \
@@ -135,7 +135,7 @@ pub fn run(a: PredictArgs) -> Result<()> {
         );
     }
     if s.stopped == "max_cost" {
-        eprintln!(
+        rh_contract::note!(
             "rh-score predict: stopped by --max-cost {:.4} USD with {} scene(s) left; run again \
              with a higher --max-cost to resume",
             a.max_cost.unwrap_or(0.0),
@@ -143,7 +143,7 @@ pub fn run(a: PredictArgs) -> Result<()> {
         );
     }
     if s.lost > 0 {
-        eprintln!(
+        rh_contract::note!(
             "rh-score predict: {} decision(s) lost; `--retry-errors` asks for them again",
             s.lost
         );

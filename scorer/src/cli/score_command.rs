@@ -107,7 +107,7 @@ pub fn run(cli: Cli) -> Result<()> {
         let scoring_id = crate::results::ScoringIdentity::of(&cfg, cli.answered_only);
         let files = crate::results::results_files(&report, identity, &scoring_id);
         for p in crate::results::write_results(dir, &files)? {
-            eprintln!("rh-score: results file {}", p.display());
+            rh_contract::note!("rh-score: results file {}", p.display());
         }
     }
     write_reports(&cli, &report, &ds, &cfg, &preds)
@@ -157,7 +157,7 @@ fn write_reports(
     } else if let Some(e) = &report.execution {
         // The disagreements are always listed (on stderr when stdout is taken).
         if !e.disagreements.is_empty() {
-            eprint!("{}", crate::execution::report::terminal(e, 50));
+            rh_contract::note_part!("{}", crate::execution::report::terminal(e, 50));
         }
     }
     if let Some(site) = site {
@@ -166,7 +166,7 @@ fn write_reports(
             .canonicalize()
             .unwrap_or(site.dir.clone())
             .join("index.html");
-        eprintln!(
+        rh_contract::note!(
             "rh-score: site with {} models and {} scenes ({} video files) in {}; open file://{}",
             site.models,
             site.scenes,
@@ -175,6 +175,6 @@ fn write_reports(
             index.display()
         );
     }
-    eprint!("{}", crate::refusal::stderr_notes(report));
+    rh_contract::note_part!("{}", crate::refusal::stderr_notes(report));
     Ok(())
 }

@@ -404,7 +404,7 @@ async fn drive(
                 gated(done?, out, bar, s, budget, client, gate)?;
             }
             _ = ticker.tick(), if log => {
-                eprintln!("{}", progress_line(s, budget, began, todo.len()));
+                rh_contract::note!("{}", progress_line(s, budget, began, todo.len()));
             }
             next = prepared.next(), if can_start => match next {
                 None => exhausted = true,
