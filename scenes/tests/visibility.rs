@@ -61,11 +61,12 @@ fn a_default_340_scene_build_is_all_valid_and_bands_share_their_cameras() {
     let (attempts, rejected) = per_family
         .values()
         .fold((0, 0), |(a, r), (fa, fr)| (a + fa, r + fr));
-    // Placement, not rejection: at most one attempt in five rejected by visibility
-    // overall (the default seed: 13 of 104, shelf_slide's shelf board hiding set-back
-    // objects from the eye and thrown golf balls too small from the room's far side).
+    // Placement, then rejection: at most one attempt in three rejected by visibility
+    // overall. Before the ego pixel rule (issue 44) 13 of 104 at the default seed; with it
+    // 129 of 467: bouncing_object 64 of 72 and thrown_object 33 of 36 (small balls far
+    // from the eye, under 128 estimated px), shelf_slide 9 of 29, furniture_tip 23 of 192.
     assert!(
-        rejected * 5 <= attempts,
+        rejected * 3 <= attempts,
         "visibility rejected {rejected} of {attempts} attempts: {per_family:?}"
     );
 }
