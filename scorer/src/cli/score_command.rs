@@ -6,7 +6,7 @@ use super::args::Cli;
 use super::dataset_arg::resolve_dataset;
 use super::output::{load_config, print_out, write_file};
 use crate::error::InputError;
-use crate::{Dataset, Report, Scoring};
+use crate::{Dataset, Report};
 use anyhow::{Context, Result};
 use std::path::Path;
 
@@ -44,27 +44,30 @@ pub fn run(cli: Cli) -> Result<()> {
         .into());
     }
     let ds = Dataset::load(&resolve_dataset(cli.dataset.clone())?)?;
-    let expected = crate::coverage::Expected::resolve(&ds, cli.subset)?;
-    let mut scoring = Scoring::new(&ds, &cfg).with_expected(expected);
-    if let Some(p) = &cli.decisions {
-        let f = std::fs::File::create(p)
-            .map_err(|e| InputError(format!("cannot write decisions to {}: {e}", p.display())))?;
-        scoring = scoring.with_decisions_output(Box::new(std::io::BufWriter::new(f)));
-    }
-    if cli.execute {
-        scoring = scoring.with_execution();
-    }
-    if preds.as_os_str() == "-" {
-        scoring.score_reader(std::io::BufReader::with_capacity(1 << 20, std::io::stdin()))?;
+    let decisions = cli.decisions.clone().map(|p| -> crate::api::OpenDecisions {
+        Box::new(move || {
+            let f = std::fs::File::create(&p).map_err(|e| {
+                InputError(format!("cannot write decisions to {}: {e}", p.display()))
+            })?;
+            Ok(Box::new(std::io::BufWriter::new(f)))
+        })
+    });
+    let opts = crate::api::ScoreOptions {
+        subset: cli.subset,
+        answered_only: cli.answered_only,
+        decisions,
+        execution: cli.execute,
+        compare: cli.compare.as_ref().map(|p| [p[0].clone(), p[1].clone()]),
+    };
+    let source = if preds.as_os_str() == "-" {
+        crate::api::Preds::Stdin
     } else {
-        scoring.score_path(&preds)?;
-    }
-    crate::refusal::check_scored(&scoring, &preds.display().to_string())?;
-    let mut report = Report::build_with(&scoring, &preds.display().to_string(), cli.answered_only);
-    if let Some(pair) = &cli.compare {
-        let c = crate::compare::compare(&scoring, &pair[0], &pair[1])?;
-        report.comparisons.push(c);
-    }
+        crate::api::Preds::Path(&preds)
+    };
+    let crate::api::Scored {
+        mut scoring,
+        mut report,
+    } = crate::api::score(&ds, &cfg, source, opts)?;
     if cli.execute {
         let cache = (!cli.no_exec_cache).then(|| {
             cli.exec_cache
