@@ -1,7 +1,9 @@
-//! ReactHuman offline scorer (`rh-score`): reads model predictions (`preds.jsonl`),
-//! derives each plan's action with the versioned action rule, scores the five metrics of
-//! SPEC §11 against a dataset's ground truth, aggregates them, and reproduces the paper's
-//! analyses and figures.
+//! ReactHuman's grading core (`rh-grade`, under the `rh-score` binary): reads model
+//! predictions (`preds.jsonl`), derives each plan's action with the versioned action rule,
+//! scores the five metrics of SPEC §11 against a dataset's ground truth, aggregates them,
+//! and reproduces the paper's analyses; [`api::score`] is the one scoring sequence. No
+//! simulator, renderer, LLM client or network: those, the figures and the site are
+//! rh-score's.
 //!
 //! Pipeline of one run: [`dataset::Dataset::load`] reads `DIR/data/*.parquet` (columns
 //! by name; a missing or mistyped column is an input error naming file and column) →
@@ -10,7 +12,7 @@
 //! [`plan`], action rule and world-frame kinematics in [`action_rule`], metrics in [`metrics`],
 //! AIA in [`aia`]) and folds results in file order into per-model accumulators
 //! ([`aggregate`]) → [`report::Report::build`] computes breakdowns and the paper's analyses →
-//! [`tables`] (terminal, Markdown, CSV), `serde_json` (JSON) and [`figures`] (SVG + PNG).
+//! [`tables`] (terminal, Markdown, CSV), `serde_json` (JSON) and rh-score's figures (SVG + PNG).
 //!
 //! Decisions recorded here and printed by `rh-score --explain` ([`explain`]):
 //! * Absurd numbers (NaN/inf, |speed| > 10 m/s, |yaw rate| > 20 rad/s, durations or
@@ -36,35 +38,24 @@ pub mod aia;
 pub mod analyses;
 pub mod api;
 pub mod baseline;
-pub mod cli;
 pub mod compare;
 pub mod config;
 pub mod coverage;
 pub mod dataset;
 pub mod dataset_diagnosis;
 pub mod error;
-pub mod execute_scored;
 pub mod execution;
 pub mod explain;
-#[cfg(feature = "predict")]
-pub mod export;
 pub mod fast_map;
-pub mod figures;
-pub mod html;
 pub mod intervals;
-pub mod leaderboard;
 pub mod metrics;
 pub mod metrics_row;
 pub mod oracle;
 pub mod plan;
 pub mod plan_json;
-#[cfg(feature = "predict")]
-pub mod predict;
 pub mod preds;
-pub mod progress;
 pub mod refusal;
 pub mod report;
-pub mod results;
 pub mod safety_rule;
 pub mod score;
 pub mod stats;

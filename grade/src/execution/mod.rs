@@ -10,12 +10,12 @@
 //!   is forked for each of the scene's decisions, in parallel (rayon).
 //! * Outcomes are cached on disk by (scene hash at Δ, plan hash, execution config hash),
 //!   so rescoring the same predictions executes nothing again.
+//!
+//! This module is the executor's plain data (what is waiting, how a run went, the
+//! report); running plans, the replay check and the videos are rh-score's
+//! (`rh_score::execution`), which links the simulator.
 
 pub mod report;
-#[cfg(feature = "execute")]
-mod run;
-#[cfg(feature = "videos")]
-pub mod videos;
 
 use crate::plan::Plan;
 use rh_contract::execution::{ExecKeyframe, ExecPlan};
@@ -23,10 +23,6 @@ use rh_contract::Action;
 use std::path::{Path, PathBuf};
 
 pub use report::ExecutionReport;
-#[cfg(feature = "execute")]
-pub use run::{cache_key, execute_all};
-#[cfg(feature = "execute")]
-pub use run::{checked_replay, replay_key};
 
 /// One scored decision waiting for execution.
 #[derive(Debug, Clone)]
