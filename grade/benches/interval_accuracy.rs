@@ -1,5 +1,5 @@
 //! How far the report's mean and balanced-accuracy intervals are from the percentile
-//! bootstrap they stand for, printed per method (`cargo bench -p rh-score --bench
+//! bootstrap they stand for, printed per method (`cargo bench -p rh-grade --bench
 //! interval_accuracy`; `-- SCENES` for another dataset size).
 //!
 //! Synthetic datasets (the fixture generator, in memory) of several seeds, scored with
@@ -18,8 +18,8 @@
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rh_score::synthetic::{dataset_of, synth_rows};
-use rh_score::{Config, Dataset, Report, Scoring};
+use rh_grade::synthetic::{dataset_of, synth_rows};
+use rh_grade::{Config, Dataset, Report, Scoring};
 
 const INTENTS: [&str; 6] = [
     "catch the falling object with both hands",
@@ -141,6 +141,6 @@ fn main() {
         "interval_accuracy: all: new (closed form) {}; old (2,000 resamples) {}; tolerance {}",
         summary(&all_new),
         summary(&all_old),
-        rh_score::stats::TOLERANCE
+        rh_grade::stats::TOLERANCE
     );
 }

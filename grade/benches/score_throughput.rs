@@ -1,7 +1,7 @@
 //! Scores 10^4, 10^5 and 10^6 decisions with the full report (every breakdown and
 //! analysis, the JSON written) and prints the time and peak memory of each.
 //!
-//! `cargo bench -p rh-score --bench score_throughput` runs the three sizes, each in a
+//! `cargo bench -p rh-grade --bench score_throughput` runs the three sizes, each in a
 //! process of its own (so each peak RSS is its own); `-- N` scores N decisions only.
 //! Synthetic dataset: 2,000 scenes (the fixture generator, in memory; ~1,930 valid); predictions:
 //! one line per (scene, model) over as many models as needed, mixing plan objects with
@@ -9,8 +9,8 @@
 //! errors and malformed lines. The file is written to a temp dir first (not timed).
 //! Memory is reported as the process's peak RSS (VmHWM) before and after scoring.
 
-use rh_score::synthetic::{dataset_of, synth_rows};
-use rh_score::{Config, Report, Scoring};
+use rh_grade::synthetic::{dataset_of, synth_rows};
+use rh_grade::{Config, Report, Scoring};
 use std::io::{BufWriter, Write};
 use std::time::Instant;
 
