@@ -1,82 +1,41 @@
-//! ReactHuman offline scorer (`rh-score`): reads model predictions (`preds.jsonl`),
-//! derives each plan's action with the versioned action rule, scores the five metrics of
-//! SPEC §11 against a dataset's ground truth, aggregates them, and reproduces the paper's
-//! analyses and figures.
-//!
-//! Pipeline of one run: [`dataset::Dataset::load`] reads `DIR/data/*.parquet` (columns
-//! by name; a missing or mistyped column is an input error naming file and column) →
-//! [`score::Scoring::score_path`] streams `preds.jsonl` line by line (capped length), parses
-//! batches in parallel with rayon ([`preds::process_line`]: lenient plan extraction in
-//! [`plan`], action rule and world-frame kinematics in [`action_rule`], metrics in [`metrics`],
-//! AIA in [`aia`]) and folds results in file order into per-model accumulators
-//! ([`aggregate`]) → [`report::Report::build`] computes breakdowns and the paper's analyses →
-//! [`tables`] (terminal, Markdown, CSV), `serde_json` (JSON) and [`figures`] (SVG + PNG).
-//!
-//! Decisions recorded here and printed by `rh-score --explain` ([`explain`]):
-//! * Absurd numbers (NaN/inf, |speed| > 10 m/s, |yaw rate| > 20 rad/s, durations or
-//!   keyframe times outside [0, 30] s, |hand coordinate| > 10 m) make the plan
-//!   unparseable (R1), counted as `absurd_number`; nothing is clamped.
-//! * Coverage: metrics over the expected scenes (eval subset, or all), an unanswered scene
-//!   counting as failed ([`coverage`]); 95% intervals ([`stats`]); `--compare` ([`compare`]).
-//! * Duplicate (scene, model) lines: the first wins; an `error` line followed by a scored
-//!   line for the same pair is a retry and is replaced.
-//! * Scenes with `valid = false` are not scored (`invalid_scene` warnings); baselines skip
-//!   them.
-//! * Memory is bounded by scenes × models (one 12-byte record per pair for the cross-model
-//!   analyses), never by the size of the predictions file.
-//! * Figures: plotters with the SVG and bitmap backends; text is drawn with `ab_glyph`
-//!   from the Hack font embedded via the `epaint_default_fonts` crate, so PNGs need no
-//!   system fonts or fontconfig.
-//! * Thresholds live in `configs/scoring.toml`, embedded as the default; `--config`
-//!   replaces it.
+//! `rh-score`, the ReactHuman offline scorer: the command line ([`cli`]) over the grading
+//! core [`rh_grade`] (predictions, plans, the action rule, metrics, intervals, the report
+//! model and its text tables, baselines, the one scoring sequence `rh_grade::api::score`),
+//! and what links more than the core: `--execute` in physics and its videos
+//! ([`execution`], features `execute` and `videos`), the model runner and the training
+//! export ([`predict`], [`export`], feature `predict`), figures, the site, leaderboards
+//! and results files, and Hub datasets ([`hub_dataset`]). The core's modules are
+//! re-exported under their own names, so `rh_score::score`, `rh_score::report` … are the
+//! core's.
 
-pub mod action_rule;
-pub mod aggregate;
-pub mod aia;
-pub mod analyses;
-pub mod api;
-pub mod baseline;
+pub use rh_grade::{
+    action_rule, aggregate, aia, analyses, api, baseline, compare, config, coverage,
+    dataset_diagnosis, error, explain, fast_map, intervals, metrics, metrics_row, oracle,
+    plan, plan_json, preds, refusal, report, safety_rule, score, stats, tables, text_table,
+};
+#[cfg(any(test, feature = "synthetic"))]
+pub use rh_grade::synthetic;
+
+/// The core's dataset reader ([`rh_grade::dataset`]) and [`resolve_dir`], which also
+/// fetches Hub datasets.
+pub mod dataset {
+    pub use crate::hub_dataset::resolve_dir;
+    pub use rh_grade::dataset::*;
+}
+
 pub mod cli;
-pub mod compare;
-pub mod config;
-pub mod coverage;
-pub mod dataset;
-pub mod dataset_diagnosis;
-pub mod error;
 pub mod execute_scored;
 pub mod execution;
-pub mod explain;
 #[cfg(feature = "predict")]
 pub mod export;
-pub mod fast_map;
 pub mod figures;
 pub mod html;
-pub mod intervals;
+pub mod hub_dataset;
 pub mod leaderboard;
-pub mod metrics;
-pub mod metrics_row;
-pub mod oracle;
-pub mod plan;
-pub mod plan_json;
 #[cfg(feature = "predict")]
 pub mod predict;
-pub mod preds;
 pub mod progress;
-pub mod refusal;
-pub mod report;
 pub mod results;
-pub mod safety_rule;
-pub mod score;
-pub mod stats;
-#[cfg(any(test, feature = "synthetic"))]
-pub mod synthetic;
-pub mod tables;
-pub mod text_table;
 
-pub use config::Config;
-pub use dataset::Dataset;
-pub use error::InputError;
-pub use report::Report;
 pub use rh_contract::Action;
-pub use safety_rule::SafetyRule;
-pub use score::Scoring;
+pub use rh_grade::{Config, Dataset, InputError, Report, SafetyRule, Scoring};

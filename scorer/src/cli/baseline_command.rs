@@ -20,7 +20,11 @@ pub fn run(
     let model = model.unwrap_or_else(|| format!("baseline-{}", kind.name()));
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
-    match write_baseline(kind, &ds, seed, &model, &cfg, &mut out) {
+    #[cfg(feature = "execute")]
+    let check: Option<rh_grade::oracle::DodgeCheck> = Some(crate::execution::physics_dodges_of);
+    #[cfg(not(feature = "execute"))]
+    let check = None;
+    match write_baseline(kind, &ds, seed, &model, &cfg, check, &mut out) {
         Err(e) => {
             let kind = e
                 .downcast_ref::<std::io::Error>()

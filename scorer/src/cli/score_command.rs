@@ -6,7 +6,7 @@ use super::args::Cli;
 use super::dataset_arg::resolve_dataset;
 use super::output::{load_config, print_out, write_file, SharedFile};
 use crate::error::InputError;
-use crate::{Dataset, Report, Scoring};
+use crate::{Dataset, Report};
 use anyhow::{Context, Result};
 use std::path::Path;
 
@@ -44,33 +44,34 @@ pub fn run(cli: Cli) -> Result<()> {
         .into());
     }
     let ds = Dataset::load(&resolve_dataset(cli.dataset.clone(), cli.allow_incomplete)?)?;
-    let expected = crate::coverage::Expected::resolve(&ds, cli.subset)?;
-    let mut scoring = Scoring::new(&ds, &cfg).with_expected(expected);
-    // Written under a temporary name, renamed into place once every line is in.
+    // Written under a temporary name, renamed into place once every line is in (a run
+    // refused before then leaves no file: the temporary is removed when dropped).
     let decisions = match &cli.decisions {
         Some(p) => Some(SharedFile::create(p, "the decision lines")?),
         None => None,
     };
-    if let Some(d) = &decisions {
-        scoring = scoring.with_decisions_output(Box::new(d.clone()));
-    }
-    if cli.execute {
-        scoring = scoring.with_execution();
-    }
-    if preds.as_os_str() == "-" {
-        scoring.score_reader(std::io::BufReader::with_capacity(1 << 20, std::io::stdin()))?;
+    let open = decisions.clone().map(|d| -> crate::api::OpenDecisions {
+        Box::new(move || Ok(Box::new(d)))
+    });
+    let opts = crate::api::ScoreOptions {
+        subset: cli.subset,
+        answered_only: cli.answered_only,
+        decisions: open,
+        execution: cli.execute,
+        compare: cli.compare.as_ref().map(|p| [p[0].clone(), p[1].clone()]),
+    };
+    let source = if preds.as_os_str() == "-" {
+        crate::api::Preds::Stdin
     } else {
-        scoring.score_path(&preds)?;
-    }
-    crate::refusal::check_scored(&scoring, &preds.display().to_string())?;
+        crate::api::Preds::Path(&preds)
+    };
+    let crate::api::Scored {
+        mut scoring,
+        mut report,
+    } = crate::api::score(&ds, &cfg, source, opts)?;
     if cli.results.is_some() {
         // A clash of results file names is found before any output is written.
         crate::results::check_file_names(scoring.models.iter().map(|m| m.name.as_str()))?;
-    }
-    let mut report = Report::build_with(&scoring, &preds.display().to_string(), cli.answered_only);
-    if let Some(pair) = &cli.compare {
-        let c = crate::compare::compare(&scoring, &pair[0], &pair[1])?;
-        report.comparisons.push(c);
     }
     if cli.execute {
         let cache = (!cli.no_exec_cache).then(|| {

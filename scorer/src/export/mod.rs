@@ -292,7 +292,14 @@ fn examples_of_batch(
     let inputs: Vec<_> = keep.iter().map(|&i| inputs[i as usize].clone()).collect();
     let keys: FastMap<_, _> = replay_keys_of_batch(&batch, file)?.into_iter().collect();
     let ds = Dataset::from_scenes(opts.dataset.clone(), inputs);
-    let hints = crate::oracle::batch_hints(&opts.dataset, &batch, &keys, &ds.scenes, &opts.config)?;
+    let hints = crate::oracle::batch_hints(
+        &opts.dataset,
+        &batch,
+        &keys,
+        &ds.scenes,
+        &opts.config,
+        dodge_check(),
+    )?;
     ds.scenes
         .par_iter()
         .map(|scene| {
@@ -347,3 +354,15 @@ fn has_frames(opts: &ExportOptions, scene_id: &str) -> bool {
         _ => false,
     }
 }
+/// The oracle's physics check of its dodges.
+#[cfg(feature = "execute")]
+fn dodge_check() -> Option<crate::oracle::DodgeCheck> {
+    Some(crate::execution::physics_dodges_of)
+}
+
+/// Without `execute`, none: a dataset with specs is refused.
+#[cfg(not(feature = "execute"))]
+fn dodge_check() -> Option<crate::oracle::DodgeCheck> {
+    None
+}
+

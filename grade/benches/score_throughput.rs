@@ -1,14 +1,16 @@
-//! Scores 1,000,000 decisions and prints the time and peak memory.
+//! Scores 10^4, 10^5 and 10^6 decisions with the full report (every breakdown and
+//! analysis, the JSON written) and prints the time and peak memory of each.
 //!
-//! `cargo bench -p rh-score` (optionally `-- N` for another number of decisions).
+//! `cargo bench -p rh-grade --bench score_throughput` runs the three sizes, each in a
+//! process of its own (so each peak RSS is its own); `-- N` scores N decisions only.
 //! Synthetic dataset: 2,000 scenes (the fixture generator, in memory; ~1,930 valid); predictions:
 //! one line per (scene, model) over as many models as needed, mixing plan objects with
 //! object keyframes, bare keyframes, raw responses with ```json fences and prose, API
 //! errors and malformed lines. The file is written to a temp dir first (not timed).
 //! Memory is reported as the process's peak RSS (VmHWM) before and after scoring.
 
-use rh_score::synthetic::{dataset_of, synth_rows};
-use rh_score::{Config, Report, Scoring};
+use rh_grade::synthetic::{dataset_of, synth_rows};
+use rh_grade::{Config, Report, Scoring};
 use std::io::{BufWriter, Write};
 use std::time::Instant;
 
@@ -23,10 +25,23 @@ fn vm_hwm_kib() -> Option<u64> {
 }
 
 fn main() {
-    let n: usize = std::env::args()
-        .skip(1)
-        .find_map(|a| a.parse().ok())
-        .unwrap_or(1_000_000);
+    match std::env::args().skip(1).find_map(|a| a.parse().ok()) {
+        Some(n) => run(n),
+        None => {
+            // One child process per size: each peak RSS is that size's own.
+            let exe = std::env::current_exe().expect("the bench's own path");
+            for n in [10_000usize, 100_000, 1_000_000] {
+                let status = std::process::Command::new(&exe)
+                    .arg(n.to_string())
+                    .status()
+                    .expect("running the bench for one size");
+                assert!(status.success(), "the bench at {n} decisions failed");
+            }
+        }
+    }
+}
+
+fn run(n: usize) {
     let rows = synth_rows(2000, 42);
     let ds = dataset_of(&rows);
     // Lines only for valid scenes (the fixture marks a few invalid, as a real build may).
@@ -75,6 +90,8 @@ fn main() {
     let mut scoring = Scoring::new(&ds, &cfg);
     scoring.score_path(&path).expect("scoring");
     let report = Report::build(&scoring, "preds.jsonl");
+    let json = serde_json::to_string_pretty(&report).expect("serializing the report") + "\n";
+    std::fs::write(dir.path().join("report.json"), &json).expect("writing the report");
     let secs = t.elapsed().as_secs_f64();
     let hwm_after = vm_hwm_kib();
 
@@ -84,9 +101,10 @@ fn main() {
         report.models.len(),
         rayon::current_num_threads());
     println!(
-        "score_throughput: scored {scored} decisions ({} lost, {} warnings) in {secs:.2} s = {:.0} decisions/s",
+        "score_throughput: scored {scored} decisions ({} lost, {} warnings) with the full report (JSON {:.1} MiB) in {secs:.2} s = {:.0} decisions/s",
         report.input.decisions_lost,
         report.input.warnings.iter().map(|w| w.count).sum::<u64>(),
+        json.len() as f64 / (1 << 20) as f64,
         scored as f64 / secs
     );
     if let (Some(b), Some(a)) = (hwm_before, hwm_after) {

@@ -5,7 +5,7 @@ use crate::config::Config;
 use serde_json::{json, Value};
 use std::f64::consts::PI;
 
-pub(crate) fn kf(t: f64, left: [f64; 3], right: [f64; 3], knee: f64) -> Value {
+pub fn kf(t: f64, left: [f64; 3], right: [f64; 3], knee: f64) -> Value {
     json!({"t": t, "left_hand": left, "right_hand": right, "knee_bend": knee})
 }
 
@@ -14,7 +14,7 @@ pub(crate) fn rest_kf(t: f64, cfg: &Config) -> Value {
 }
 
 /// A plan in the SPEC §9 schema (confidence 1).
-pub(crate) fn plan(intent: &str, cmd: [f64; 3], dur: f64, keyframes: Vec<Value>) -> Value {
+pub fn plan(intent: &str, cmd: [f64; 3], dur: f64, keyframes: Vec<Value>) -> Value {
     json!({
         "intent": intent,
         "confidence": 1.0,

@@ -1,10 +1,10 @@
 //! Bootstrap intervals of a report row's means (d_end, HDE d_min, AIA), from the compact
-//! per-(scene, model) records: resampled over the row's scenes, seeded by the model, row
-//! and metric names (see [`crate::stats`]).
+//! per-(scene, model) records: over the row's scenes, resampled (seeded by the model, row
+//! and metric names) or, for large rows, in closed form (see [`crate::stats`]).
 
 use crate::aggregate::Rec;
 use crate::dataset::Dataset;
-use crate::stats::{bootstrap_mean, seed_for, StatsConfig};
+use crate::stats::{mean_interval, seed_for, StatsConfig};
 use rh_contract::Action;
 
 /// The intervals `[d_end, d_min, aia]` of row `group` of model `name` over the
@@ -39,8 +39,8 @@ pub fn mean_intervals(
     }
     let seed = |metric: &str| seed_for(cfg.seed, &[name, group, metric]);
     [
-        bootstrap_mean(&d_end, cfg, seed("d_end")),
-        bootstrap_mean(&d_min, cfg, seed("d_min")),
-        bootstrap_mean(&aia, cfg, seed("aia")),
+        mean_interval(&d_end, cfg, seed("d_end")),
+        mean_interval(&d_min, cfg, seed("d_min")),
+        mean_interval(&aia, cfg, seed("aia")),
     ]
 }

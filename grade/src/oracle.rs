@@ -149,7 +149,7 @@ pub fn dodge(scene: &Scene, hints: Option<&OracleHints>, cfg: &Config) -> Value 
 }
 
 /// The heuristic walk away from the impact point (see the module doc).
-fn heuristic_dodge(scene: &Scene, hints: Option<&OracleHints>, cfg: &Config) -> Value {
+pub fn heuristic_dodge(scene: &Scene, hints: Option<&OracleHints>, cfg: &Config) -> Value {
     let [x0, y0, th0] = scene.observer_pose;
     let p = scene.hazard_point();
     let (ux, uy) = (p[0] - x0, p[1] - y0);
@@ -197,17 +197,34 @@ pub fn oracle_plan(scene: &Scene, hints: Option<&OracleHints>, cfg: &Config) -> 
     }
 }
 
+/// The physics check of the oracle's dodges, which needs the simulator
+/// (`rh_score::execution::physics_dodges_of`): for the valid DODGE scenes among `scenes`
+/// whose spec replays (`keys`), the escape walks that replace a heuristic dodge (from
+/// `hints`) the executor finds struck, by scene id.
+pub type DodgeCheck = fn(
+    &Path,
+    &[&Scene],
+    &FastMap<String, ReplayKey>,
+    &BTreeMap<String, OracleHints>,
+    &Config,
+) -> BTreeMap<String, Value>;
+
 /// The hints of every scene: [`read_hints`], then the physics-checked dodges
-/// ([`physics_dodges`]).
-pub fn load_hints(ds: &Dataset, cfg: &Config) -> Result<BTreeMap<String, OracleHints>> {
-    #[cfg_attr(not(feature = "execute"), allow(unused_mut))]
+/// ([`physics_dodges`]) with `check`; without one, a dataset with specs is refused.
+pub fn load_hints(
+    ds: &Dataset,
+    cfg: &Config,
+    check: Option<DodgeCheck>,
+) -> Result<BTreeMap<String, OracleHints>> {
     let mut hints = read_hints(ds)?;
-    #[cfg(feature = "execute")]
-    for (id, plan) in physics_dodges(ds, &hints, cfg) {
-        hints.entry(id).or_default().dodge = Some(plan);
+    match check {
+        Some(check) => {
+            for (id, plan) in physics_dodges(ds, &hints, cfg, check) {
+                hints.entry(id).or_default().dodge = Some(plan);
+            }
+        }
+        None => refuse_without_physics(&ds.dir, cfg)?,
     }
-    #[cfg(not(feature = "execute"))]
-    refuse_without_physics(&ds.dir, cfg)?;
     Ok(hints)
 }
 
@@ -221,34 +238,31 @@ pub fn batch_hints(
     keys: &FastMap<String, ReplayKey>,
     scenes: &[Scene],
     cfg: &Config,
+    check: Option<DodgeCheck>,
 ) -> Result<BTreeMap<String, OracleHints>> {
     let delta = |id: &str| {
         keys.get(id)
             .and_then(|k| decision_time(dir, k))
             .unwrap_or(DEFAULT_DELTA)
     };
-    #[cfg_attr(not(feature = "execute"), allow(unused_mut))]
     let mut hints: BTreeMap<String, OracleHints> = motions_of_batch(batch, &delta)?
         .unwrap_or_default()
         .into_iter()
         .collect();
-    #[cfg(feature = "execute")]
-    {
-        let scenes: Vec<&Scene> = scenes.iter().collect();
-        for (id, plan) in physics_dodges_of(dir, &scenes, keys, &hints, cfg) {
-            hints.entry(id).or_default().dodge = Some(plan);
+    match check {
+        Some(check) => {
+            let scenes: Vec<&Scene> = scenes.iter().collect();
+            for (id, plan) in check(dir, &scenes, keys, &hints, cfg) {
+                hints.entry(id).or_default().dodge = Some(plan);
+            }
         }
-    }
-    #[cfg(not(feature = "execute"))]
-    {
-        let _ = scenes;
-        refuse_without_physics(dir, cfg)?;
+        None => refuse_without_physics(dir, cfg)?,
     }
     Ok(hints)
 }
 
-/// Without `execute` the oracle cannot check its dodges: a dataset with specs is refused.
-#[cfg(not(feature = "execute"))]
+/// Without the physics check the oracle cannot check its dodges: a dataset with specs is
+/// refused.
 fn refuse_without_physics(dir: &Path, _cfg: &Config) -> Result<()> {
     if dir.join("specs").is_dir() {
         return Err(crate::error::InputError(
@@ -265,67 +279,17 @@ fn refuse_without_physics(dir: &Path, _cfg: &Config) -> Result<()> {
 /// (`rh_physics::execute::escape`, the walks of the label's validator
 /// `valid_escapable`, so one exists in every valid scene of rule v4 that would strike)
 /// replaces it. Scenes without specs, or where nothing escapes, keep the heuristic.
-#[cfg(feature = "execute")]
 pub fn physics_dodges(
     ds: &Dataset,
     hints: &BTreeMap<String, OracleHints>,
     cfg: &Config,
+    check: DodgeCheck,
 ) -> BTreeMap<String, Value> {
     let Ok(keys) = read_replay_keys(&ds.dir) else {
         return BTreeMap::new();
     };
     let scenes: Vec<&Scene> = ds.scenes.iter().collect();
-    physics_dodges_of(&ds.dir, &scenes, &keys, hints, cfg)
-}
-
-/// [`physics_dodges`] of the valid DODGE scenes among `scenes`, with their replay keys.
-#[cfg(feature = "execute")]
-fn physics_dodges_of(
-    dir: &Path,
-    scenes: &[&Scene],
-    keys: &FastMap<String, ReplayKey>,
-    hints: &BTreeMap<String, OracleHints>,
-    cfg: &Config,
-) -> BTreeMap<String, Value> {
-    use rayon::prelude::*;
-    use rh_physics::execute::escape::{escape_plans, first_unstruck};
-    let dodges: Vec<&Scene> = scenes
-        .iter()
-        .copied()
-        .filter(|s| s.valid && s.gt_action == Action::Dodge)
-        .collect();
-    let found: Vec<Option<(String, Value)>> = dodges
-        .par_iter()
-        .map(|s| {
-            let key = keys.get(&s.scene_id)?;
-            let (replay, _) = crate::execution::checked_replay(dir, key, &s.scene_id).ok()?;
-            let heuristic = heuristic_dodge(s, hints.get(&s.scene_id), cfg);
-            let parsed = crate::plan::plan_from_value(&heuristic, cfg).ok()?;
-            let mut plans = vec![crate::execution::exec_plan(&parsed)];
-            plans.extend(escape_plans(replay.spec()));
-            match first_unstruck(&replay, &plans, &cfg.execution)? {
-                0 => None,
-                i => Some((s.scene_id.clone(), escape_json(&plans[i]))),
-            }
-        })
-        .collect();
-    found.into_iter().flatten().collect()
-}
-
-/// An escape walk as a plan line's `plan` (numbers unchanged through JSON).
-#[cfg(feature = "execute")]
-fn escape_json(p: &rh_contract::execution::ExecPlan) -> Value {
-    let keyframes = p
-        .keyframes
-        .iter()
-        .map(|k| kf(k.t, k.left, k.right, k.knee_bend))
-        .collect();
-    plan(
-        "Dodge: walk out of the hazard's path.",
-        p.walking_cmd,
-        p.walking_duration,
-        keyframes,
-    )
+    check(&ds.dir, &scenes, &keys, hints, cfg)
 }
 
 /// Reads the hints of every scene from `DIR/data/*.parquet` (`time_to_impact`,

@@ -175,10 +175,14 @@ STATISTICS (every interval is 95%)
   * Rates — SAA, safety, per-class recall, freeze rate, the analyses' per-model rows:
     Wilson score interval on k of n (n = the rate's denominator), closed form.
   * Means — d_end, HDE d_min, AIA (overall and per ground-truth action) — and balanced
-    accuracy: percentile bootstrap over scenes, {boot} resamples (fewer on samples so
-    large that values x resamples > {cap}), seeded from [statistics] seed = {seed} and the
-    model, row and metric names: reports are reproducible run to run. Balanced accuracy
-    resamples within each ground-truth class (stratified).
+    accuracy: percentile bootstrap over scenes. Samples of at most {upto} values (scenes)
+    are resampled {boot} times (fewer on samples so large that values x resamples >
+    {cap}), seeded from [statistics] seed = {seed} and the model, row and metric names:
+    reports are reproducible run to run. Larger samples get the same bootstrap
+    distribution's 2.5% and 97.5% quantiles in closed form (its exact first four
+    cumulants through the Cornish-Fisher expansion; within 0.075 half-widths of a
+    40,000-resample bootstrap; a sample too skewed for it is resampled). Balanced
+    accuracy resamples within each ground-truth class (stratified).
   * Per-class recall: SAA on the expected scenes of one ground-truth class; balanced
     accuracy: the mean recall over the classes that have scenes.
   * --compare A B: paired comparison on the expected scenes both A and B answered. For
@@ -240,6 +244,7 @@ EXIT STATUS
 "#,
         boot = cfg.statistics.bootstrap_resamples,
         cap = cfg.statistics.max_bootstrap_draws,
+        upto = cfg.statistics.resample_up_to,
         seed = cfg.statistics.seed,
         mr = an.miss_radius,
         fs = an.far_standing,

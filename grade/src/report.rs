@@ -8,6 +8,7 @@ use crate::analyses::{
 use crate::config::Config;
 use crate::dataset::{Dataset, SPEED_BANDS};
 use crate::score::{Scoring, WarningAcc};
+use rayon::prelude::*;
 use rh_contract::Action;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -183,7 +184,7 @@ fn model_report(
         },
         recall,
         balanced_accuracy: crate::stats::balanced_accuracy(&classes),
-        balanced_accuracy_ci: crate::stats::bootstrap_balanced(&classes, cx.stats, seed),
+        balanced_accuracy_ci: crate::stats::balanced_interval(&classes, cx.stats, seed),
         prompt_version: if m.prompt_versions.is_empty() {
             "-".to_string()
         } else {
@@ -384,8 +385,10 @@ impl Report {
                     .map(|(m, _)| m.name.clone())
                     .collect(),
             },
+            // One task per model (rayon keeps the order; each row's numbers depend on its
+            // own data and seed only, so they are the same on any number of threads).
             models: owned
-                .iter()
+                .par_iter()
                 .zip(&unanswered)
                 .map(|(m, u)| model_report(m, &[m.records.as_slice()], u, &cx))
                 .collect(),
@@ -540,5 +543,23 @@ mod tests {
             .unwrap();
         assert_eq!(f.share, Some(0.0));
         assert!(!r.analyses.lookalikes.is_empty());
+    }
+
+    #[test]
+    fn the_report_is_the_same_on_any_number_of_threads() {
+        // Large enough that the means take the closed form and the small rows resample.
+        let ds = dataset_of(&synth_rows(1200, 4));
+        let kinds = [BaselineKind::Random, BaselineKind::Oracle, BaselineKind::AlwaysDodge];
+        let json = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| serde_json::to_string(&run(&ds, &kinds, "")).unwrap())
+        };
+        let one = json(1);
+        assert_eq!(one, json(3));
+        assert_eq!(one, json(8));
+        let r = run(&ds, &kinds, "");
+        let random = r.models.iter().find(|m| m.model == "random").unwrap();
+        assert!(random.overall.expected as usize > Config::default().statistics.resample_up_to);
+        assert!(random.overall.aia_ci.is_some() && random.balanced_accuracy_ci.is_some());
     }
 }

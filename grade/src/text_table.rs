@@ -1,47 +1,47 @@
 //! A plain text table, written aligned for a terminal, as Markdown or as CSV, and the
 //! number formats of the report's cells (percentages, intervals).
 
-pub(crate) fn pct(v: Option<f64>) -> String {
+pub fn pct(v: Option<f64>) -> String {
     v.map_or("—".into(), |x| format!("{:.1}", 100.0 * x))
 }
 
-pub(crate) fn num(v: Option<f64>, digits: usize) -> String {
+pub fn num(v: Option<f64>, digits: usize) -> String {
     v.map_or("—".into(), |x| format!("{x:.digits$}"))
 }
 
 /// A 95% interval of a rate, in %: "54.1–77.3".
-pub(crate) fn pct_ci(v: Option<[f64; 2]>) -> String {
+pub fn pct_ci(v: Option<[f64; 2]>) -> String {
     v.map_or("—".into(), |[a, b]| {
         format!("{:.1}–{:.1}", 100.0 * a, 100.0 * b)
     })
 }
 
 /// A 95% interval of a mean: "0.12–0.30".
-pub(crate) fn num_ci(v: Option<[f64; 2]>, digits: usize) -> String {
+pub fn num_ci(v: Option<[f64; 2]>, digits: usize) -> String {
     v.map_or("—".into(), |[a, b]| format!("{a:.digits$}–{b:.digits$}"))
 }
 
 /// How a column's cells sit in its width.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Align {
+pub enum Align {
     Left,
     Right,
 }
 
 /// How [`Table::text`] lays a table out for a terminal.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct TextStyle {
+pub struct TextStyle {
     /// Put before every line.
-    pub(crate) indent: &'static str,
+    pub indent: &'static str,
     /// Between two columns.
-    pub(crate) gap: &'static str,
+    pub gap: &'static str,
     /// A line of `-` under the head.
-    pub(crate) rule: bool,
+    pub rule: bool,
 }
 
 impl TextStyle {
     /// The report's tables: no indent, two spaces between columns, a rule under the head.
-    pub(crate) const REPORT: TextStyle = TextStyle {
+    pub const REPORT: TextStyle = TextStyle {
         indent: "",
         gap: "  ",
         rule: true,
@@ -49,7 +49,7 @@ impl TextStyle {
 }
 
 /// A CSV field: quoted when it holds a comma, a quote or a newline.
-pub(crate) fn csv_field(s: &str) -> String {
+pub fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
@@ -60,7 +60,7 @@ pub(crate) fn csv_field(s: &str) -> String {
 /// A simple table rendered aligned (terminal), as Markdown or as CSV: the one writer of
 /// the scorer's text tables. By default the first column is left-aligned and the others
 /// right-aligned, each as wide as its widest cell.
-pub(crate) struct Table {
+pub struct Table {
     head: Vec<String>,
     rows: Vec<Vec<String>>,
     align: Vec<Align>,
@@ -70,11 +70,11 @@ pub(crate) struct Table {
 }
 
 impl Table {
-    pub(crate) fn new(head: &[&str]) -> Self {
+    pub fn new(head: &[&str]) -> Self {
         Table::from_head(head.iter().map(|s| s.to_string()).collect())
     }
 
-    pub(crate) fn from_head(head: Vec<String>) -> Self {
+    pub fn from_head(head: Vec<String>) -> Self {
         let n = head.len();
         let align = (0..n)
             .map(|i| if i == 0 { Align::Left } else { Align::Right })
@@ -89,35 +89,35 @@ impl Table {
     }
 
     /// Each column's alignment (one per column of the head).
-    pub(crate) fn aligned(mut self, align: &[Align]) -> Self {
+    pub fn aligned(mut self, align: &[Align]) -> Self {
         assert_eq!(align.len(), self.head.len(), "one alignment per column");
         self.align = align.to_vec();
         self
     }
 
     /// Each column's least width in the terminal layout (one per column of the head).
-    pub(crate) fn min_widths(mut self, widths: &[usize]) -> Self {
+    pub fn min_widths(mut self, widths: &[usize]) -> Self {
         assert_eq!(widths.len(), self.head.len(), "one width per column");
         self.min_width = widths.to_vec();
         self
     }
 
     /// Markdown's separator row without spaces (`|---|---:|`).
-    pub(crate) fn compact_markdown(mut self) -> Self {
+    pub fn compact_markdown(mut self) -> Self {
         self.compact_markdown = true;
         self
     }
 
-    pub(crate) fn row(&mut self, r: Vec<String>) {
+    pub fn row(&mut self, r: Vec<String>) {
         self.rows.push(r);
     }
 
     /// The report's terminal layout ([`TextStyle::REPORT`]).
-    pub(crate) fn text(&self) -> String {
+    pub fn text(&self) -> String {
         self.text_with(TextStyle::REPORT)
     }
 
-    pub(crate) fn text_with(&self, style: TextStyle) -> String {
+    pub fn text_with(&self, style: TextStyle) -> String {
         let n = self.head.len();
         let mut w = self.min_width.clone();
         for r in std::iter::once(&self.head).chain(&self.rows) {
@@ -158,7 +158,7 @@ impl Table {
         out
     }
 
-    pub(crate) fn markdown(&self) -> String {
+    pub fn markdown(&self) -> String {
         let mut out = String::new();
         let esc = |s: &str| s.replace('|', "\\|");
         let line = |r: &[String]| {
@@ -186,7 +186,7 @@ impl Table {
     }
 
     /// The head and the rows as CSV ([`csv_field`]).
-    pub(crate) fn csv(&self) -> String {
+    pub fn csv(&self) -> String {
         let mut out = String::new();
         for r in std::iter::once(&self.head).chain(&self.rows) {
             let fields: Vec<String> = r.iter().map(|c| csv_field(c)).collect();

@@ -177,18 +177,21 @@ pub fn majority_action(ds: &Dataset) -> Action {
     best
 }
 
-/// Writes one prediction line per scene, in dataset order.
+/// Writes one prediction line per scene, in dataset order; the oracle's dodges are
+/// checked in physics with `check` (without one, a dataset with specs is refused).
+#[allow(clippy::too_many_arguments)]
 pub fn write_baseline(
     kind: BaselineKind,
     ds: &Dataset,
     seed: u64,
     model: &str,
     cfg: &Config,
+    check: Option<crate::oracle::DodgeCheck>,
     out: &mut dyn Write,
 ) -> Result<()> {
     let majority = majority_action(ds);
     let hints = if kind == BaselineKind::Oracle {
-        crate::oracle::load_hints(ds, cfg)?
+        crate::oracle::load_hints(ds, cfg, check)?
     } else {
         Default::default()
     };
