@@ -380,6 +380,7 @@ mod tests {
             restitution: 0.1,
             linvel: [0.0; 3],
             angvel: [0.0; 3],
+            push_mass: None,
             ccd: false,
         }
     }
