@@ -143,7 +143,7 @@ fn oracle_plans_catch_and_never_get_struck_dodging() {
         catch >= 20,
         "too few CATCH scenes ({catch}) for the test to mean anything"
     );
-    // Issue #23's target on an unseen seed: >= 95% (measured: 134 of 141, rule v6).
+    // Issue #23's target on an unseen seed: >= 95% (measured: 137 of 142, rule v6).
     assert!(
         caught as f64 >= 0.95 * catch as f64,
         "oracle caught only {caught}/{catch}"
@@ -206,7 +206,7 @@ fn freeze_is_struck_exactly_where_the_label_says_danger() {
     );
     assert!(danger >= 20 && safe >= 20, "{danger} / {safe} scenes");
     // Issue #23: harmed on >= 95% of danger_present scenes and on none of the others
-    // (measured under rule v6: 156 of 157, and 1 of 183 — a lead pillow at the harm limit,
+    // (measured under rule v6: 160 of 161, and 1 of 179 — a target at the harm limit,
     // docs/execution.md — so this assertion fails until that disagreement is resolved).
     assert!(
         danger_struck as f64 >= 0.95 * danger as f64,
