@@ -19,7 +19,10 @@ fn part_area(shape: &ShapeSpec, d: [f64; 3]) -> f64 {
         ShapeSpec::Cylinder {
             half_height,
             radius,
-        } => std::f64::consts::PI * radius * radius * d[2].abs() + 4.0 * radius * half_height * lateral,
+        } => {
+            std::f64::consts::PI * radius * radius * d[2].abs()
+                + 4.0 * radius * half_height * lateral
+        }
         ShapeSpec::Capsule {
             half_height,
             radius,
@@ -39,7 +42,8 @@ pub fn drag_area(parts: &[PartSpec], d: [f64; 3], drag: &DragSpec) -> f64 {
     parts
         .iter()
         .map(|p| {
-            let local = rot(p.rotation).inverse() * Vector::new(d[0] as Real, d[1] as Real, d[2] as Real);
+            let local =
+                rot(p.rotation).inverse() * Vector::new(d[0] as Real, d[1] as Real, d[2] as Real);
             let local = [local.x as f64, local.y as f64, local.z as f64];
             coefficient(&p.shape, drag) * part_area(&p.shape, local)
         })
@@ -84,7 +88,11 @@ pub fn apply(rb: &mut RigidBody, parts: &[PartSpec], drag: &DragSpec) {
         return;
     }
     let local = rb.rotation().inverse() * (v / speed);
-    let ca = drag_area(parts, [local.x as f64, local.y as f64, local.z as f64], drag);
+    let ca = drag_area(
+        parts,
+        [local.x as f64, local.y as f64, local.z as f64],
+        drag,
+    );
     let magnitude = 0.5 * drag.air_density * ca * (speed as f64) * (speed as f64);
     rb.add_force(-v / speed * magnitude as Real, false);
 }
@@ -149,6 +157,10 @@ mod tests {
         // too; an apple (0.21 kg, 8 cm: ~37 m/s) does not.
         assert!(feels_drag(&body(0.2, panel), &drag, 9.81));
         assert!(!feels_drag(&body(60.0, panel), &drag, 9.81));
-        assert!(!feels_drag(&body(0.21, ShapeSpec::Sphere { radius: 0.04 }), &drag, 9.81));
+        assert!(!feels_drag(
+            &body(0.21, ShapeSpec::Sphere { radius: 0.04 }),
+            &drag,
+            9.81
+        ));
     }
 }

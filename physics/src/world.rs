@@ -123,7 +123,13 @@ fn insert_bodies(
     for b in &spec.bodies {
         // A push gives a body of another mass these velocities (`BodySpec::push_mass`).
         let scale = b.push_scale();
-        let scaled = |v: [f64; 3]| if scale == 1.0 { v } else { v.map(|c| c * scale) };
+        let scaled = |v: [f64; 3]| {
+            if scale == 1.0 {
+                v
+            } else {
+                v.map(|c| c * scale)
+            }
+        };
         let builder = match b.kind {
             BodyKind::Fixed => RigidBodyBuilder::fixed(),
             BodyKind::Dynamic => RigidBodyBuilder::dynamic()

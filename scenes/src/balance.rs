@@ -314,15 +314,13 @@ pub fn label_balance(
     let rows: Vec<EvalRow> = built_families
         .iter()
         .flat_map(|(balance, scenes)| {
-            scenes
-                .iter()
-                .map(|p| EvalRow {
-                    family: balance.family.as_str(),
-                    scene_index: p.index,
-                    valid: p.valid,
-                    action: p.action.as_str(),
-                    twin: p.twin,
-                })
+            scenes.iter().map(|p| EvalRow {
+                family: balance.family.as_str(),
+                scene_index: p.index,
+                valid: p.valid,
+                action: p.action.as_str(),
+                twin: p.twin,
+            })
         })
         .collect();
     let chosen_rows = crate::eval_subset::select(&rows, &eval_cfg).0;
@@ -361,8 +359,11 @@ fn count_subset(balance: &mut FamilyBalance, scenes: &[PoolScene], chosen: &[usi
         }
     }
     // Twin pairs, counted once (from the lower index), both scenes valid.
-    let at: std::collections::BTreeMap<u64, usize> =
-        scenes.iter().enumerate().map(|(i, s)| (s.index, i)).collect();
+    let at: std::collections::BTreeMap<u64, usize> = scenes
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (s.index, i))
+        .collect();
     for (i, p) in scenes.iter().enumerate() {
         let Some(&j) = p.twin.filter(|&t| t > p.index).and_then(|t| at.get(&t)) else {
             continue;

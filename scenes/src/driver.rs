@@ -193,9 +193,13 @@ pub fn produce_planned_group(
             first_index: slot.probe_group * 4,
             count: probe_count,
         };
-        let (mut probe, rejections) = probe_group_counted(&selection, bands, catalog, &probe_config)
-            .map_err(|e| e.to_string())?;
-        let twins = slot.pair.twin.then(|| pair_twins(&mut probe, &slot, genuine, config));
+        let (mut probe, rejections) =
+            probe_group_counted(&selection, bands, catalog, &probe_config)
+                .map_err(|e| e.to_string())?;
+        let twins = slot
+            .pair
+            .twin
+            .then(|| twins::pair_twins(&mut probe, &slot, genuine, config));
         Ok((probe, rejections, twins.flatten()))
     };
     let produced = if slot.pair.twin {
@@ -214,10 +218,15 @@ pub fn produce_planned_group(
     let valid = |r: &[SceneResult]| r.iter().all(|r| r.verdicts.all());
     // N means N: a probe (or twin) group that cannot be made valid gives way to a group
     // planned afresh, unpaired (the pair's other group then names no twin either).
-    let replanned = || replanned_group(catalog, families, seed, g, count, config).map_err(|e| input(&e));
+    let replanned =
+        || replanned_group(catalog, families, seed, g, count, config).map_err(|e| input(&e));
     if slot.role == twins::Role::Probe {
         probe.truncate(count as usize);
-        return if valid(&probe) { Ok((probe, rejections)) } else { replanned() };
+        return if valid(&probe) {
+            Ok((probe, rejections))
+        } else {
+            replanned()
+        };
     }
     let Some(mut twin) = twins else {
         return replanned();
@@ -228,52 +237,6 @@ pub fn produce_planned_group(
         ..Rejections::default()
     };
     Ok((twin, rejected))
-}
-
-/// The twins of a twin pair's probe bands, labelled (`config`: the build's, not the
-/// probe's), each pair kept only where its hazards diverge in the window
-/// ([`twins::keep_if_divergent`]). `None` — and every probe band unpaired — when a probe
-/// or twin band fails a validator: then the twin group is planned afresh.
-fn pair_twins(
-    probe: &mut [SceneResult],
-    slot: &twins::Slot,
-    genuine: &rh_catalog::Object,
-    config: &Config,
-) -> Option<Vec<SceneResult>> {
-    let mut twin = Vec::with_capacity(probe.len());
-    for (band, r) in probe.iter_mut().enumerate() {
-        let index = slot.twin_group * 4 + band as u64;
-        let mut spec = twins::twin_spec(&mut r.spec, genuine, index, slot.twin_group);
-        spec = SceneSpec::from_json(&spec.to_json()).expect("a spec parses back");
-        twins::keep_if_divergent(&mut r.spec, &mut spec, config.probes.divergence_min);
-        let sim = simulate(&spec, SimOptions::default());
-        twin.push(label_scene(spec, sim, config));
-    }
-    if std::env::var_os("RH_TWIN_DEBUG").is_some() {
-        for (p, t) in probe.iter().zip(&twin) {
-            eprintln!(
-                "twin {} {} {:?} {}/{} valid {}/{} {:?} d {:.3}",
-                p.spec.family,
-                p.spec.selection.object_id,
-                crate::intent::Intent::of(&p.spec),
-                p.labels.gt_action.as_str(),
-                t.labels.gt_action.as_str(),
-                p.verdicts.all(),
-                t.verdicts.all(),
-                t.verdicts.as_array(),
-                t.spec.family_params.get(twins::DIVERGENCE_PARAM).copied().unwrap_or(0.0)
-            );
-        }
-    }
-    let all_valid = probe.iter().chain(&twin).all(|r| r.verdicts.all());
-    if !all_valid {
-        for r in probe.iter_mut() {
-            r.spec.family_params.remove(twins::TWIN_PARAM);
-            r.spec.family_params.remove(twins::DIVERGENCE_PARAM);
-        }
-        return None;
-    }
-    Some(twin)
 }
 
 /// What a probe group's bands are a function of (with the driver's code): the build's

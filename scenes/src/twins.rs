@@ -208,7 +208,9 @@ pub fn divergence(a: &SceneSpec, b: &SceneSpec) -> f64 {
     window_path(a)
         .iter()
         .zip(window_path(b))
-        .map(|(p, q)| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt())
+        .map(|(p, q)| {
+            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+        })
         .fold(0.0, f64::max)
 }
 
@@ -223,6 +225,57 @@ pub fn keep_if_divergent(probe: &mut SceneSpec, twin: &mut SceneSpec, divergence
         }
     }
     d
+}
+
+/// The twins of a twin pair's probe bands, labelled (`config`: the build's, not the
+/// probe's), each pair kept only where its hazards diverge in the window
+/// ([`keep_if_divergent`]). `None` — and every probe band unpaired — when a probe
+/// or twin band fails a validator: then the twin group is planned afresh.
+pub(crate) fn pair_twins(
+    probe: &mut [crate::driver::SceneResult],
+    slot: &Slot,
+    genuine: &rh_catalog::Object,
+    config: &crate::config::Config,
+) -> Option<Vec<crate::driver::SceneResult>> {
+    let mut twin = Vec::with_capacity(probe.len());
+    for (band, r) in probe.iter_mut().enumerate() {
+        let index = slot.twin_group * 4 + band as u64;
+        let mut spec = twin_spec(&mut r.spec, genuine, index, slot.twin_group);
+        spec = SceneSpec::from_json(&spec.to_json()).expect("a spec parses back");
+        keep_if_divergent(&mut r.spec, &mut spec, config.probes.divergence_min);
+        let sim =
+            rh_physics::simulate::simulate(&spec, rh_physics::simulate::SimOptions::default());
+        twin.push(crate::driver::label_scene(spec, sim, config));
+    }
+    if std::env::var_os("RH_TWIN_DEBUG").is_some() {
+        for (p, t) in probe.iter().zip(&twin) {
+            eprintln!(
+                "twin {} {} {:?} {}/{} valid {}/{} {:?} d {:.3}",
+                p.spec.family,
+                p.spec.selection.object_id,
+                crate::intent::Intent::of(&p.spec),
+                p.labels.gt_action.as_str(),
+                t.labels.gt_action.as_str(),
+                p.verdicts.all(),
+                t.verdicts.all(),
+                t.verdicts.as_array(),
+                t.spec
+                    .family_params
+                    .get(DIVERGENCE_PARAM)
+                    .copied()
+                    .unwrap_or(0.0)
+            );
+        }
+    }
+    let all_valid = probe.iter().chain(&twin).all(|r| r.verdicts.all());
+    if !all_valid {
+        for r in probe.iter_mut() {
+            r.spec.family_params.remove(TWIN_PARAM);
+            r.spec.family_params.remove(DIVERGENCE_PARAM);
+        }
+        return None;
+    }
+    Some(twin)
 }
 
 /// The other scene's index of a twin pair, if `spec` is in one.

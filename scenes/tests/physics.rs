@@ -53,7 +53,11 @@ fn ceiling_drop_falls_freely_once_off_its_mount() {
     let results = scenes("ceiling_drop", 6, 3);
     assert_eq!(results.len(), 24);
     for r in &results {
-        let sim = plain(r);
+        // Free fall: without the air drag a foam panel feels (label rule v6; its own
+        // closed form is in tests/twins.rs).
+        let mut undragged = r.clone();
+        undragged.spec.physics.drag = None;
+        let sim = plain(&undragged);
         let contacts = &sim.hazard_contacts;
         let floor = (1..=sim.steps())
             .find(|&k| contacts[k as usize] & TOUCH_FLOOR != 0)
@@ -90,9 +94,17 @@ fn ceiling_drop_falls_freely_once_off_its_mount() {
             "{}: only {checked} free-fall steps",
             r.spec.scene_id
         );
+        // The label's floor time is the scene's own (drag included).
+        let real = plain(r);
+        let floor = (1..=real.steps())
+            .find(|&k| real.hazard_contacts[k as usize] & TOUCH_FLOOR != 0)
+            .expect("reaches the floor");
         let t = r.labels.time_to_floor.expect("a floor time");
+        // The label times the lowest point's own arrival, which may come up to one step
+        // after the solver first reports the contact (`label::time_to_floor`: a body
+        // slowed by drag is still a few millimetres up at its contact step).
         assert!(
-            t > (floor as f64 - 2.0) * dt && t <= floor as f64 * dt + 1e-9,
+            t > (floor as f64 - 2.0) * dt && t <= (floor + 1) as f64 * dt + 1e-9,
             "{}: time_to_floor {t} vs first floor contact at step {floor}",
             r.spec.scene_id
         );
@@ -101,10 +113,16 @@ fn ceiling_drop_falls_freely_once_off_its_mount() {
 
 #[test]
 fn object_drop_falls_ballistically_once_clear_of_the_table() {
-    let results = scenes("object_drop", 10, 5);
+    // Pushed off the board (label rule v6), most objects tumble as they leave it; enough
+    // groups to find those that fall clear.
+    let results = scenes("object_drop", 40, 5);
     let mut clear_falls = 0;
     for r in &results {
-        let sim = plain(r);
+        // Free fall: without the air drag a light body feels (its own closed form is in
+        // tests/twins.rs).
+        let mut undragged = r.clone();
+        undragged.spec.physics.drag = None;
+        let sim = plain(&undragged);
         let floor = sim
             .time_to_floor_step(r.spec.labels.floor_contact_eps)
             .expect("reaches the floor");

@@ -59,8 +59,15 @@ fn a_twin_pair_differs_only_in_the_object() {
         let (twin, _) = produce_planned_group(&catalog, families, 5, twin_group, 4, &config)
             .unwrap_or_else(|_| panic!("group {twin_group}"));
         assert_eq!((probe.len(), twin.len()), (4, 4));
-        if !probe[0].spec.family_params.contains_key(twins::DIVERGENCE_PARAM) {
-            assert!(probe.iter().chain(&twin).all(|r| twins::twin_of(&r.spec).is_none()));
+        if !probe[0]
+            .spec
+            .family_params
+            .contains_key(twins::DIVERGENCE_PARAM)
+        {
+            assert!(probe
+                .iter()
+                .chain(&twin)
+                .all(|r| twins::twin_of(&r.spec).is_none()));
             continue;
         }
         checked += 1;
@@ -72,7 +79,10 @@ fn a_twin_pair_differs_only_in_the_object() {
                 assert_eq!(twins::twin_of(&p.spec), Some(t.spec.scene_index));
                 assert_eq!(twins::twin_of(&t.spec), Some(p.spec.scene_index));
             } else {
-                assert_eq!((twins::twin_of(&p.spec), twins::twin_of(&t.spec)), (None, None));
+                assert_eq!(
+                    (twins::twin_of(&p.spec), twins::twin_of(&t.spec)),
+                    (None, None)
+                );
             }
             assert_eq!(
                 p.spec.scene_index + 4 * (twin_group - probe_group),
@@ -216,10 +226,21 @@ fn the_same_push_gives_speeds_in_the_inverse_ratio_of_the_masses() {
     let light = twins::twin_spec(&mut steel, apple, 1, 0);
     let (m_heavy, m_light) = (steel.bodies[h].mass, light.bodies[h].mass);
     assert!(m_heavy > 5.0 * m_light, "{m_heavy} {m_light}");
-    let (v_heavy, v_light) = (norm(hazard_velocity(&steel, 0)), norm(hazard_velocity(&light, 0)));
+    let (v_heavy, v_light) = (
+        norm(hazard_velocity(&steel, 0)),
+        norm(hazard_velocity(&light, 0)),
+    );
     let p = push * given;
-    assert!((m_heavy * v_heavy - p).abs() < 1e-5 * p, "{} {p}", m_heavy * v_heavy);
-    assert!((m_light * v_light - p).abs() < 1e-5 * p, "{} {p}", m_light * v_light);
+    assert!(
+        (m_heavy * v_heavy - p).abs() < 1e-5 * p,
+        "{} {p}",
+        m_heavy * v_heavy
+    );
+    assert!(
+        (m_light * v_light - p).abs() < 1e-5 * p,
+        "{} {p}",
+        m_light * v_light
+    );
     assert!((v_light / v_heavy - m_heavy / m_light).abs() < 1e-4 * m_heavy / m_light);
     // Without a push both start at the spec's velocity (rule v5's twins).
     steel.bodies[h].push_mass = None;
@@ -262,7 +283,10 @@ fn air_drag_on_a_constructed_panel_matches_its_terminal_velocity() {
         let v = -hazard_velocity(&spec, steps)[2];
         let t = steps as f64 * dt;
         let expected = vt * (g * t / vt).tanh();
-        assert!((v - expected).abs() < 0.01 * expected, "t {t}: {v} against {expected}");
+        assert!(
+            (v - expected).abs() < 0.01 * expected,
+            "t {t}: {v} against {expected}"
+        );
     }
     // The same panel at 6 kg: no drag, free fall.
     spec.bodies[h].mass = 6.0;
@@ -286,10 +310,10 @@ fn twins_diverge_in_the_window() {
         .filter_map(|g| twins::slot(&config.probes, families, g))
         .find(|s| s.pair.twin && s.role == Role::Probe && s.pair.family == "sliding_object")
         .unwrap();
-    let (probe, _) = produce_planned_group(&catalog, families, 5, slot.probe_group, 4, &config)
-        .unwrap();
-    let (twin, _) = produce_planned_group(&catalog, families, 5, slot.twin_group, 4, &config)
-        .unwrap();
+    let (probe, _) =
+        produce_planned_group(&catalog, families, 5, slot.probe_group, 4, &config).unwrap();
+    let (twin, _) =
+        produce_planned_group(&catalog, families, 5, slot.twin_group, 4, &config).unwrap();
     let mut paired = 0;
     for (p, t) in probe.iter().zip(&twin) {
         let d = twins::divergence(&p.spec, &t.spec);
@@ -313,5 +337,9 @@ fn twins_diverge_in_the_window() {
     // Rule v6's: the same push — far apart by Δ.
     let mut a = thrown("steel_apple");
     let b = twins::twin_spec(&mut a, catalog_apple, 1, 0);
-    assert!(twins::divergence(&a, &b) > 1.0, "{}", twins::divergence(&a, &b));
+    assert!(
+        twins::divergence(&a, &b) > 1.0,
+        "{}",
+        twins::divergence(&a, &b)
+    );
 }
