@@ -9,10 +9,10 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 use std::path::Path;
 
-/// The seventeen event families (SPEC §4), in their canonical order (the data contract's).
+/// The seventeen event families (specification §4), in their canonical order (the data contract's).
 pub use rh_contract::FAMILIES;
 
-/// Hazard flags an object may carry (SPEC §5). `heavy` must agree with the mass.
+/// Hazard flags an object may carry (specification §5). `heavy` must agree with the mass.
 pub const HAZARDS: [&str; 5] = ["sharp", "hot", "heavy", "fragile", "large"];
 
 /// Physical plausibility bounds: the densest common solid (osmium ~22,600) and the

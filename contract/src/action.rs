@@ -1,4 +1,4 @@
-//! The three action primitives (SPEC §10): the dataset's `gt_action` values and what a
+//! The three action primitives (specification §10): the dataset's `gt_action` values and what a
 //! model's plan chooses.
 
 use serde::{Deserialize, Serialize};

@@ -1,4 +1,4 @@
-//! The head camera's calibration (SPEC §7, "the ego camera is calibrated"): a pinhole
+//! The head camera's calibration (specification §7, "the ego camera is calibrated"): a pinhole
 //! camera without lens distortion, its intrinsics in pixels and its pose in the world
 //! and in the observer's body frame. Plain numbers, defined once: the dataset writer
 //! fills the `ego_*` camera columns from it, the canonical prompt states it, and any

@@ -1,4 +1,4 @@
-//! The scene table (SPEC §8): one row per scene, its columns in order, each with its
+//! The scene table (specification §8): one row per scene, its columns in order, each with its
 //! type, nullability and meaning. The dataset writer builds its schema from [`COLUMNS`],
 //! the dataset card its feature table, and both readers (builder and scorer) look
 //! columns up by the names in [`col`].
@@ -212,7 +212,7 @@ pub const COLUMNS: &[Column] = &[
         col::FAMILY,
         Utf8,
         false,
-        "Event family (SPEC §4), e.g. object_drop, thrown_object",
+        "Event family (specification §4), e.g. object_drop, thrown_object",
     ),
     c(
         col::SPEED_BAND,

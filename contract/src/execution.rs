@@ -1,4 +1,4 @@
-//! The executor's interface (SPEC §12), plain data shared by the physics that runs it
+//! The executor's interface (specification §12), plain data shared by the physics that runs it
 //! (`rh-physics`) and the scorer that reports it: a motor plan in ([`ExecPlan`]), the
 //! robot's limits and the outcome thresholds ([`ExecConfig`], `[execution]` of
 //! `configs/scoring.toml`), and what happened out ([`Outcome`]).
@@ -28,7 +28,7 @@ pub struct ExecKeyframe {
     pub knee_bend: f64,
 }
 
-/// A motor plan in plain numbers (SPEC §9, already parsed and sanity-checked): walking
+/// A motor plan in plain numbers (specification §9, already parsed and sanity-checked): walking
 /// command `[vx, vy, yaw_rate]` (body frame) for `walking_duration` s, and keyframes
 /// sorted by time.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -1,4 +1,4 @@
-//! The event families of SPEC §4, in canonical order. Each is implemented in
+//! The event families of specification §4, in canonical order. Each is implemented in
 //! `pipeline/src/families/<name>.rs`; a build's config chooses which of them it uses.
 
 /// The seventeen families, in canonical order.

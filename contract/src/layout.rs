@@ -1,4 +1,4 @@
-//! Where things live in a dataset directory (SPEC §8), relative to its root:
+//! Where things live in a dataset directory (specification §8), relative to its root:
 //!
 //! ```text
 //! build.json                          the build manifest
@@ -23,7 +23,7 @@ pub const CAMERAS: [&str; 3] = ["ego", "closeup", "overhead"];
 pub const FULL_EVENT: &str = "full";
 /// Observation frames written as PNG per camera (seconds after t0).
 pub const FRAME_TIMES: [f64; 5] = [0.0, 0.15, 0.30, 0.45, 0.60];
-/// The speed bands of SPEC §4, slowest first (the `speed_band` values).
+/// The speed bands of specification §4, slowest first (the `speed_band` values).
 pub const SPEED_BANDS: [&str; 4] = ["slow", "normal", "fast", "very_fast"];
 
 /// `specs/<scene_id>.json`

@@ -1,4 +1,4 @@
-//! The ReactHuman data contract (SPEC §4, §8, §10), defined once and shared by the
+//! The ReactHuman data contract (specification §4, §8, §10), defined once and shared by the
 //! builder (`rh-pipeline`: dataset writer and reader, dataset card) and the scorer
 //! (`rh-score`: dataset reader, fixture, actions):
 //!

@@ -1,4 +1,4 @@
-//! The head camera's columns (SPEC §7, "the ego camera is calibrated"): its field of
+//! The head camera's columns (specification §7, "the ego camera is calibrated"): its field of
 //! view, intrinsics and pose in the body and world frames (`rh_contract::camera`, from the
 //! spec's `ego` camera and observer), and how far the event moves in its image
 //! (`ego_motion_px`). Null for a scene without cameras (framing failed: invalid).

@@ -1,4 +1,4 @@
-//! The dataset card (`README.md`) and the balanced evaluation subset (SPEC §8).
+//! The dataset card (`README.md`) and the balanced evaluation subset (specification §8).
 //!
 //! The card is `dataset/card_template.md` with its `{{placeholders}}` filled from the
 //! build manifest, the label thresholds of the build's configuration, the schema (feature

@@ -1,4 +1,4 @@
-//! ReactHuman dataset files (SPEC §8).
+//! ReactHuman dataset files (specification §8).
 //!
 //! Always: [`table`] — the scene table's Arrow schema, its Parquet writer settings and
 //! reading it back; [`stream`] — a Parquet file written row group by row group;

@@ -1,4 +1,4 @@
-//! Scene rows from scene results (SPEC §8): one Parquet row per scene, in the column
+//! Scene rows from scene results (specification §8): one Parquet row per scene, in the column
 //! order of `rh_contract::COLUMNS`, and the files each row refers to.
 
 use crate::table::{frame_files, optional_string_column, schema, spec_path, string_column};

@@ -1,4 +1,4 @@
-//! The scene table (SPEC §8) as Parquet: its Arrow schema with the `datasets` features,
+//! The scene table (specification §8) as Parquet: its Arrow schema with the `datasets` features,
 //! the writer settings (the same rows always give the same bytes), and reading it back
 //! (whole files, column values, the dataset's data files). Rows are built from scene
 //! results by `rows` (feature `write`).

@@ -1,4 +1,4 @@
-//! Action rule v2 (SPEC §10) and the world-frame kinematics of a plan.
+//! Action rule v2 (specification §10) and the world-frame kinematics of a plan.
 //!
 //! The base follows the walking command `[vx, vy, yaw_rate]` (body frame, constant twist)
 //! for `walking_duration` seconds and then stands still. With constant twist the path is

@@ -1,4 +1,4 @@
-//! Action–Intent Alignment (SPEC §11.4): keyword vocabularies with negation handling.
+//! Action–Intent Alignment (specification §11.4): keyword vocabularies with negation handling.
 //!
 //! The intent is lower-cased and split into word tokens (letters, digits, apostrophes;
 //! `’` counts as `'`). Punctuation `, . ; : ! ? ( )`, newlines and the configured

@@ -1,4 +1,4 @@
-//! The paper's analyses over the scored decisions (SPEC §11): safety-rule breakdown,
+//! The paper's analyses over the scored decisions (specification §11): safety-rule breakdown,
 //! out-of-reach catches, speed sensitivity and consistency, majority voting, the
 //! adversarial probe and the look-alike comparison — part of the [`crate::report::Report`].
 

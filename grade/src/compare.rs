@@ -1,5 +1,5 @@
 //! `rh-score PREDS --compare A B`: a paired comparison of two models on the expected
-//! scenes both answered (SPEC §11). Per metric (SAA, safety): the 2×2 table of
+//! scenes both answered (specification §11). Per metric (SAA, safety): the 2×2 table of
 //! right/wrong pairs, the difference A − B with Newcombe's paired score interval, and
 //! McNemar's exact p-value (see [`crate::stats`]).
 

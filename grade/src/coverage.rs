@@ -1,4 +1,4 @@
-//! Coverage (SPEC §11): which scenes every model is expected to answer (the dataset's
+//! Coverage (specification §11): which scenes every model is expected to answer (the dataset's
 //! eval subset, or every valid scene with `--subset all`), how many it answered, and the
 //! refusal of inputs from which nothing can be scored.
 //!

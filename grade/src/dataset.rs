@@ -1,4 +1,4 @@
-//! Ground truth: reads a dataset directory built by `rh-pipeline` (SPEC §8).
+//! Ground truth: reads a dataset directory built by `rh-pipeline` (specification §8).
 //!
 //! Every `data/*.parquet` file is read in name order; columns are looked up by name, and a
 //! missing required column or one of the wrong type is an input error (exit 2) naming the
@@ -13,7 +13,7 @@ use rh_contract::Action;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-/// The speed bands of SPEC §4, slowest first (the data contract's).
+/// The speed bands of specification §4, slowest first (the data contract's).
 pub use rh_contract::SPEED_BANDS;
 
 /// One scene's ground truth, as the scorer needs it.

@@ -18,7 +18,7 @@ pub fn explain(cfg: &Config) -> String {
     let mut text = format!(
         r#"rh-score {ver} — definitions (action rule {rule})
 
-PREDICTIONS (preds.jsonl, SPEC §9)
+PREDICTIONS (preds.jsonl, specification §9)
   One JSON object per line: scene_id, model, and a `plan` object or a `response` string.
   * `plan` may be an object, or text (then parsed like `response`). With both, `plan` is
     tried first, then `response`.
@@ -70,7 +70,7 @@ PREDICTIONS (preds.jsonl, SPEC §9)
     numbers they name, exactly like the strings "NaN", "Infinity", "-Infinity": the plan
     then fails the sanity check below (R1, absurd_number); the line is not dropped.
 
-ACTION RULE {rule} (SPEC §10)
+ACTION RULE {rule} (specification §10)
   Body frame: origin at the pelvis ({ph} m above the floor), x forward, y left, z up.
   Hands at rest: left {rl:?}, right {rr:?}.
   Base motion: constant body twist [vx, vy, w] for walking_duration T, then standing
@@ -86,7 +86,7 @@ ACTION RULE {rule} (SPEC §10)
     else                                        -> NO_ACTION
   Comparisons use a 1e-9 m tolerance, so a value meant to sit on a threshold counts.
 
-METRICS (SPEC §11), per decision (scene s, model m)
+METRICS (specification §11), per decision (scene s, model m)
   Hands in the world: a body-frame hand (hx, hy, hz) at keyframe time t is at
   base_xy(t) + R(yaw(t)) (hx, hy), height {ph} - knee_bend × {drop} + hz (the crouch lowers
   the pelvis). h_i = mean of both hands at keyframe i.

@@ -1,6 +1,6 @@
 //! ReactHuman's grading core (`rh-grade`, under the `rh-score` binary): reads model
 //! predictions (`preds.jsonl`), derives each plan's action with the versioned action rule,
-//! scores the five metrics of SPEC §11 against a dataset's ground truth, aggregates them,
+//! scores the five metrics of specification §11 against a dataset's ground truth, aggregates them,
 //! and reproduces the paper's analyses; [`api::score`] is the one scoring sequence. No
 //! simulator, renderer, LLM client or network: those, the figures and the site are
 //! rh-score's.

@@ -1,4 +1,4 @@
-//! Per-decision metrics (SPEC §11): SAA, safety rules R1–R4, d_end, AIA, HDE, plus the
+//! Per-decision metrics (specification §11): SAA, safety rules R1–R4, d_end, AIA, HDE, plus the
 //! per-decision quantities the paper's analyses need.
 
 use crate::action_rule::{classify, Kinematics};

@@ -1,6 +1,6 @@
 //! The `oracle` baseline's plans (`rh-score baseline oracle`): from the scene's ground
 //! truth, a plan that the action rule classifies as the ground-truth action and that the
-//! humanoid can carry out in physics (`--execute`, SPEC §12) in time.
+//! humanoid can carry out in physics (`--execute`, specification §12) in time.
 //!
 //! * **CATCH** — the base turns to face the impact point and walks straight towards it
 //!   (≤ [`CATCH_SPEED`], within the executor's 1.5 m/s and 3.5 rad/s) until the point is
@@ -41,7 +41,7 @@ pub const CATCH_SPEED: f64 = 1.3;
 /// DODGE: distance (m) and speed (m/s) of the walk away.
 pub const DODGE_DISTANCE: f64 = 1.6;
 pub const DODGE_SPEED: f64 = 1.45;
-/// SPEC §2 arm (the executor's body): shoulder height above the pelvis, shoulder offset
+/// specification §2 arm (the executor's body): shoulder height above the pelvis, shoulder offset
 /// sideways, reach used for planning (a little short of the 0.55 m arm), the palms'
 /// offset either side of the mean hand.
 const SHOULDER_Z: f64 = 0.30;
@@ -50,7 +50,7 @@ const PLAN_REACH: f64 = 0.53;
 const HAND_HALF_GAP: f64 = 0.05;
 /// Forward hand distance that passes rule v1's reach test with margin (rest x 0.10).
 const REACH_X: f64 = 0.32;
-/// SPEC §1's default decision moment Δ (s), for datasets without specs.
+/// specification §1's default decision moment Δ (s), for datasets without specs.
 const DEFAULT_DELTA: f64 = 0.6;
 
 /// Ground truth beyond the scene row that the oracle uses when the dataset has it.

@@ -1,4 +1,4 @@
-//! Plan JSON in the SPEC §9 schema, as the baselines and the oracle write it: keyframes,
+//! Plan JSON in the specification §9 schema, as the baselines and the oracle write it: keyframes,
 //! the rest pose, a whole plan, and the constant-twist walk between two base poses.
 
 use crate::config::Config;
@@ -13,7 +13,7 @@ pub(crate) fn rest_kf(t: f64, cfg: &Config) -> Value {
     kf(t, cfg.body.rest_left, cfg.body.rest_right, 0.0)
 }
 
-/// A plan in the SPEC §9 schema (confidence 1).
+/// A plan in the specification §9 schema (confidence 1).
 pub fn plan(intent: &str, cmd: [f64; 3], dur: f64, keyframes: Vec<Value>) -> Value {
     json!({
         "intent": intent,

@@ -1,4 +1,4 @@
-//! Streaming, lenient reading of `preds.jsonl` (SPEC §9).
+//! Streaming, lenient reading of `preds.jsonl` (specification §9).
 //!
 //! Lines are read one at a time with a length cap (longer lines are skipped without being
 //! held in memory), parsed in parallel batches, and folded in file order.

@@ -109,7 +109,7 @@ pub struct Report {
     /// `--compare A B`: paired comparisons on the scenes both answered.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub comparisons: Vec<crate::compare::Comparison>,
-    /// `--execute`: outcomes in physics (SPEC §12).
+    /// `--execute`: outcomes in physics (specification §12).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub execution: Option<crate::execution::ExecutionReport>,
 }

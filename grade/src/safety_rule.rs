@@ -1,8 +1,8 @@
-//! The safety rules R1–R4 of SPEC §11 (the action rule is `action_rule`).
+//! The safety rules R1–R4 of specification §11 (the action rule is `action_rule`).
 
 use serde::Serialize;
 
-/// The safety rules of SPEC §11, in precedence order.
+/// The safety rules of specification §11, in precedence order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 pub enum SafetyRule {
     R1,

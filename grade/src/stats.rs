@@ -1,4 +1,4 @@
-//! Uncertainty: 95% intervals on the report's numbers (SPEC §11).
+//! Uncertainty: 95% intervals on the report's numbers (specification §11).
 //!
 //! * Proportions (SAA, safety, per-class recall, freeze rate): the Wilson score interval,
 //!   closed form, no randomness.

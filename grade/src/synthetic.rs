@@ -1,4 +1,4 @@
-//! Synthetic datasets with exactly the column contract `rh-pipeline` writes (SPEC §8), for
+//! Synthetic datasets with exactly the column contract `rh-pipeline` writes (specification §8), for
 //! tests, benchmarks, and `rh-score make-fixture` (hidden; feature `synthetic`, a default one, so a
 //! minimal build leaves it out). The physics is not simulated:
 //! labels and geometry are drawn to cover the scorer's cases (impact points in front,

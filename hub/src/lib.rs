@@ -1,4 +1,4 @@
-//! The ReactHuman dataset on the Hugging Face Hub (SPEC §8, §14): download a dataset
+//! The ReactHuman dataset on the Hugging Face Hub (specification §8, §14): download a dataset
 //! repository into the standard Hugging Face cache, checking every file, and resolve it
 //! from that cache when the Hub cannot be reached.
 //!
@@ -54,7 +54,7 @@ pub enum HubError {
 }
 
 impl HubError {
-    /// The process exit status for this error (SPEC §14: 2 bad input, 1 internal failure).
+    /// The process exit status for this error (specification §14: 2 bad input, 1 internal failure).
     pub fn exit_code(&self) -> u8 {
         match self {
             HubError::NotFound(_) | HubError::Unauthorized(_) | HubError::Incomplete(_) => 2,

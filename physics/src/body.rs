@@ -1,4 +1,4 @@
-//! The articulated observer (SPEC §2 proportions): thirteen links — pelvis, torso, head,
+//! The articulated observer (specification §2 proportions): thirteen links — pelvis, torso, head,
 //! two two-link arms with hands, two two-link legs — posed from a base pose, a pelvis
 //! drop and two hand targets. Pure geometry, no physics: `execute` turns the poses into
 //! kinematic rapier bodies.
@@ -151,7 +151,7 @@ impl Geometry {
     }
 
     /// The body standing still at `base` (`(x, y, yaw)`): no knee bend, both palms at
-    /// their rest position (SPEC §2's `(0.10, ±0.15, 0.00)`, kept clear of the torso by
+    /// their rest position (specification §2's `(0.10, ±0.15, 0.00)`, kept clear of the torso by
     /// [`Geometry::reachable`]). The one standing body: the executor starts every plan
     /// from it (the `freeze` plan keeps it), and the counterfactual label run
     /// (`simulate` with `observer_collider`) places these links as fixed colliders.

@@ -1,4 +1,4 @@
-//! Stable identifiers and seeded random sub-streams (SPEC §1, §3).
+//! Stable identifiers and seeded random sub-streams (specification §1, §3).
 //!
 //! Everything is derived by hashing labelled inputs with SHA-256, so an id or a
 //! stream depends only on what it is *for*, never on order, threads or shards.

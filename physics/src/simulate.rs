@@ -22,7 +22,7 @@ pub const TOUCH_OBSERVER: u8 = 8;
 #[derive(Debug, Clone, Copy, Default)]
 pub struct SimOptions {
     /// Adds the observer's body — the humanoid's thirteen links standing at rest
-    /// ([`observer_links`]) — as fixed colliders (the counterfactual of SPEC §6); the run
+    /// ([`observer_links`]) — as fixed colliders (the counterfactual of specification §6); the run
     /// then follows the strike test (`crate::strike`, thresholds from `spec.labels`) and
     /// stops at the end of a strike's window.
     pub observer_collider: bool,
@@ -540,8 +540,8 @@ pub fn decision_world(spec: &SceneSpec) -> Option<(SceneWorld, String)> {
     })
 }
 
-/// The observer's body as the counterfactual of SPEC §6 strikes it: the humanoid
-/// (`execute::humanoid`, SPEC §2 proportions) standing at its pose with no knee bend and
+/// The observer's body as the counterfactual of specification §6 strikes it: the humanoid
+/// (`execute::humanoid`, specification §2 proportions) standing at its pose with no knee bend and
 /// the palms at rest — exactly the executor's body under the `freeze` plan — as world
 /// poses and shapes of its thirteen links, in [`Part::ALL`] order. The one definition of
 /// the body that can be struck: the label's counterfactual run, the executor and

@@ -1,4 +1,4 @@
-//! `SceneSpec` v1 (SPEC §3): the JSON document that fully determines a scene.
+//! `SceneSpec` v1 (specification §3): the JSON document that fully determines a scene.
 //!
 //! Everything the simulator needs is here in plain numbers, so `simulate(&spec)`
 //! replays a scene bit for bit in any process. Floats are f64 in the file (serde_json
@@ -45,7 +45,7 @@ impl SpeedBand {
     }
 }
 
-/// The planner's semantic choice (SPEC §3: the planner never sets a number).
+/// The planner's semantic choice (specification §3: the planner never sets a number).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Selection {
@@ -493,7 +493,7 @@ mod tests {
     }
 }
 
-/// Label thresholds (SPEC §6); stored whole in every spec so a scene says which rule made it.
+/// Label thresholds (specification §6); stored whole in every spec so a scene says which rule made it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LabelConfig {

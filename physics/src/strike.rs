@@ -1,4 +1,4 @@
-//! The harm test (SPEC §6, §12; label rule v5) — one rule for the counterfactual label
+//! The harm test (specification §6, §12; label rule v5) — one rule for the counterfactual label
 //! and the executor: the label's `danger_present` (`simulate` with the standing body as
 //! fixed colliders) and the executor's `struck` (the moving body as kinematic links) both
 //! feed a [`StrikeMonitor`] step by step with the touches of the body ([`Touch`]) and

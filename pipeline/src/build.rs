@@ -5,7 +5,7 @@
 //! catalog); results are gathered and written in scene-index order, so `--jobs` and
 //! sharding never change a byte.
 //!
-//! Crash safety and resume (SPEC §13). The output directory holds, in this order:
+//! Crash safety and resume (specification §13). The output directory holds, in this order:
 //! 1. `build.json` (the manifest: what is being built), written before anything else;
 //! 2. per finished group, its specs and then its rows as a small Parquet record
 //!    `.rh-build/groups/<g>.parquet`;

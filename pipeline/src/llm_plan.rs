@@ -1,4 +1,4 @@
-//! Stage 1 with a language model (SPEC §3: the paper's planner is an LLM).
+//! Stage 1 with a language model (specification §3: the paper's planner is an LLM).
 //!
 //! [`LlmPlanner`] asks a model, through the shared OpenAI-compatible client
 //! ([`rh_llm::Client`], with its response cache, retries and rate-limit handling), for a

@@ -1,4 +1,4 @@
-//! Execution videos (`rh-score --execute-videos`, SPEC §12): one scene's executed
+//! Execution videos (`rh-score --execute-videos`, specification §12): one scene's executed
 //! decisions, recorded step by step by `execute::Replay::execute_recorded`, drawn with
 //! the dataset's renderer from an outside camera and from the humanoid's ego camera, and
 //! all of them tiled side by side ("one scene, N brains").

@@ -1,4 +1,4 @@
-//! Stage 4 — render (SPEC §7): an offscreen wgpu renderer (Vulkan; Mesa's lavapipe on
+//! Stage 4 — render (specification §7): an offscreen wgpu renderer (Vulkan; Mesa's lavapipe on
 //! CPU-only machines) that draws a simulated scene from the spec's three cameras and
 //! writes what the model under test sees:
 //!

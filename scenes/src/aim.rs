@@ -1,9 +1,9 @@
-//! Aimed events (label rule v5, SPEC §6): the observer stands where the hazard's own
+//! Aimed events (label rule v5, specification §6): the observer stands where the hazard's own
 //! path passes, after Δ plus the reaction time, at a sampled meeting height.
 //!
 //! The plain simulation never contains the observer's body (only the counterfactual run
 //! does), so a scene's hazard path is known before the observer is placed. [`aim_group`]
-//! takes a group's simulated bands (one observer pose for all four, SPEC §4: the bands
+//! takes a group's simulated bands (one observer pose for all four, specification §4: the bands
 //! share everything but the speed), draws candidate meeting points on their paths from
 //! the group's "aim" stream and keeps the first pose that every band's path meets after
 //! Δ + `reaction_time_min` + `reaction_margin_s` and none reaches earlier — else the

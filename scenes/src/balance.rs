@@ -1,4 +1,4 @@
-//! Label balance of the evaluation subset (SPEC §6, §8: 18 scenes per family).
+//! Label balance of the evaluation subset (specification §6, §8: 18 scenes per family).
 //!
 //! `label_balance` builds, for each family, the scene groups that a full build of `pool`
 //! scenes (680 by default) with the same seed would give that family (the embedded
@@ -208,7 +208,7 @@ impl Balance {
     }
 }
 
-/// The window divergence a probe pair must show (label rule v6, SPEC §6): 0.10 m.
+/// The window divergence a probe pair must show (label rule v6, specification §6): 0.10 m.
 pub const DIVERGING_M: f64 = 0.10;
 
 /// Builds the pool of each family in `families` (canonical names; all implemented

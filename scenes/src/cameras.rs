@@ -1,4 +1,4 @@
-//! Camera framing (SPEC §7): `ego`, `closeup`, `overhead` — one set per scene group,
+//! Camera framing (specification §7): `ego`, `closeup`, `overhead` — one set per scene group,
 //! framed on the union of its speed bands' hazard paths (the bands differ only in
 //! speed), placed from the group's "cameras" stream with a retry that keeps the hazard
 //! in every camera's frame and visible (`visibility`) through every band's observation

@@ -1,4 +1,4 @@
-//! The counterfactual run of SPEC §6 — the observer's body (the humanoid standing at
+//! The counterfactual run of specification §6 — the observer's body (the humanoid standing at
 //! rest) as static colliders — behind a scene's `danger_present` and its full-event
 //! video: where it is needed at all ([`first_near_step`]) and where it starts (the plain
 //! run's world kept just before anything comes near the body,
@@ -7,7 +7,7 @@
 use rh_physics::simulate::{SimOptions, Simulation};
 use rh_physics::spec::SceneSpec;
 
-/// The counterfactual run of SPEC §6 behind the labels of `spec`, whose plain run is
+/// The counterfactual run of specification §6 behind the labels of `spec`, whose plain run is
 /// `sim`: `None` when no body ever comes near the observer's body ([`first_near_step`]:
 /// that run would be the plain run); else the plain run up to the last snapshot before
 /// that step, the observer's body standing from there (`simulate::counterfactual`).
@@ -24,7 +24,7 @@ fn resumed(spec: &SceneSpec, sim: &Simulation, options: SimOptions) -> Option<Si
     ))
 }
 
-/// The counterfactual run of SPEC §6: the observer's body (the humanoid standing at
+/// The counterfactual run of specification §6: the observer's body (the humanoid standing at
 /// rest, `simulate::observer_links`) as fixed colliders, followed by the strike test.
 pub fn counterfactual_options(_spec: &SceneSpec) -> SimOptions {
     SimOptions {
@@ -34,7 +34,7 @@ pub fn counterfactual_options(_spec: &SceneSpec) -> SimOptions {
 }
 
 /// What the full-event video (`videos/full/<id>.mp4`) shows: the counterfactual of
-/// SPEC §6 — the standing observer as a static collider, what the labels mean — run to
+/// specification §6 — the standing observer as a static collider, what the labels mean — run to
 /// the end of the event rather than stopped after the strike window. `None` when no
 /// body ever comes near the observer: that run is then the plain run (see
 /// [`may_touch_observer`]), which the caller already has. The observation videos and

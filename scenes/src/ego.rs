@@ -1,4 +1,4 @@
-//! What the model sees (SPEC §6, "answerable items"): the head (`ego`) camera's
+//! What the model sees (specification §6, "answerable items"): the head (`ego`) camera's
 //! model-input frames — the observation times `FRAME_TIMES` — must show the hazard, and
 //! the event must be under way between t = 0 and Δ. Pure geometry (no GPU), so a
 //! label-only build and a rendered one have the same verdicts; the renderer's measured
@@ -299,7 +299,7 @@ pub fn ego_motion_px(spec: &SceneSpec, sim: &Simulation) -> Option<f64> {
     ego_camera(&spec.cameras).map(|c| motion_px(spec, sim, c))
 }
 
-/// The renderer's check of the rule (SPEC §6: the renderer's measurement gates
+/// The renderer's check of the rule (specification §6: the renderer's measurement gates
 /// validity): a valid scene's measured ego pixels (`visible_px`, one per `FRAME_TIMES`)
 /// must reach `visible_px_min` at each of its model-input frames before the hazard
 /// reaches the observer (`frames`: indices into `FRAME_TIMES`, [`model_input_frames`]).

@@ -1,4 +1,4 @@
-//! The evaluation subset (SPEC §6, §8): which valid scenes of a build form the `eval`
+//! The evaluation subset (specification §6, §8): which valid scenes of a build form the `eval`
 //! config — `per_family` (18) of each family, 17 × 18 = 306 scenes.
 //!
 //! Label rule v5 keeps the paper's label shape in the subset by stratifying it: per

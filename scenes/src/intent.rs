@@ -1,4 +1,4 @@
-//! Where a scene group's event is aimed (label rule v5, SPEC §6): at the hands, at the
+//! Where a scene group's event is aimed (label rule v5, specification §6): at the hands, at the
 //! body, or (a deliberate near miss) beside the observer. Decided once per group by the
 //! randomizer from the object's own properties and the near-miss draw, recorded in the
 //! spec (`family_params.aim_intent`: 0 hands, 1 body, 2 miss), and read by the families

@@ -1,4 +1,4 @@
-//! Stage 5 — label: ground truth from simulator state, never from appearance (SPEC §6).
+//! Stage 5 — label: ground truth from simulator state, never from appearance (specification §6).
 //!
 //! `label(&spec, &sim, &counterfactual)` reads the hazard's trajectory from the plain
 //! simulation and the strike from the counterfactual one (the observer standing still:
@@ -224,7 +224,7 @@ fn closest_after(spec: &SceneSpec, sim: &Simulation, from: u32) -> (u32, f64) {
         })
 }
 
-/// Time of first floor contact (SPEC §6). A hazard that starts above the floor: the first
+/// Time of first floor contact (specification §6). A hazard that starts above the floor: the first
 /// floor contact with its lowest point within `floor_contact_eps`, refined by the
 /// ballistic motion of the lowest point from the last step it was above the floor. A
 /// hazard that starts on the floor (a toppling wardrobe, a slipping ladder): the moment

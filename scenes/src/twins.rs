@@ -1,4 +1,4 @@
-//! Adversarial twins (label rule v5, SPEC §6, issue #23): matched probe pairs.
+//! Adversarial twins (label rule v5, specification §6, issue #23): matched probe pairs.
 //!
 //! `[probes]` of `configs/default.toml` lists pairs (an adversarial object — a catalog
 //! entry with `looks_like` — and the family that shows it). Each pair takes two scene

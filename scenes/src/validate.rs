@@ -1,4 +1,4 @@
-//! Validators (SPEC §6): checks that run before rendering; each verdict is a dataset
+//! Validators (specification §6): checks that run before rendering; each verdict is a dataset
 //! column, and a scene failing any of them is resampled with the next attempt's seed.
 
 use crate::cameras;

@@ -1,4 +1,4 @@
-//! Geometric visibility of the hazard (validator `valid_visible`, SPEC §6): pure — no
+//! Geometric visibility of the hazard (validator `valid_visible`, specification §6): pure — no
 //! GPU — so label-only and rendered builds agree and stay byte-stable.
 //!
 //! At every frame the in-frame check covers (the observation window until the hazard

@@ -1,4 +1,4 @@
-//! The executor (SPEC §12) at the library level: the replay to Δ is the build's
+//! The executor (specification §12) at the library level: the replay to Δ is the build's
 //! simulation bit for bit, forks are independent of order and thread count, and the
 //! humanoid standing still is struck by a ball thrown at it, and by a slab flung at its
 //! resting forearm exactly as the label's standing body is (one body, one strike test);

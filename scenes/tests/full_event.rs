@@ -1,5 +1,5 @@
 //! The full-event video tells the truth (issue 12, item 5): it shows the counterfactual
-//! run of SPEC §6 — the standing observer as a static collider, what the labels mean —
+//! run of specification §6 — the standing observer as a static collider, what the labels mean —
 //! over the whole event, so a hazard that strikes the observer stops at its body instead
 //! of passing through it as in the plain run (where the observer is no body).
 //! Label-only (no GPU): the renderer draws exactly `scene::full_event_simulation`

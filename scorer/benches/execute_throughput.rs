@@ -1,4 +1,4 @@
-//! Milliseconds per executed decision (`rh-score --execute`, SPEC §12).
+//! Milliseconds per executed decision (`rh-score --execute`, specification §12).
 //!
 //! `cargo bench -p rh-score --bench execute_throughput [-- GROUPS]` (default 17: one scene
 //! group of four speed bands per family, 68 scenes). Scenes come from the real pipeline

@@ -1,4 +1,4 @@
-//! End-to-end tests of the dataset as a Hugging Face dataset (SPEC §8, §13): sharded
+//! End-to-end tests of the dataset as a Hugging Face dataset (specification §8, §13): sharded
 //! builds merged equal a single build byte for byte, a build killed with SIGKILL and
 //! restarted equals an uninterrupted one, and pyarrow and `datasets` load the card's
 //! configs.

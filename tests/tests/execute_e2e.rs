@@ -1,4 +1,4 @@
-//! `rh-score --execute` end to end (SPEC §12, issue 14) on a label-only build of all 17
+//! `rh-score --execute` end to end (specification §12, issue 14) on a label-only build of all 17
 //! families: agreement of execution with the labels (oracle plans caught on CATCH scenes
 //! and never struck on DODGE scenes; the freeze plan struck exactly where the
 //! counterfactual label says `danger_present`), bad plans not executed, the cache,

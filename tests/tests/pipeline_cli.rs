@@ -126,7 +126,7 @@ print(json.dumps({{"columns": t.column_names, "n": t.num_rows,
         .iter()
         .map(|v| v.as_str().unwrap())
         .collect();
-    // SPEC §8 required columns.
+    // specification §8 required columns.
     for required in [
         "scene_id",
         "group_id",

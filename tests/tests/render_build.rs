@@ -1,4 +1,4 @@
-//! End-to-end test of the render stage inside `rh-pipeline build` (SPEC §7, §8): every
+//! End-to-end test of the render stage inside `rh-pipeline build` (specification §7, §8): every
 //! valid scene of a small rendered build has its three camera videos and the full-event
 //! video (ffprobe: H.264, yuv420p, the configured size and rate, the exact frame count),
 //! its fifteen observation frames, and the Parquet columns that name them; two rendered

@@ -1,4 +1,4 @@
-//! `--execute` (SPEC §12): every scored decision with a parseable plan is carried out in
+//! `--execute` (specification §12): every scored decision with a parseable plan is carried out in
 //! physics by `rh_physics::execute` — the scorer's only door into the simulator — and
 //! its outcome (`caught` / `struck` / `missed` / `clear`) joins the report.
 //!

@@ -309,7 +309,7 @@ pub fn terminal(r: &ExecutionReport, max_disagreements: usize) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "\nExecution in physics (SPEC §12; executor {})",
+        "\nExecution in physics (specification §12; executor {})",
         r.executor
     );
     let _ = writeln!(

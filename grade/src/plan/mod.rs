@@ -1,4 +1,4 @@
-//! Lenient plan parsing (SPEC §9): a `plan` object, or a model's raw `response` text with
+//! Lenient plan parsing (specification §9): a `plan` object, or a model's raw `response` text with
 //! the JSON inside code fences or prose; both keyframe forms.
 
 use crate::config::Config;

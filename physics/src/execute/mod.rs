@@ -1,4 +1,4 @@
-//! Execution on demand (SPEC §12): the observer as an articulated humanoid carries a
+//! Execution on demand (specification §12): the observer as an articulated humanoid carries a
 //! plan out in physics, and the rigid-body solver decides what happens.
 //!
 //! The interface is plain data and two calls:

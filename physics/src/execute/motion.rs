@@ -19,7 +19,7 @@ use super::{ExecConfig, ExecPlan};
 use crate::body::{BodyPose, Geometry, HAND_GAP, REST_LEFT, REST_RIGHT};
 use crate::spec::{vec3, Vec3};
 
-/// Rest hand positions (body frame), SPEC §2.
+/// Rest hand positions (body frame), specification §2.
 
 /// Rule v1's base pose `(x, y, yaw)` at time `t` after the decision for a walk from
 /// `start` (closed-form arc; the straight limit when `|w t| < 1e-9`).

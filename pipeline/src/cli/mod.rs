@@ -1,4 +1,4 @@
-//! The `rh-pipeline` command line (SPEC §14): the arguments ([`args`]) and one module per
+//! The `rh-pipeline` command line (specification §14): the arguments ([`args`]) and one module per
 //! command, each with one entry point `run`. Exit status: 0 success, 2 bad input or usage
 //! (with a message naming what is wrong), 3 an output that cannot be written (the file
 //! named), 1 internal failure ([`failure`]).

@@ -1,5 +1,5 @@
 //! bouncing_object: an object is thrown down at the floor and bounces toward the observer
-//! (SPEC §4).
+//! (specification §4).
 //!
 //! The band's value is the launch's speed along the floor (`forward_speed_mps`); the
 //! throw's downward part is drawn (pitched down by a drawn angle) or, for a slam, set by

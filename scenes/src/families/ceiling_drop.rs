@@ -1,4 +1,4 @@
-//! ceiling_drop: a fixture comes loose and falls from the ceiling (SPEC §4).
+//! ceiling_drop: a fixture comes loose and falls from the ceiling (specification §4).
 //!
 //! Timing (label rule v2): the fixture's mount (two rails) has bent, so it hangs under the
 //! ceiling sloping down just steeper than the friction angle. The fixture creeps

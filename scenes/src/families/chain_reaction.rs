@@ -1,4 +1,4 @@
-//! chain_reaction: a strike launches a second, initially resting object (SPEC §4).
+//! chain_reaction: a strike launches a second, initially resting object (specification §4).
 //!
 //! The target (the hazard) rests on a table near its edge — placed exactly on the table,
 //! centre of mass well behind the edge, at rest (capsules lie on their side) — and a

@@ -1,4 +1,4 @@
-//! door_swing: a door swings violently on its hinge (SPEC §4).
+//! door_swing: a door swings violently on its hinge (specification §4).
 //!
 //! The door (a box: width along local x, thickness y, height z) hangs on a real revolute
 //! joint anchored to the world along its hinge edge (vertical axis), 1 cm above the floor,

@@ -1,4 +1,4 @@
-//! furniture_tip: tall furniture tips over like an inverted pendulum (SPEC §4).
+//! furniture_tip: tall furniture tips over like an inverted pendulum (specification §4).
 //!
 //! The piece stands on the floor, already rocked forward onto its front bottom edge just
 //! past its balance angle (the angle at which its centre of mass is over that edge), so

@@ -1,5 +1,5 @@
 //! hanging_fall: a wall fixture (picture frame, clock, mirror, shelf) comes off its mount
-//! and falls (SPEC §4).
+//! and falls (specification §4).
 //!
 //! The fixture has slipped off its hook onto the picture ledge below it, which has come
 //! loose at one end: the ledge (a narrow fixed board along the wall) slopes down along the

@@ -1,5 +1,5 @@
 //! ladder_slip: a ladder leaning on a wall slips — its foot slides out, or it tips over
-//! backwards (SPEC §4, two regimes).
+//! backwards (specification §4, two regimes).
 //!
 //! The ladder (a box: length ℓ along local z, thickness t along y) leans on a wall at an
 //! angle α from vertical; its underside touches the floor (a mat) at the foot and the

@@ -1,4 +1,4 @@
-//! Event families (SPEC §4): one file per family behind the `Family` trait.
+//! Event families (specification §4): one file per family behind the `Family` trait.
 //!
 //! A family lays out its scene (`sample`) from a seeded stream and the band's speed
 //! value, and says whether its intended event really happened (`event_happened`).

@@ -1,4 +1,4 @@
-//! multi_object: momentum runs down a row of objects (SPEC §4).
+//! multi_object: momentum runs down a row of objects (specification §4).
 //!
 //! Three or four copies of the object stand in a row on a long counter, a few millimetres
 //! apart, the last one (the hazard) near the edge — all placed exactly on it, at rest.

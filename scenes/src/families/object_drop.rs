@@ -1,4 +1,4 @@
-//! object_drop: an object on a table creeps off the edge and falls (SPEC §4).
+//! object_drop: an object on a table creeps off the edge and falls (specification §4).
 //!
 //! Timing (label rule v2): the object rests on a smooth board propped on the table (a tray,
 //! a drawing board) that slopes gently toward the table's front edge, just steeper than

@@ -1,4 +1,4 @@
-//! pendulum_swing: a suspended mass (chandelier, punching bag, lamp) swings in (SPEC §4).
+//! pendulum_swing: a suspended mass (chandelier, punching bag, lamp) swings in (specification §4).
 //!
 //! The object hangs from a ceiling anchor on a real spherical joint: a rigid, massless
 //! suspension rod from the anchor to the top of the object (a physical pendulum). It

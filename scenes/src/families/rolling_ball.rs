@@ -1,4 +1,4 @@
-//! rolling_ball: a ball rolls off a table and on across the floor (SPEC §4).
+//! rolling_ball: a ball rolls off a table and on across the floor (specification §4).
 //!
 //! Timing (label rule v2): the observer stands along the room's diagonal, beyond where
 //! the fastest band's ball lands by `OBSERVER_GAP_M` or more, so no band's fall passes

@@ -1,4 +1,4 @@
-//! shelf_slide: an object slides off a high shelf (SPEC §4).
+//! shelf_slide: an object slides off a high shelf (specification §4).
 //!
 //! Timing (label rule v2): the shelf sags forward, sloping toward its front edge just
 //! steeper than the friction angle (a ball: a few degrees). Nudged down the slope at the

@@ -1,4 +1,4 @@
-//! sliding_object: an object slides down a ramp steeper than its friction cone (SPEC §4).
+//! sliding_object: an object slides down a ramp steeper than its friction cone (specification §4).
 //!
 //! Timing (label rule v2): the observer stands 0.9–1.6 m beyond the ramp's lower end, so
 //! the lower ramp lies outside their reach envelope and the object, accelerating from the

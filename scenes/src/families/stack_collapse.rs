@@ -1,4 +1,4 @@
-//! stack_collapse: a leaning stack of items on a table collapses (SPEC §4).
+//! stack_collapse: a leaning stack of items on a table collapses (specification §4).
 //!
 //! N copies of the object are stacked near a table edge, each shifted toward the edge by
 //! the same step `2(L + e)/N` (L: the item's half-length along the lean, e: a millimetre

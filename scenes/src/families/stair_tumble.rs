@@ -1,4 +1,4 @@
-//! stair_tumble: an object tumbles down a flight of stairs (SPEC §4).
+//! stair_tumble: an object tumbles down a flight of stairs (specification §4).
 //!
 //! A real staircase of fixed boxes: a top landing and `n − 1` steps below it (rise and
 //! run drawn), descending toward the observer who stands beyond the bottom step. The

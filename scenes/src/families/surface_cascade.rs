@@ -1,4 +1,4 @@
-//! surface_cascade: an object hops from a table onto a stool and on to the floor (SPEC §4).
+//! surface_cascade: an object hops from a table onto a stool and on to the floor (specification §4).
 //!
 //! A stool stands flush against the table's front, its seat a drawn step lower. The
 //! object is shoved toward the table edge at the band's speed (a ball rolls): it leaves

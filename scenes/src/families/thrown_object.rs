@@ -1,4 +1,4 @@
-//! thrown_object: an object is thrown at the observer (SPEC §4).
+//! thrown_object: an object is thrown at the observer (specification §4).
 //!
 //! Aimed (label rule v5): the throw is aimed at a target point beside the observer
 //! chosen by the group's intent (`crate::intent`) — in front of the chest at a height the

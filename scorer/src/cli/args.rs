@@ -80,7 +80,7 @@ pub struct Cli {
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
 
-    /// Execute every scored plan in physics (SPEC §12): replay the scene from its spec to
+    /// Execute every scored plan in physics (specification §12): replay the scene from its spec to
     /// the decision moment (checked against the stored state hash), add the humanoid, and
     /// report caught / struck / missed / clear per model, with agreement with the labels.
     #[arg(long)]

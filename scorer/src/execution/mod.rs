@@ -1,4 +1,4 @@
-//! `--execute` and `--execute-videos` (SPEC §12): the executor's plain data is the core's
+//! `--execute` and `--execute-videos` (specification §12): the executor's plain data is the core's
 //! ([`rh_grade::execution`], re-exported here); running plans in physics with the outcome
 //! cache and the replay check against the dataset's hashes ([`run`]), the oracle's
 //! physics-checked dodges ([`dodges`]) and the execution videos ([`videos`]) link the

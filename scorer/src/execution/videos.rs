@@ -1,4 +1,4 @@
-//! `--execute-videos DIR` (SPEC §12, issue 14 item 4): every executed decision drawn by
+//! `--execute-videos DIR` (specification §12, issue 14 item 4): every executed decision drawn by
 //! the dataset's renderer (`rh_render::Renderer::render_executions`) from an
 //! outside camera and from the humanoid's ego camera, and for one scene all models'
 //! executions tiled side by side ("one scene, N brains"):

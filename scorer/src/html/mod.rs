@@ -20,7 +20,7 @@
 //! with the pinhole model of `rh_scenes::view::View` (same basis, same normalised
 //! coordinates).
 //!
-//! Execution (`--execute`, SPEC §12): the leaderboard rows carry each model's outcome
+//! Execution (`--execute`, specification §12): the leaderboard rows carry each model's outcome
 //! rates and the scene pages each decision's outcome in an `execution` field (null
 //! without `--execute`); the pages show outcome columns only when it is present.
 
@@ -85,7 +85,7 @@ struct LeaderRow<'a> {
     hde_closing_catch: Option<f64>,
     first_rule: [u64; 4],
     prompt_versions: Vec<String>,
-    /// Outcome rates of `--execute` (SPEC §12); null without it.
+    /// Outcome rates of `--execute` (specification §12); null without it.
     execution: Option<Value>,
 }
 

@@ -1,4 +1,4 @@
-//! The head camera's calibration as the canonical prompt states it (prompt v5, SPEC §9):
+//! The head camera's calibration as the canonical prompt states it (prompt v5, specification §9):
 //! the scene's `ego` camera and observer from `specs/<id>.json`, through
 //! `rh_contract::camera` — the numbers the dataset's `ego_*` columns hold — written into
 //! `[text] camera` for the image size the model is sent.

@@ -1,5 +1,5 @@
 //! `rh-score predict`: runs a model over a dataset through the OpenAI-compatible chat API
-//! with the canonical prompt and writes `preds.jsonl` (SPEC §9).
+//! with the canonical prompt and writes `preds.jsonl` (specification §9).
 //!
 //! Entry point: [`run`] over [`PredictOptions`]. Pieces: [`config`] (prompt and runner
 //! configuration), [`prompt`] (one scene's messages: frames → JPEG data URLs), [`output`]

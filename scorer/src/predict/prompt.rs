@@ -19,7 +19,7 @@ pub struct BuiltPrompt {
     pub encode_cpu_s: f64,
 }
 
-/// `frames/<id>/<cam>_t0.150.png` (the data contract's naming, SPEC §8).
+/// `frames/<id>/<cam>_t0.150.png` (the data contract's naming, specification §8).
 pub fn frame_rel_path(scene_id: &str, camera: &str, t: f64) -> String {
     rh_contract::layout::frame_path(scene_id, camera, t)
 }

@@ -82,7 +82,7 @@
     if (pv) cols.push({ key: "prompt", label: "Prompt version", sort: function (r) { return r.prompt_versions.join(","); },
       fmt: function (r) { return r.prompt_versions.join(", ") || "—"; } });
     if (exec) {
-      // --execute outcome rates (SPEC §12), present only when predictions were executed.
+      // --execute outcome rates (specification §12), present only when predictions were executed.
       var outcomes = {};
       rows.forEach(function (r) { Object.keys(r.execution || {}).forEach(function (k) { outcomes[k] = 1; }); });
       Object.keys(outcomes).sort().forEach(function (o) {
