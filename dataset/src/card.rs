@@ -136,7 +136,7 @@ fn eval_counts_text(eval: &BTreeMap<String, usize>, per_family: usize) -> String
 fn eval_rule_text(cfg: &EvalConfig) -> String {
     match cfg.catch_share {
         Some(share) => format!(
-            "evaluation subset, stratified by label (label rule v5): up to {} valid scenes per \
+            "evaluation subset, stratified by label: up to {} valid scenes per \
              family, {:.0}% of them CATCH where the family has them, at most {} NO_ACTION (its \
              adversarial twin pairs, taken first, up to {}; never a pair of two NO_ACTION), the \
              rest DODGE; a family short of CATCH gives more DODGE and the other way round; a \

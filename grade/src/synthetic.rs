@@ -346,12 +346,25 @@ pub fn write_dataset(dir: &Path, rows: &[FixtureRow], drop: &[&str]) -> Result<(
     let path = dir.join(data_file_name(0, 1));
     write_atomic(&path, &rh_dataset::table::parquet_bytes(&batch))?;
     for r in rows {
+        // The observer and its head camera, as a built spec has them (the prompt states the
+        // camera's calibration): the head 1.24 m up, looking ahead and down at the floor
+        // 2 m away, 720p with a 60° vertical field of view.
+        let [x, y, yaw] = r.scene.observer_pose;
         let spec = serde_json::json!({
             "schema_version": 1,
             "scene_id": r.scene.scene_id,
             "fixture": true,
             "family": r.scene.family,
             "observer_pose": r.scene.observer_pose,
+            "observer": { "x": x, "y": y, "yaw": yaw, "pelvis_z": 0.79 },
+            "cameras": [{
+                "name": "ego",
+                "position": [x, y, 1.24],
+                "look_at": [x + 2.0 * yaw.cos(), y + 2.0 * yaw.sin(), 0.0],
+                "fov_y": std::f64::consts::FRAC_PI_3,
+                "width": 1280,
+                "height": 720,
+            }],
         });
         write_atomic(
             &dir.join(spec_path(&r.scene.scene_id)),

@@ -268,7 +268,7 @@ struct RawConfig {
     #[serde(default)]
     eval: crate::eval_subset::EvalConfig,
     #[serde(default)]
-    probes: crate::twins::ProbeConfig,
+    probes: ProbeConfig,
 }
 
 /// The whole, validated build configuration (`Deserialize` reads back the copy a build
@@ -292,7 +292,7 @@ pub struct Config {
     pub eval: crate::eval_subset::EvalConfig,
     /// Adversarial probe pairs and their twins (absent in manifests of older builds: none).
     #[serde(default)]
-    pub probes: crate::twins::ProbeConfig,
+    pub probes: ProbeConfig,
     /// Set by the driver for the groups of an adversarial probe pair (`twins`): their
     /// intent (`intent::Intent::for_object`) is this catalog object's, the pair's benign
     /// member, whichever object they show. Not part of any file.
@@ -720,6 +720,35 @@ fn parse<T: serde::de::DeserializeOwned>(name: &str, text: &str) -> Result<T, Co
             message: e.message().to_string(),
         }
     })
+}
+
+/// `[probes]` of `configs/default.toml` (absent: no twins, builds before label rule v5).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeConfig {
+    #[serde(default)]
+    pub pairs: Vec<ProbePair>,
+    /// Label rule v6: a pair is a probe only where its hazards' centres of mass come this
+    /// far apart (m) at some physics step of the observation window [`divergence`];
+    /// otherwise both scenes stay, unpaired. 0: every pair is kept (rule v5).
+    #[serde(default)]
+    pub divergence_min: f64,
+}
+
+/// One probe pair: the disguised object and the family that shows it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbePair {
+    pub adversarial: String,
+    pub family: String,
+    /// `false`: the object only needs to appear (one probe group, no twin) — for objects
+    /// whose look-alike the physics cannot tell apart in any family that shows them.
+    #[serde(default = "yes")]
+    pub twin: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 #[cfg(test)]

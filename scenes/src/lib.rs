@@ -23,6 +23,7 @@ pub mod families;
 pub mod intent;
 pub mod label;
 pub mod randomize;
+pub mod result;
 pub mod selection;
 pub mod shared;
 pub mod twins;

@@ -22,10 +22,10 @@
 //! dataset's `twin_scene_id`). The driver (`driver::produce_planned_group`) asks
 //! [`slot`] which role a group plays.
 
+use crate::result::SceneResult;
 use rh_catalog::{Catalog, Object};
 use rh_physics::seeds;
 use rh_physics::spec::SceneSpec;
-use serde::{Deserialize, Serialize};
 
 /// The `family_params` key holding the other scene's index of a twin pair.
 pub const TWIN_PARAM: &str = "twin_scene_index";
@@ -35,34 +35,7 @@ pub const TWIN_PARAM: &str = "twin_scene_index";
 /// dropped for showing too little.
 pub const DIVERGENCE_PARAM: &str = "twin_divergence_m";
 
-/// `[probes]` of `configs/default.toml` (absent: no twins, builds before label rule v5).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ProbeConfig {
-    #[serde(default)]
-    pub pairs: Vec<ProbePair>,
-    /// Label rule v6: a pair is a probe only where its hazards' centres of mass come this
-    /// far apart (m) at some physics step of the observation window [`divergence`];
-    /// otherwise both scenes stay, unpaired. 0: every pair is kept (rule v5).
-    #[serde(default)]
-    pub divergence_min: f64,
-}
-
-/// One probe pair: the disguised object and the family that shows it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ProbePair {
-    pub adversarial: String,
-    pub family: String,
-    /// `false`: the object only needs to appear (one probe group, no twin) — for objects
-    /// whose look-alike the physics cannot tell apart in any family that shows them.
-    #[serde(default = "yes")]
-    pub twin: bool,
-}
-
-fn yes() -> bool {
-    true
-}
+pub use crate::config::{ProbeConfig, ProbePair};
 
 /// Which side of a pair a group is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -227,25 +200,26 @@ pub fn keep_if_divergent(probe: &mut SceneSpec, twin: &mut SceneSpec, divergence
     d
 }
 
-/// The twins of a twin pair's probe bands, labelled (`config`: the build's, not the
-/// probe's), each pair kept only where its hazards diverge in the window
-/// ([`keep_if_divergent`]). `None` — and every probe band unpaired — when a probe
-/// or twin band fails a validator: then the twin group is planned afresh.
+/// The twins of a twin pair's probe bands, labelled by `label` (the build's labelling,
+/// not the probe's), each pair kept only where its hazards come `divergence_min` apart in
+/// the window ([`keep_if_divergent`]). `None` — and every probe band unpaired — when a
+/// probe or twin band fails a validator: then the twin group is planned afresh.
 pub(crate) fn pair_twins(
-    probe: &mut [crate::driver::SceneResult],
+    probe: &mut [SceneResult],
     slot: &Slot,
     genuine: &rh_catalog::Object,
-    config: &crate::config::Config,
-) -> Option<Vec<crate::driver::SceneResult>> {
+    divergence_min: f64,
+    label: &dyn Fn(SceneSpec, rh_physics::simulate::Simulation) -> SceneResult,
+) -> Option<Vec<SceneResult>> {
     let mut twin = Vec::with_capacity(probe.len());
     for (band, r) in probe.iter_mut().enumerate() {
         let index = slot.twin_group * 4 + band as u64;
         let mut spec = twin_spec(&mut r.spec, genuine, index, slot.twin_group);
         spec = SceneSpec::from_json(&spec.to_json()).expect("a spec parses back");
-        keep_if_divergent(&mut r.spec, &mut spec, config.probes.divergence_min);
+        keep_if_divergent(&mut r.spec, &mut spec, divergence_min);
         let sim =
             rh_physics::simulate::simulate(&spec, rh_physics::simulate::SimOptions::default());
-        twin.push(crate::driver::label_scene(spec, sim, config));
+        twin.push(label(spec, sim));
     }
     if std::env::var_os("RH_TWIN_DEBUG").is_some() {
         for (p, t) in probe.iter().zip(&twin) {

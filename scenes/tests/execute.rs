@@ -154,7 +154,11 @@ fn ball_scene(mass: f64, at: [f64; 3], vz: f64) -> rh_physics::spec::SceneSpec {
     ball.friction = 0.8;
     ball.linvel = [0.0, 0.0, vz];
     ball.angvel = [0.0; 3];
+    // The velocity as given (not a push scaled to another body's mass), no air drag:
+    // the closed forms below are for a ball in vacuum.
+    ball.push_mass = None;
     ball.ccd = true;
+    spec.physics.drag = None;
     spec.bodies = vec![ball];
     spec.joints.clear();
     spec.hazard = 0;
@@ -210,6 +214,9 @@ fn flung_slab(
     h.linvel = velocity;
     h.angvel = [0.0; 3];
     h.restitution = 0.0;
+    // The velocity as given (not a push scaled to another body's mass), no air drag.
+    h.push_mass = None;
+    spec.physics.drag = None;
     spec
 }
 

@@ -93,7 +93,7 @@ fn dataset_build_layout_card_and_manifest() {
         "path: eval/test-*.parquet",
         "n<1K",
         "| `impact_point` | `float64[3]`, nullable |",
-        "Label rule `v5`",
+        "Label rule `v6`",
         "the articulated humanoid the executor moves",
         "where the hands can hold it",
         "`valid_escapable`",
@@ -112,7 +112,7 @@ fn dataset_build_layout_card_and_manifest() {
         "Bang",
         "| build seed | 11 |",
         "takes up to 18 valid scenes per family",
-        "stratified by label (label rule v5): up to 18 valid scenes per family",
+        "stratified by label: up to 18 valid scenes per family",
         "over the whole simulation",
         "cast_column",
     ] {

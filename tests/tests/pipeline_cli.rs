@@ -391,8 +391,10 @@ fn all_seventeen_families_build_valid_and_replay() {
         attempts += a;
         visible += v;
     }
+    // The ego pixel rule (issue 44) rejects small far balls often: bouncing_object and
+    // thrown_object most (scenes/tests/visibility.rs has the figures).
     assert!(
-        visible * 5 <= attempts,
+        visible * 3 <= attempts,
         "visibility rejected {visible} of {attempts}"
     );
     let script = format!(
@@ -437,8 +439,10 @@ fn balance_reports_counts_per_action_per_family() {
             .iter()
             .map(|k| r[*k].as_u64().unwrap())
             .sum::<u64>();
+        // At most one NO_ACTION, two where a twin pair's member is one
+        // ([eval] twin_no_action_per_family).
         assert!(
-            (1..=8).contains(&subset) && r["no_action"].as_u64().unwrap() <= 1,
+            (1..=8).contains(&subset) && r["no_action"].as_u64().unwrap() <= 2,
             "{r}"
         );
         assert!((20..=40).contains(&pool), "{r}");

@@ -3,8 +3,8 @@
 //! action, every rule that fired, the distances and the planned hand path in the world
 //! frame — plus each model's `prompt_version`s.
 //!
-//! The same policy as the scoring pass ([`crate::preds`]): unknown or invalid scenes are
-//! skipped, the first line of a (scene, model) pair wins, and a scored line after an
+//! The same policy as the scoring pass ([`crate::preds`]): unknown, invalid and
+//! unexpected scenes (outside the report's subset) are skipped, the first line of a (scene, model) pair wins, and a scored line after an
 //! `error` line replaces it (a retry).
 
 use crate::action_rule::kinematics;
@@ -159,7 +159,13 @@ fn decide(
 
 /// Reads the predictions file again and keeps each decision's details. `models` is the
 /// report's model order (models that appear only on skipped lines are left out).
-pub fn collect(path: &Path, ds: &Dataset, cfg: &Config, models: &[String]) -> Result<Collected> {
+pub fn collect(
+    path: &Path,
+    ds: &Dataset,
+    cfg: &Config,
+    models: &[String],
+    expected: &[bool],
+) -> Result<Collected> {
     let f = std::fs::File::open(path)
         .map_err(|e| InputError(format!("cannot read predictions {}: {e}", path.display())))?;
     let aia = AiaMatcher::new(&cfg.aia);
@@ -189,7 +195,7 @@ pub fn collect(path: &Path, ds: &Dataset, cfg: &Config, models: &[String]) -> Re
         let (Some(&mi), Some((si, sc))) = (index.get(model.as_str()), ds.get(&scene_id)) else {
             continue;
         };
-        if !sc.valid {
+        if !sc.valid || !expected.get(si as usize).copied().unwrap_or(false) {
             continue;
         }
         let per_scene = out.decisions.entry(si).or_default();
@@ -244,7 +250,8 @@ mod tests {
         let path = dir.path().join("preds.jsonl");
         let text: String = lines.iter().map(|l| l.to_string() + "\n").collect();
         std::fs::write(&path, text + "not json\n").unwrap();
-        let c = collect(&path, &ds, &cfg, &["m".to_string()]).unwrap();
+        let all: Vec<bool> = ds.scenes.iter().map(|s| s.valid).collect();
+        let c = collect(&path, &ds, &cfg, &["m".to_string()], &all).unwrap();
         let (ia, ib) = (ds.get(a).unwrap().0, ds.get(b).unwrap().0);
         assert_eq!(c.decisions.len(), 2);
         let da = &c.decisions[&ia][&0];

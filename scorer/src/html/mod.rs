@@ -215,11 +215,18 @@ fn write_into(
     write(&dir.join("assets/site.js"), JS)?;
 
     let models: Vec<String> = report.models.iter().map(|m| m.model.clone()).collect();
-    let collected = collect::collect(preds, ds, cfg, &models)?;
+    // The scenes the report scored (its subset), so every count on the site is the report's.
+    let subset = match report.coverage.subset.as_str() {
+        "all" => crate::dataset::Subset::All,
+        _ => crate::dataset::Subset::Eval,
+    };
+    let expected = crate::coverage::Expected::resolve(ds, Some(subset))?;
+    let collected = collect::collect(preds, ds, cfg, &models, &expected.mask)?;
 
     let figures_html = figures_html(report, dir)?;
     write_board(report, &collected, &figures_html, dir)?;
-    let (scenes, media_files) = write_scenes(report, ds, &models, &collected, dir)?;
+    let (scenes, media_files) =
+        write_scenes(report, ds, &models, &collected, &expected.mask, dir)?;
     write_static_pages(dir)?;
 
     Ok(SiteSummary {
@@ -331,6 +338,7 @@ fn write_scenes(
     ds: &Dataset,
     models: &[String],
     collected: &collect::Collected,
+    expected: &[bool],
     dir: &Path,
 ) -> Result<(usize, usize)> {
     let ds_rows = rows::read_rows(&ds.dir)?;
@@ -340,7 +348,8 @@ fn write_scenes(
     let mut scenes = 0usize;
     let empty = std::collections::BTreeMap::new();
     for (si, sc) in ds.scenes.iter().enumerate() {
-        if !sc.valid {
+        // The report's scenes only (its subset), so the site counts what the report counts.
+        if !sc.valid || !expected.get(si).copied().unwrap_or(false) {
             continue;
         }
         let Some(row) = ds_rows.get(&sc.scene_id) else {
