@@ -25,7 +25,12 @@ pub fn teaser(rows: &RecordBatch) -> String {
     };
     let images: Vec<String> = FRAME_TIMES
         .iter()
-        .map(|&t| format!("![ego view at t = {t:.2} s]({})", frame_path(&ids[i], "ego", t)))
+        .map(|&t| {
+            format!(
+                "![ego view at t = {t:.2} s]({})",
+                frame_path(&ids[i], "ego", t)
+            )
+        })
         .collect();
     format!(
         "{}\n\n*Scene `{}` ({}), the ego frames at t = 0, 0.15, 0.30, 0.45, 0.60 s: what a \
@@ -60,12 +65,27 @@ mod tests {
 
     fn rows(valid: [bool; 2], video: [Option<&str>; 2]) -> RecordBatch {
         RecordBatch::try_from_iter(vec![
-            ("scene_id", Arc::new(StringArray::from(vec!["bbbb0001", "aaaa0000"])) as _),
-            ("scene_index", Arc::new(UInt64Array::from(vec![1u64, 0])) as _),
-            ("family", Arc::new(StringArray::from(vec!["door_swing", "object_drop"])) as _),
-            ("gt_action", Arc::new(StringArray::from(vec!["DODGE", "CATCH"])) as _),
+            (
+                "scene_id",
+                Arc::new(StringArray::from(vec!["bbbb0001", "aaaa0000"])) as _,
+            ),
+            (
+                "scene_index",
+                Arc::new(UInt64Array::from(vec![1u64, 0])) as _,
+            ),
+            (
+                "family",
+                Arc::new(StringArray::from(vec!["door_swing", "object_drop"])) as _,
+            ),
+            (
+                "gt_action",
+                Arc::new(StringArray::from(vec!["DODGE", "CATCH"])) as _,
+            ),
             ("valid", Arc::new(BooleanArray::from(valid.to_vec())) as _),
-            ("ego_file_name", Arc::new(StringArray::from(video.to_vec())) as _),
+            (
+                "ego_file_name",
+                Arc::new(StringArray::from(video.to_vec())) as _,
+            ),
         ])
         .unwrap()
     }

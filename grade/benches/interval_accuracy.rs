@@ -43,7 +43,11 @@ fn preds(ds: &Dataset, models: usize, seed: u64) -> String {
                 1 => [f(&mut rng, -0.9, 0.0), f(&mut rng, -0.9, 0.9), 0.0],
                 _ => [0.0, 0.0, 0.0],
             };
-            let reach = if kind == 0 { f(&mut rng, 0.2, 0.6) } else { 0.1 };
+            let reach = if kind == 0 {
+                f(&mut rng, 0.2, 0.6)
+            } else {
+                0.1
+            };
             let (hx, hz) = (reach, f(&mut rng, -0.1, 0.4));
             let dur = f(&mut rng, 0.3, 1.5);
             out += &serde_json::json!({
@@ -104,7 +108,12 @@ fn errors(new: &[Option<[f64; 2]>], reference: &[Option<[f64; 2]>]) -> Vec<f64> 
 
 fn summary(e: &[f64]) -> String {
     let q = |p: f64| e[((e.len() - 1) as f64 * p).round() as usize];
-    format!("max {:.3}, p99 {:.3}, median {:.3}", q(1.0), q(0.99), q(0.5))
+    format!(
+        "max {:.3}, p99 {:.3}, median {:.3}",
+        q(1.0),
+        q(0.99),
+        q(0.5)
+    )
 }
 
 fn main() {

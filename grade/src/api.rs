@@ -80,7 +80,9 @@ pub fn score<'a>(
     crate::refusal::check_scored(&scoring, &name)?;
     let mut report = Report::build_with(&scoring, &name, opts.answered_only);
     if let Some([a, b]) = &opts.compare {
-        report.comparisons.push(crate::compare::compare(&scoring, a, b)?);
+        report
+            .comparisons
+            .push(crate::compare::compare(&scoring, a, b)?);
     }
     Ok(Scored { scoring, report })
 }

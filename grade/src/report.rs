@@ -549,9 +549,16 @@ mod tests {
     fn the_report_is_the_same_on_any_number_of_threads() {
         // Large enough that the means take the closed form and the small rows resample.
         let ds = dataset_of(&synth_rows(1200, 4));
-        let kinds = [BaselineKind::Random, BaselineKind::Oracle, BaselineKind::AlwaysDodge];
+        let kinds = [
+            BaselineKind::Random,
+            BaselineKind::Oracle,
+            BaselineKind::AlwaysDodge,
+        ];
         let json = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
             pool.install(|| serde_json::to_string(&run(&ds, &kinds, "")).unwrap())
         };
         let one = json(1);

@@ -215,7 +215,12 @@ pub fn mean_cumulants(values: &[f64]) -> [f64; 4] {
         m4 += d2 * d2;
     }
     let (m2, m3, m4) = (m2 / n, m3 / n, m4 / n);
-    [mean, m2 / n, m3 / (n * n), (m4 - 3.0 * m2 * m2) / (n * n * n)]
+    [
+        mean,
+        m2 / n,
+        m3 / (n * n),
+        (m4 - 3.0 * m2 * m2) / (n * n * n),
+    ]
 }
 
 /// 95% interval of the mean of `values` (the percentile bootstrap's; see the module
@@ -231,7 +236,9 @@ pub fn mean_interval(values: &[f64], cfg: &StatsConfig, seed: u64) -> Option<[f6
     // The bootstrap's means never leave the sample's range.
     let (min, max) = values
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
     Some([lo.clamp(min, max), hi.clamp(min, max)])
 }
 
@@ -252,17 +259,18 @@ pub fn balanced_cumulants(classes: &[(u64, u64)]) -> [f64; 4] {
         k[2] += pq * (1.0 - 2.0 * p) / (n * n);
         k[3] += pq * (1.0 - 6.0 * pq) / (n * n * n);
     }
-    [k[0] / c, k[1] / (c * c), k[2] / (c * c * c), k[3] / (c * c * c * c)]
+    [
+        k[0] / c,
+        k[1] / (c * c),
+        k[2] / (c * c * c),
+        k[3] / (c * c * c * c),
+    ]
 }
 
 /// 95% interval of the balanced accuracy (the stratified bootstrap's; see the module
 /// notes): resampled up to `cfg.resample_up_to` scenes, closed form above; `None` when
 /// no class has a scene.
-pub fn balanced_interval(
-    classes: &[(u64, u64)],
-    cfg: &StatsConfig,
-    seed: u64,
-) -> Option<[f64; 2]> {
+pub fn balanced_interval(classes: &[(u64, u64)], cfg: &StatsConfig, seed: u64) -> Option<[f64; 2]> {
     balanced_accuracy(classes)?;
     let total: u64 = classes.iter().map(|c| c.1).sum();
     if total <= cfg.resample_up_to as u64 {
@@ -422,7 +430,9 @@ mod tests {
     fn samples() -> Vec<(&'static str, Vec<f64>)> {
         let mut x: u64 = 12345;
         let mut u = move || {
-            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (x >> 11) as f64 / (1u64 << 53) as f64
         };
         let exp: Vec<f64> = (0..400).map(|_| -(1.0 - u()).ln() * 0.4).collect();
@@ -463,13 +473,19 @@ mod tests {
             assert!(v.len() > cfg.resample_up_to);
             let new = mean_interval(&v, &cfg, 5).unwrap();
             let reference = bootstrap_mean(&v, &reference_cfg(), 11).unwrap();
-            assert!(within(new, reference, TOLERANCE), "{name}: {new:?} vs {reference:?}");
+            assert!(
+                within(new, reference, TOLERANCE),
+                "{name}: {new:?} vs {reference:?}"
+            );
             // The expansion adds what the normal interval misses: the skewed sample's
             // interval is shifted right of mean ± z·sd.
             if name == "exponential" {
                 let [m, var, _, _] = mean_cumulants(&v);
                 let normal = [m - Z95 * var.sqrt(), m + Z95 * var.sqrt()];
-                assert!(new[0] > normal[0] && new[1] > normal[1], "{new:?} {normal:?}");
+                assert!(
+                    new[0] > normal[0] && new[1] > normal[1],
+                    "{new:?} {normal:?}"
+                );
             }
         }
     }
@@ -483,20 +499,31 @@ mod tests {
         ] {
             let new = balanced_interval(&classes, &cfg, 5).unwrap();
             let reference = bootstrap_balanced(&classes, &reference_cfg(), 11).unwrap();
-            assert!(within(new, reference, TOLERANCE), "{classes:?}: {new:?} vs {reference:?}");
+            assert!(
+                within(new, reference, TOLERANCE),
+                "{classes:?}: {new:?} vs {reference:?}"
+            );
         }
         // Every class at 0 or 1: no spread, as the resampling says.
         let ci = balanced_interval(&[(400, 400), (0, 300), (0, 100)], &cfg, 1).unwrap();
-        assert!(close(ci[0], 1.0 / 3.0, 1e-12) && close(ci[1], 1.0 / 3.0, 1e-12), "{ci:?}");
+        assert!(
+            close(ci[0], 1.0 / 3.0, 1e-12) && close(ci[1], 1.0 / 3.0, 1e-12),
+            "{ci:?}"
+        );
     }
 
     #[test]
     fn small_samples_are_resampled_as_before() {
         let cfg = StatsConfig::default();
-        let v: Vec<f64> = (0..cfg.resample_up_to).map(|i| (i % 9) as f64 * 0.3).collect();
+        let v: Vec<f64> = (0..cfg.resample_up_to)
+            .map(|i| (i % 9) as f64 * 0.3)
+            .collect();
         assert_eq!(mean_interval(&v, &cfg, 3), bootstrap_mean(&v, &cfg, 3));
         let classes = [(30, 50), (10, 30), (5, 20)];
-        assert_eq!(balanced_interval(&classes, &cfg, 3), bootstrap_balanced(&classes, &cfg, 3));
+        assert_eq!(
+            balanced_interval(&classes, &cfg, 3),
+            bootstrap_balanced(&classes, &cfg, 3)
+        );
         // A sample too skewed for the expansion (one outlier in 500) is resampled too.
         let mut w = vec![0.0; 499];
         w.push(100.0);

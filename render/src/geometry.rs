@@ -3,12 +3,12 @@
 //! posed per step, ropes, and what each camera sees.
 
 use super::camera::{inverse_view_proj_rows, view_proj};
+use super::cells::rects_meet;
 use super::gpu::{self, Uniforms, ViewJob};
 use super::lighting::Lighting;
 use super::mesh::*;
 use super::observer::observer_mesh;
 use super::recipes;
-use super::cells::rects_meet;
 use super::regions::{bounds, cover, screen_rect, shadow_regions};
 use super::tiles::{LightRows, SurfaceTiles};
 use super::Shading;

@@ -50,27 +50,41 @@ pub fn contact_sheet(title: &str, tiles: &[SheetTile]) -> Result<ContactSheet, R
     let rows = n.div_ceil(cols);
     let (w, h) = (cols * TILE_W, title_h + rows * (TILE_H + caption_h));
     let mut sheet = image::RgbImage::from_pixel(w, h, image::Rgb([24, 24, 28]));
-    font::draw_text(&mut sheet, 8, 6, &fit(title, w - 16), SCALE, [255, 255, 255]);
+    font::draw_text(
+        &mut sheet,
+        8,
+        6,
+        &fit(title, w - 16),
+        SCALE,
+        [255, 255, 255],
+    );
     for (i, tile) in tiles.iter().enumerate() {
         let img = image::open(&tile.frame)
             .map_err(|e| RenderError::Io(format!("{}: {e}", tile.frame.display())))?
             .to_rgb8();
-        let frame = image::imageops::resize(
-            &img,
-            TILE_W,
-            TILE_H,
-            image::imageops::FilterType::Triangle,
-        );
+        let frame =
+            image::imageops::resize(&img, TILE_W, TILE_H, image::imageops::FilterType::Triangle);
         // A short last row is centred rather than leaving empty tiles at its end.
         let (row, col) = (i as u32 / cols, i as u32 % cols);
-        let in_row = if row + 1 == rows { n - row * cols } else { cols };
+        let in_row = if row + 1 == rows {
+            n - row * cols
+        } else {
+            cols
+        };
         let x = col * TILE_W + (cols - in_row) * TILE_W / 2;
         let y = title_h + row * (TILE_H + caption_h);
         image::imageops::replace(&mut sheet, &frame, x as i64, (y + caption_h) as i64);
         let colours = [[235, 235, 235], [190, 200, 215]];
         for (k, line) in tile.lines.iter().enumerate() {
             let ty = y + 3 + k as u32 * line_h;
-            font::draw_text(&mut sheet, x + 6, ty, &fit(line, TILE_W - 12), SCALE, colours[k]);
+            font::draw_text(
+                &mut sheet,
+                x + 6,
+                ty,
+                &fit(line, TILE_W - 12),
+                SCALE,
+                colours[k],
+            );
         }
     }
     let mut png = Vec::new();

@@ -349,7 +349,9 @@ fn contact_sheet_draws_every_tile_with_its_frame() {
         .map(|(spec, _, _)| SheetTile {
             family: spec.family.clone(),
             scene_id: spec.scene_id.clone(),
-            frame: f.dir.join(rh_contract::layout::frame_path(&spec.scene_id, "ego", 0.30)),
+            frame: f
+                .dir
+                .join(rh_contract::layout::frame_path(&spec.scene_id, "ego", 0.30)),
             lines: [spec.family.clone(), "ego t 0.30 s".into()],
         })
         .collect();
@@ -364,7 +366,11 @@ fn contact_sheet_draws_every_tile_with_its_frame() {
         let sum: u64 = img.pixels().flat_map(|p| p.0).map(|c| c as u64).sum();
         sum / (img.width() as u64 * img.height() as u64)
     };
-    assert!(mean(&img) > 76 + 40, "sheet mean {} (background 76)", mean(&img));
+    assert!(
+        mean(&img) > 76 + 40,
+        "sheet mean {} (background 76)",
+        mean(&img)
+    );
     // Nothing to draw is an error.
     let err = contact_sheet("none", &[]).unwrap_err().to_string();
     assert!(err.contains("nothing to draw"), "{err}");

@@ -138,13 +138,16 @@ pub fn produce_planned_group(
         let (mut probe, rejections) =
             probe_group_counted(&selection, bands, catalog, &probe_config)
                 .map_err(|e| e.to_string())?;
-        let twins = slot
-            .pair
-            .twin
-            .then(|| {
-                let label = |spec, sim| label_scene(spec, sim, config);
-                twins::pair_twins(&mut probe, &slot, genuine, config.probes.divergence_min, &label)
-            });
+        let twins = slot.pair.twin.then(|| {
+            let label = |spec, sim| label_scene(spec, sim, config);
+            twins::pair_twins(
+                &mut probe,
+                &slot,
+                genuine,
+                config.probes.divergence_min,
+                &label,
+            )
+        });
         Ok((probe, rejections, twins.flatten()))
     };
     let produced = if slot.pair.twin {

@@ -46,8 +46,7 @@ fn built_scenes(family: &str, groups: u64) -> Vec<SceneResult> {
     let mut out = Vec::new();
     for j in 0..groups {
         let group = fi + names.len() as u64 * j;
-        let (results, _) =
-            plan_and_produce(&catalog, &names, None, 7, group, 4, &config).unwrap();
+        let (results, _) = plan_and_produce(&catalog, &names, None, 7, group, 4, &config).unwrap();
         assert!(results.iter().all(|r| r.spec.family == family));
         out.extend(results);
     }

@@ -8,13 +8,13 @@
 //! re-exported under their own names, so `rh_score::score`, `rh_score::report` … are the
 //! core's.
 
-pub use rh_grade::{
-    action_rule, aggregate, aia, analyses, api, baseline, compare, config, coverage,
-    dataset_diagnosis, error, explain, fast_map, intervals, metrics, metrics_row, oracle,
-    plan, plan_json, preds, refusal, report, safety_rule, score, stats, tables, text_table,
-};
 #[cfg(any(test, feature = "synthetic"))]
 pub use rh_grade::synthetic;
+pub use rh_grade::{
+    action_rule, aggregate, aia, analyses, api, baseline, compare, config, coverage,
+    dataset_diagnosis, error, explain, fast_map, intervals, metrics, metrics_row, oracle, plan,
+    plan_json, preds, refusal, report, safety_rule, score, stats, tables, text_table,
+};
 
 /// The core's dataset reader ([`rh_grade::dataset`]) and [`resolve_dir`], which also
 /// fetches Hub datasets.

@@ -457,7 +457,10 @@ fn the_card_parses_as_commonmark_without_indented_code() {
         })
         .collect();
     for t in ["list<string>", "float64[3]", "bool", "string"] {
-        assert!(code.iter().any(|c| c == t), "the rendered card shows no `{t}`");
+        assert!(
+            code.iter().any(|c| c == t),
+            "the rendered card shows no `{t}`"
+        );
     }
     assert!(Parser::new("| a | list<string> |").any(|e| matches!(e, Event::InlineHtml(_))));
     // Counter-check that the test can fail: the same text with one paragraph indented.

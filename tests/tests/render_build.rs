@@ -84,8 +84,13 @@ fn colour_tags(path: &Path) -> [String; 4] {
     assert!(out.status.success(), "ffprobe {}", path.display());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let s = &v["streams"][0];
-    ["color_space", "color_primaries", "color_transfer", "color_range"]
-        .map(|k| s[k].as_str().unwrap_or("").to_string())
+    [
+        "color_space",
+        "color_primaries",
+        "color_transfer",
+        "color_range",
+    ]
+    .map(|k| s[k].as_str().unwrap_or("").to_string())
 }
 
 /// What every video says of its colour (render/src/encode.rs): sRGB pixels (BT.709
@@ -297,11 +302,19 @@ print(json.dumps({{"checked": checked, "unrendered": unrendered, "bad": bad,
             "{caption}"
         );
         let time = &frame[frame.len() - 9..frame.len() - 4];
-        assert!(caption.contains(&format!("ego t {} s", &time[..4])), "{caption} / {frame}");
+        assert!(
+            caption.contains(&format!("ego t {} s", &time[..4])),
+            "{caption} / {frame}"
+        );
     }
     let plain = run_ok(
         "rh-pipeline",
-        &["sheet", single.to_str().unwrap(), "--out", sheet.to_str().unwrap()],
+        &[
+            "sheet",
+            single.to_str().unwrap(),
+            "--out",
+            sheet.to_str().unwrap(),
+        ],
     );
     assert!(plain.contains("ego frames"), "{plain}");
     let other = run_ok(
@@ -317,10 +330,23 @@ print(json.dumps({{"checked": checked, "unrendered": unrendered, "bad": bad,
         ],
     );
     let o: serde_json::Value = serde_json::from_str(&other).unwrap();
-    assert!(o["tiles"][0]["frame"].as_str().unwrap().contains("/closeup_t"), "{o}");
+    assert!(
+        o["tiles"][0]["frame"]
+            .as_str()
+            .unwrap()
+            .contains("/closeup_t"),
+        "{o}"
+    );
     let bad = run(
         "rh-pipeline",
-        &["sheet", single.to_str().unwrap(), "--out", sheet.to_str().unwrap(), "--camera", "top"],
+        &[
+            "sheet",
+            single.to_str().unwrap(),
+            "--out",
+            sheet.to_str().unwrap(),
+            "--camera",
+            "top",
+        ],
     );
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--camera top"));

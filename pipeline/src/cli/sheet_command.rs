@@ -21,7 +21,8 @@ pub fn run(dir: &Path, out: &Path, camera: &str, json: bool) -> Result<(), Failu
             dir.display()
         )));
     }
-    let title = format!(
+    let title =
+        format!(
         "{camera} frames{}: per family the first valid scene, at the time the hazard shows most",
         if camera == "ego" { " - what the model sees" } else { "" }
     );

@@ -9,8 +9,8 @@ mod setup;
 mod ids;
 mod moving;
 
-use super::mesh::Vertex;
 use super::cells::{rect_area, rect_union, rects_meet};
+use super::mesh::Vertex;
 use super::RenderError;
 pub use ids::{IdImage, IdPass, IdView};
 use readback::Finish;

@@ -50,9 +50,9 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(p) => Some(SharedFile::create(p, "the decision lines")?),
         None => None,
     };
-    let open = decisions.clone().map(|d| -> crate::api::OpenDecisions {
-        Box::new(move || Ok(Box::new(d)))
-    });
+    let open = decisions
+        .clone()
+        .map(|d| -> crate::api::OpenDecisions { Box::new(move || Ok(Box::new(d))) });
     let opts = crate::api::ScoreOptions {
         subset: cli.subset,
         answered_only: cli.answered_only,

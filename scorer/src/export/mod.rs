@@ -365,4 +365,3 @@ fn dodge_check() -> Option<crate::oracle::DodgeCheck> {
 fn dodge_check() -> Option<crate::oracle::DodgeCheck> {
     None
 }
-

@@ -225,8 +225,7 @@ fn write_into(
 
     let figures_html = figures_html(report, dir)?;
     write_board(report, &collected, &figures_html, dir)?;
-    let (scenes, media_files) =
-        write_scenes(report, ds, &models, &collected, &expected.mask, dir)?;
+    let (scenes, media_files) = write_scenes(report, ds, &models, &collected, &expected.mask, dir)?;
     write_static_pages(dir)?;
 
     Ok(SiteSummary {
