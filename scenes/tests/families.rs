@@ -22,14 +22,20 @@ fn all_names() -> Vec<String> {
         .collect()
 }
 
+/// The group indices of `family`'s first `groups` groups, as a full build of every family
+/// deals them (families in turn).
+fn groups_of(family: &str, groups: u64) -> Vec<u64> {
+    let names = all_names();
+    let fi = names.iter().position(|n| n == family).unwrap() as u64;
+    (0..groups).map(|j| fi + names.len() as u64 * j).collect()
+}
+
 /// The scenes of `groups` groups of `family`, as a full build with seed 7 deals them.
 fn scenes(family: &str, groups: u64) -> Vec<SceneResult> {
     let (catalog, config) = setup();
     let names = all_names();
-    let fi = names.iter().position(|n| n == family).unwrap() as u64;
     let mut out = Vec::new();
-    for j in 0..groups {
-        let group = fi + names.len() as u64 * j;
+    for group in groups_of(family, groups) {
         let selection = plan_group(&catalog, &names, 7, group).unwrap();
         assert_eq!(selection.family, family);
         out.extend(produce_group(&selection, 7, group * 4, 4, &catalog, &config).unwrap());
@@ -42,10 +48,8 @@ fn scenes(family: &str, groups: u64) -> Vec<SceneResult> {
 fn built_scenes(family: &str, groups: u64) -> Vec<SceneResult> {
     let (catalog, config) = setup();
     let names = all_names();
-    let fi = names.iter().position(|n| n == family).unwrap() as u64;
     let mut out = Vec::new();
-    for j in 0..groups {
-        let group = fi + names.len() as u64 * j;
+    for group in groups_of(family, groups) {
         let (results, _) = plan_and_produce(&catalog, &names, None, 7, group, 4, &config).unwrap();
         assert!(results.iter().all(|r| r.spec.family == family));
         out.extend(results);

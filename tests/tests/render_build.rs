@@ -37,6 +37,18 @@ fn build_args<'a>(config: &'a Path, out: &'a Path, extra: &[&'a str]) -> Vec<&'a
     args
 }
 
+/// `rh-pipeline sheet DIR --out OUT` and `extra`.
+fn sheet_args<'a>(dir: &'a Path, out: &'a Path, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec![
+        "sheet",
+        dir.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    args
+}
+
 fn build(config: &Path, out: &Path, extra: &[&str]) {
     run_ok("rh-pipeline", &build_args(config, out, extra));
 }
@@ -269,16 +281,7 @@ print(json.dumps({{"checked": checked, "unrendered": unrendered, "bad": bad,
 
     // The contact sheet: one tile per family.
     let sheet = tmp.path().join("sheet.png");
-    let json = run_ok(
-        "rh-pipeline",
-        &[
-            "sheet",
-            single.to_str().unwrap(),
-            "--out",
-            sheet.to_str().unwrap(),
-            "--json",
-        ],
-    );
+    let json = run_ok("rh-pipeline", &sheet_args(&single, &sheet, &["--json"]));
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
     let families: Vec<&str> = v["tiles"]
         .as_array()
@@ -307,27 +310,11 @@ print(json.dumps({{"checked": checked, "unrendered": unrendered, "bad": bad,
             "{caption} / {frame}"
         );
     }
-    let plain = run_ok(
-        "rh-pipeline",
-        &[
-            "sheet",
-            single.to_str().unwrap(),
-            "--out",
-            sheet.to_str().unwrap(),
-        ],
-    );
+    let plain = run_ok("rh-pipeline", &sheet_args(&single, &sheet, &[]));
     assert!(plain.contains("ego frames"), "{plain}");
     let other = run_ok(
         "rh-pipeline",
-        &[
-            "sheet",
-            single.to_str().unwrap(),
-            "--out",
-            sheet.to_str().unwrap(),
-            "--camera",
-            "closeup",
-            "--json",
-        ],
+        &sheet_args(&single, &sheet, &["--camera", "closeup", "--json"]),
     );
     let o: serde_json::Value = serde_json::from_str(&other).unwrap();
     assert!(
@@ -339,14 +326,7 @@ print(json.dumps({{"checked": checked, "unrendered": unrendered, "bad": bad,
     );
     let bad = run(
         "rh-pipeline",
-        &[
-            "sheet",
-            single.to_str().unwrap(),
-            "--out",
-            sheet.to_str().unwrap(),
-            "--camera",
-            "top",
-        ],
+        &sheet_args(&single, &sheet, &["--camera", "top"]),
     );
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--camera top"));
@@ -359,15 +339,7 @@ print(json.dumps({{"checked": checked, "unrendered": unrendered, "bad": bad,
     // A dataset built without rendering has nothing to tile: a clear error, exit 2.
     let bare = tmp.path().join("bare");
     build(&config, &bare, &["--no-render"]);
-    let out = run(
-        "rh-pipeline",
-        &[
-            "sheet",
-            bare.to_str().unwrap(),
-            "--out",
-            sheet.to_str().unwrap(),
-        ],
-    );
+    let out = run("rh-pipeline", &sheet_args(&bare, &sheet, &[]));
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no rendered scenes"));
 }
