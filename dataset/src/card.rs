@@ -138,13 +138,18 @@ fn eval_rule_text(cfg: &EvalConfig) -> String {
         Some(share) => format!(
             "evaluation subset, stratified by label: up to {} valid scenes per \
              family, {:.0}% of them CATCH where the family has them, at most {} NO_ACTION (its \
-             adversarial twin pairs, taken first, up to {}; never a pair of two NO_ACTION), the \
-             rest DODGE; a family short of CATCH gives more DODGE and the other way round; a \
+             adversarial twin pairs, taken first{}, up to {}; never a pair of two NO_ACTION), \
+             the rest DODGE; a family short of CATCH gives more DODGE and the other way round; a \
              family short of real decisions takes more NO_ACTION only while the subset's \
              NO_ACTION scenes stay within {:.1}% of it",
             cfg.per_family,
             100.0 * share,
             cfg.no_action_per_family,
+            if cfg.decisive_pairs_first {
+                ", CATCH / DODGE pairs before those with a NO_ACTION scene"
+            } else {
+                ""
+            },
             cfg.no_action_per_family.max(cfg.twin_no_action_per_family),
             100.0 * cfg.no_action_fill_share
         ),
@@ -641,7 +646,7 @@ standing body (a knife that stops a metre away: standing still is safe). Rule v4
 every dangerous or too fast reachable hazard `DODGE`, touch or not, and rules v2–v3 every \
 benign reachable one `CATCH`, including balls rolling to the feet, which the executor's \
 humanoid cannot catch (`rh-score --execute`: on a 340-scene build the oracle baseline \
-caught 58 of 146 rule-v3 CATCH labels, 137 of 142 rule-v6 ones; 69 of 72 under rule v4).
+caught 58 of 146 rule-v3 CATCH labels, 128 of 134 rule-v6 ones; 69 of 72 under rule v4).
 * **Escape** (validator `valid_escapable`, rule v4): a `DODGE` scene with danger present whose \
 hazard reaches the observer within {esc_within} s of Δ must be escapable — of {esc_n} walks of {esc_d} m at {esc_v} m/s in evenly spaced directions (the \
 first straight back), hands at rest, executed in physics from Δ by the executor of `rh-score \

@@ -38,6 +38,11 @@ pub struct EvalConfig {
     /// probe like any other. Further NO_ACTION scenes stay within `no_action_per_family`.
     #[serde(default, skip_serializing_if = "is_zero_usize")]
     pub twin_no_action_per_family: usize,
+    /// Probe pairs without a NO_ACTION scene are taken before those with one (each in the
+    /// probe's order), so the NO_ACTION caps keep the most pairs (false: the probe's order
+    /// alone — builds before it).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub decisive_pairs_first: bool,
     /// With `catch_share`: families still short of `per_family` take further NO_ACTION
     /// scenes of their own, one family at a time in name order, while the subset's
     /// NO_ACTION scenes stay within this share of `per_family` × families (0: never —
@@ -63,6 +68,7 @@ impl Default for EvalConfig {
             no_action_per_family: 0,
             twin_pairs_per_family: 0,
             twin_no_action_per_family: 0,
+            decisive_pairs_first: false,
             no_action_fill_share: 0.0,
         }
     }
@@ -157,26 +163,18 @@ fn stratified(rows: &[EvalRow], members: &[usize], cfg: &EvalConfig, share: f64)
         members.iter().map(|&r| (rows[r].scene_index, r)).collect();
     let pair_none_cap = cfg.no_action_per_family.max(cfg.twin_no_action_per_family);
     let mut taken: Vec<usize> = Vec::new();
-    for &r in members {
+    for (r, q) in probe_pairs(rows, members, &by_index, cfg) {
         if taken.len() + 2 > n.min(2 * cfg.twin_pairs_per_family) {
             break;
         }
-        let twin = rows[r].twin.filter(|&t| t > rows[r].scene_index);
-        if let Some(&q) = twin.and_then(|t| by_index.get(&t)) {
-            // A pair of two NO_ACTION scenes is no probe: nothing reaches the observer
-            // with either object (the probe's aim failed), so no decision tells them apart.
-            if rows[r].action == "NO_ACTION" && rows[q].action == "NO_ACTION" {
-                continue;
-            }
-            // Within the family's NO_ACTION cap, like every other scene.
-            let none = [r, q]
-                .iter()
-                .chain(&taken)
-                .filter(|&&x| rows[x].action == "NO_ACTION")
-                .count();
-            if none <= pair_none_cap {
-                taken.extend([r, q]);
-            }
+        // Within the family's NO_ACTION cap, like every other scene.
+        let none = [r, q]
+            .iter()
+            .chain(&taken)
+            .filter(|&&x| rows[x].action == "NO_ACTION")
+            .count();
+        if none <= pair_none_cap {
+            taken.extend([r, q]);
         }
     }
     let count = |action: &str| taken.iter().filter(|&&r| rows[r].action == action).count();
@@ -210,6 +208,33 @@ fn stratified(rows: &[EvalRow], members: &[usize], cfg: &EvalConfig, share: f64)
         }
     }
     taken
+}
+
+/// A family's probe pairs (both scenes valid members, not both NO_ACTION: nothing reaches
+/// the observer with either object, so no decision tells them apart) in the probe's (the
+/// lower index's) order; with `decisive_pairs_first`, the pairs without a NO_ACTION scene
+/// come first (each kind in that order), so the NO_ACTION cap keeps the most pairs.
+fn probe_pairs(
+    rows: &[EvalRow],
+    members: &[usize],
+    by_index: &BTreeMap<u64, usize>,
+    cfg: &EvalConfig,
+) -> Vec<(usize, usize)> {
+    let mut pairs: Vec<(usize, usize)> = members
+        .iter()
+        .filter_map(|&r| {
+            let twin = rows[r].twin.filter(|&t| t > rows[r].scene_index)?;
+            by_index.get(&twin).map(|&q| (r, q))
+        })
+        .filter(|&(r, q)| !(rows[r].action == "NO_ACTION" && rows[q].action == "NO_ACTION"))
+        .collect();
+    if cfg.decisive_pairs_first {
+        // Stable: within each kind, the probe's order.
+        pairs.sort_by_key(|&(r, q)| {
+            usize::from(rows[r].action == "NO_ACTION") + usize::from(rows[q].action == "NO_ACTION")
+        });
+    }
+    pairs
 }
 
 /// Whole speed-band groups (all four bands valid) in index order while they fit, then
@@ -271,6 +296,7 @@ mod tests {
             no_action_per_family: 1,
             twin_pairs_per_family: 0,
             twin_no_action_per_family: 0,
+            decisive_pairs_first: false,
             no_action_fill_share: 0.0,
         };
         // Family a: 3 CATCH, 12 DODGE, 4 NO_ACTION: CATCH short, DODGE fills.
@@ -329,6 +355,7 @@ mod tests {
             no_action_per_family: 1,
             twin_pairs_per_family: 0,
             twin_no_action_per_family: 0,
+            decisive_pairs_first: false,
             // 3 families × 4 = 12 scenes: at most floor(0.34 × 12) = 4 NO_ACTION.
             no_action_fill_share: 0.34,
         };
@@ -373,6 +400,7 @@ mod tests {
             no_action_per_family: 1,
             twin_pairs_per_family: 2,
             twin_no_action_per_family: 0,
+            decisive_pairs_first: false,
             no_action_fill_share: 0.0,
         };
         // Pair 0–4: NO_ACTION / NO_ACTION, left out (no probe, and over the cap of one);
@@ -402,6 +430,7 @@ mod tests {
             no_action_per_family: 1,
             twin_pairs_per_family: 3,
             twin_no_action_per_family: 2,
+            decisive_pairs_first: false,
             ..EvalConfig::default()
         };
         // NO_ACTION / NO_ACTION: no probe, left out although the cap is two; CATCH /
@@ -428,6 +457,40 @@ mod tests {
         // Pairs 1–11 and 2–12; CATCH target 4 less the pairs' 2: 3 and 20; the rest
         // DODGE (21, 22); no single NO_ACTION (the pairs already hold two).
         assert_eq!(indices, vec![1, 2, 3, 11, 12, 20, 21, 22]);
+    }
+
+    #[test]
+    fn decisive_pairs_are_taken_before_pairs_with_a_no_action_scene() {
+        let cfg = EvalConfig {
+            per_family: 6,
+            catch_share: Some(0.5),
+            no_action_per_family: 1,
+            twin_pairs_per_family: 2,
+            twin_no_action_per_family: 1,
+            decisive_pairs_first: true,
+            ..EvalConfig::default()
+        };
+        let rows: Vec<EvalRow> = [
+            pair(0, 10, "CATCH", "NO_ACTION"),
+            pair(1, 11, "CATCH", "NO_ACTION"),
+            pair(2, 12, "CATCH", "DODGE"),
+            pair(3, 13, "DODGE", "CATCH"),
+        ]
+        .concat();
+        let pick = |cfg: &EvalConfig| -> Vec<u64> {
+            let (chosen, _) = select(&rows, cfg);
+            chosen.iter().map(|&r| rows[r].scene_index).collect()
+        };
+        // Decisive first: pairs 2–12 and 3–13; CATCH target 3 less their 2: scene 0; the
+        // NO_ACTION cap of one: scene 10.
+        assert_eq!(pick(&cfg), vec![0, 2, 3, 10, 12, 13]);
+        // The probe's order alone: pair 0–10 uses the cap, 1–11 is left out, then 2–12;
+        // one more CATCH (1) and a DODGE (13).
+        let ordered = EvalConfig {
+            decisive_pairs_first: false,
+            ..cfg.clone()
+        };
+        assert_eq!(pick(&ordered), vec![0, 1, 2, 10, 12, 13]);
     }
 
     #[test]
