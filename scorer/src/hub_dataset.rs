@@ -44,7 +44,14 @@ pub fn resolve_dir(arg: Option<String>) -> Result<PathBuf> {
             match rh_dataset::release::check_download(repo, &snapshot.path, &released) {
                 Ok(Some(note)) => rh_contract::note!("rh-score: {note}"),
                 Ok(None) => {}
-                Err(e) => return Err(InputError(e).into()),
+                Err(e) => {
+                    let paper = crate::dataset_diagnosis::paper_scene_folders(&snapshot.path);
+                    return Err(InputError(match paper {
+                        0 => e,
+                        _ => format!("{e} ({paper} scene folders <family>/<family>__dN_vM/: the paper's metadata-only layout)"),
+                    })
+                    .into());
+                }
             }
             Ok(snapshot.path)
         }

@@ -85,6 +85,17 @@ fn plain_build(dir: &Path) -> String {
     run_ok("rh-pipeline", &["fingerprint", d])
 }
 
+/// `rh-pipeline build --release [--release-config RELEASE] --out OUT EXTRA...` (without
+/// RELEASE: the embedded configs/release.toml).
+fn build_release(release: Option<&Path>, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec!["build", "--release", "--out", out.to_str().unwrap()];
+    if let Some(r) = release {
+        args.extend(["--release-config", r.to_str().unwrap()]);
+    }
+    args.extend_from_slice(extra);
+    run("rh-pipeline", &args)
+}
+
 #[test]
 fn build_release_refuses_pins_that_differ_and_builds_the_release_exactly() {
     let tmp = tempfile::tempdir().unwrap();
@@ -106,17 +117,7 @@ fn build_release_refuses_pins_that_differ_and_builds_the_release_exactly() {
     other["config_sha256"] = serde_json::json!("0".repeat(64));
     release_file(&wrong, &other, &fingerprint, "v0");
     let out_dir = tmp.path().join("refused");
-    let out = run(
-        "rh-pipeline",
-        &[
-            "build",
-            "--release",
-            "--release-config",
-            wrong.to_str().unwrap(),
-            "--out",
-            out_dir.to_str().unwrap(),
-        ],
-    );
+    let out = build_release(Some(&wrong), &out_dir, &[]);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
@@ -151,18 +152,10 @@ fn build_release_refuses_pins_that_differ_and_builds_the_release_exactly() {
         tmp.path().join("labels.toml"),
     )
     .unwrap();
-    let out = run(
-        "rh-pipeline",
-        &[
-            "build",
-            "--release",
-            "--release-config",
-            right.to_str().unwrap(),
-            "--config",
-            changed.to_str().unwrap(),
-            "--out",
-            out_dir.to_str().unwrap(),
-        ],
+    let out = build_release(
+        Some(&right),
+        &out_dir,
+        &["--config", changed.to_str().unwrap()],
     );
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
@@ -187,17 +180,7 @@ fn build_release_refuses_pins_that_differ_and_builds_the_release_exactly() {
     // The right pins: the release is built, equal file for file to the plain build but
     // for the release it records (build.json) and names (the card).
     let released = tmp.path().join("released");
-    let out = run(
-        "rh-pipeline",
-        &[
-            "build",
-            "--release",
-            "--release-config",
-            right.to_str().unwrap(),
-            "--out",
-            released.to_str().unwrap(),
-        ],
-    );
+    let out = build_release(Some(&right), &released, &[]);
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
     assert!(
@@ -224,17 +207,7 @@ fn build_release_refuses_pins_that_differ_and_builds_the_release_exactly() {
         })
         .collect();
     release_file(&mismatched, &manifest, &bad, rule);
-    let out = run(
-        "rh-pipeline",
-        &[
-            "build",
-            "--release",
-            "--release-config",
-            mismatched.to_str().unwrap(),
-            "--out",
-            tmp.path().join("again").to_str().unwrap(),
-        ],
-    );
+    let out = build_release(Some(&mismatched), &tmp.path().join("again"), &[]);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
@@ -253,18 +226,7 @@ fn the_embedded_release_pins_the_embedded_configuration() {
     // shard records the release; the whole release's fingerprint is checked in
     // `the_canonical_release_reproduces_its_pinned_fingerprint`.
     let tmp = tempfile::tempdir().unwrap();
-    let out = run(
-        "rh-pipeline",
-        &[
-            "build",
-            "--release",
-            "--no-render",
-            "--shard",
-            "0/170",
-            "--out",
-            tmp.path().to_str().unwrap(),
-        ],
-    );
+    let out = build_release(None, tmp.path(), &["--no-render", "--shard", "0/170"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let m = build_json(tmp.path());
     let release = toml_value(&configs("release.toml"));
@@ -288,16 +250,7 @@ fn the_canonical_release_reproduces_its_pinned_fingerprint() {
     // The label-only part of the canonical release (680 scenes): its fingerprint is the
     // one configs/release.toml pins (the rendered release has the same one).
     let tmp = tempfile::tempdir().unwrap();
-    let out = run(
-        "rh-pipeline",
-        &[
-            "build",
-            "--release",
-            "--no-render",
-            "--out",
-            tmp.path().to_str().unwrap(),
-        ],
-    );
+    let out = build_release(None, tmp.path(), &["--no-render"]);
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
     assert!(
@@ -315,21 +268,16 @@ fn the_canonical_release_reproduces_its_pinned_fingerprint() {
     );
 }
 
-/// Paper-style metadata only: a card and a scene list, no tables.
+/// The paper's metadata-only layout (`<family>/<family>__dN_vM/` with metadata.json and
+/// spec.json, as grade's `dataset_diagnosis` knows it): a card and scene folders, no tables.
 fn paper_style_repo() -> BTreeMap<String, Vec<u8>> {
+    let file = |p: &str, text: &str| (p.to_string(), text.as_bytes().to_vec());
     BTreeMap::from([
-        (
-            ".gitattributes".to_string(),
-            b"*.json filter=lfs\n".to_vec(),
-        ),
-        (
-            "README.md".to_string(),
-            b"# ReactHuman (paper release)\n".to_vec(),
-        ),
-        (
-            "metadata/scenes.json".to_string(),
-            b"[{\"scene_id\": \"s0\", \"family\": \"object_drop\"}]\n".to_vec(),
-        ),
+        file(".gitattributes", "*.json filter=lfs\n"),
+        file("README.md", "# ReactHuman (paper release)\n"),
+        file("object_drop/object_drop__d1_v1/metadata.json", "{}\n"),
+        file("object_drop/object_drop__d1_v1/spec.json", "{}\n"),
+        file("shelf_slide/shelf_slide__d1_v1/metadata.json", "{}\n"),
     ])
 }
 
@@ -373,18 +321,7 @@ fn the_release_from_the_hub_is_checked_and_scored_and_other_repositories_are_ref
     let rel = tmp.path().join("release.toml");
     release_file(&rel, &manifest, &fingerprint, rule);
     let released = tmp.path().join("released");
-    let out = run(
-        "rh-pipeline",
-        &[
-            "build",
-            "--release",
-            "--release-config",
-            rel.to_str().unwrap(),
-            "--quiet",
-            "--out",
-            released.to_str().unwrap(),
-        ],
-    );
+    let out = build_release(Some(&rel), &released, &["--quiet"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let preds = tmp.path().join("preds.jsonl");
     let text = run_ok(
@@ -440,11 +377,17 @@ fn the_release_from_the_hub_is_checked_and_scored_and_other_repositories_are_ref
         "{err}"
     );
     assert!(
-        err.contains("3 file(s): .gitattributes, README.md, metadata/scenes.json"),
+        err.contains(
+            "5 file(s): .gitattributes, README.md, object_drop/object_drop__d1_v1/metadata.json"
+        ),
         "{err}"
     );
     assert!(
         err.contains("rh-pipeline build --release") && err.contains(&released_repo()),
+        "{err}"
+    );
+    assert!(
+        err.contains("2 scene folders <family>/<family>__dN_vM/: the paper's metadata-only layout"),
         "{err}"
     );
     // `rh-pipeline download` still fetches it (it is a Hub dataset like any other).
