@@ -205,6 +205,17 @@ pub struct CardInput<'a> {
     pub eval: Option<&'a BTreeMap<String, usize>>,
 }
 
+/// The project's release, the paper's, and the release this build is (if one).
+fn insert_release(v: &mut BTreeMap<&str, String>, m: &Manifest) {
+    v.insert("repo_id", rh_hub::released_dataset());
+    v.insert("paper_repo", PAPER_RELEASE.into());
+    let line = m
+        .release
+        .as_ref()
+        .map(|id| format!(", release `{id}` of the benchmark"));
+    v.insert("release_line", line.unwrap_or_default());
+}
+
 /// Renders `README.md`.
 pub fn text(input: &CardInput) -> String {
     let m = input.manifest;
@@ -215,14 +226,7 @@ pub fn text(input: &CardInput) -> String {
         .expect("a manifest written by this version holds the label config");
     let mut v: BTreeMap<&str, String> = BTreeMap::new();
     v.insert("size_category", size_category(n_rows).into());
-    v.insert("repo_id", rh_hub::released_dataset());
-    v.insert("paper_repo", PAPER_RELEASE.into());
-    v.insert(
-        "release_line",
-        m.release.as_ref().map_or(String::new(), |id| {
-            format!(", release `{id}` of the benchmark")
-        }),
-    );
+    insert_release(&mut v, m);
     v.insert(
         "row_group_size",
         table::row_group_size(m.render).to_string(),
