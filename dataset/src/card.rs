@@ -15,6 +15,8 @@ use std::collections::BTreeMap;
 use std::fmt::Write;
 
 const TEMPLATE: &str = include_str!("../card_template.md");
+/// The paper's own Hub release: metadata only (no tables, no frames), cited as the paper's.
+const PAPER_RELEASE: &str = "Alan123/reacthuman-benchmark-scaled";
 
 /// The `eval` config's Parquet file.
 pub const EVAL_FILE: &str = "eval/test-00000-of-00001.parquet";
@@ -208,6 +210,17 @@ pub struct CardInput<'a> {
     pub eval: Option<&'a BTreeMap<String, usize>>,
 }
 
+/// The project's release, the paper's, and the release this build is (if one).
+fn insert_release(v: &mut BTreeMap<&str, String>, m: &Manifest) {
+    v.insert("repo_id", rh_hub::released_dataset());
+    v.insert("paper_repo", PAPER_RELEASE.into());
+    let line = m
+        .release
+        .as_ref()
+        .map(|id| format!(", release `{id}` of the benchmark"));
+    v.insert("release_line", line.unwrap_or_default());
+}
+
 /// Renders `README.md`.
 pub fn text(input: &CardInput) -> String {
     let m = input.manifest;
@@ -218,7 +231,7 @@ pub fn text(input: &CardInput) -> String {
         .expect("a manifest written by this version holds the label config");
     let mut v: BTreeMap<&str, String> = BTreeMap::new();
     v.insert("size_category", size_category(n_rows).into());
-    v.insert("repo_id", rh_hub::RELEASED_DATASET.into());
+    insert_release(&mut v, m);
     v.insert(
         "row_group_size",
         table::row_group_size(m.render).to_string(),

@@ -2,7 +2,8 @@
 //!
 //! Always: [`table`] — the scene table's Arrow schema, its Parquet writer settings and
 //! reading it back; [`stream`] — a Parquet file written row group by row group;
-//! [`manifest`] — reading `build.json` (writing one needs `write`).
+//! [`manifest`] — reading `build.json` (writing one needs `write`); [`release`] — the
+//! canonical release (`configs/release.toml`), the dataset fingerprint, download checks.
 //! With feature `write` (default): [`rows`] (scene rows from scene results),
 //! [`camera_columns`] (the head camera's calibration and motion columns),
 //! [`media_columns`] (the measured-visibility and mask columns), [`integrity`] (SHA-256 sums), [`records`] (finished scene groups of a
@@ -12,6 +13,7 @@
 pub mod frames;
 pub mod manifest;
 pub mod read;
+pub mod release;
 pub mod stream;
 pub mod table;
 

@@ -70,6 +70,10 @@ pub struct Manifest {
     /// different adapters do not merge: their pixels, the models' inputs, may differ.
     #[serde(default)]
     pub render_adapter: Option<rh_contract::adapter::RenderAdapter>,
+    /// The release this is a build of (`rh-pipeline build --release`: the `id` of
+    /// `configs/release.toml`); absent for any other build.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub release: Option<String>,
 }
 
 /// A fingerprint of a configuration (also used to tell the embedded default apart).
@@ -114,6 +118,7 @@ impl Manifest {
             files: None,
             selections: None,
             render_adapter: None,
+            release: None,
         }
     }
 
@@ -199,6 +204,11 @@ impl Manifest {
         );
         cmp("render", self.render.to_string(), other.render.to_string());
         cmp("masks", self.masks.to_string(), other.masks.to_string());
+        cmp(
+            "release",
+            format!("{:?}", self.release),
+            format!("{:?}", other.release),
+        );
         if self.config_sha256 != other.config_sha256 || self.config != other.config {
             d.push("configuration".into());
         }
@@ -284,12 +294,15 @@ impl Manifest {
     /// The `rh-pipeline build` command line of this build (its recorded arguments; a
     /// `--config`, `--catalog` or `--descriptions` it was given is named, not spelled out).
     pub fn build_command(&self, dir: &Path) -> String {
-        let mut cmd = format!(
-            "rh-pipeline build --n {} --seed {} --out {}",
-            self.n,
-            self.seed,
-            dir.display()
-        );
+        let mut cmd = match &self.release {
+            Some(_) => format!("rh-pipeline build --release --out {}", dir.display()),
+            None => format!(
+                "rh-pipeline build --n {} --seed {} --out {}",
+                self.n,
+                self.seed,
+                dir.display()
+            ),
+        };
         if !self.render {
             cmd.push_str(" --no-render");
         }

@@ -26,9 +26,14 @@ use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-/// The released dataset: what `rh-score` scores against when neither `--dataset` nor
-/// `$RH_DATASET` is given.
-pub const RELEASED_DATASET: &str = "Alan123/reacthuman-benchmark-scaled";
+/// The project's released dataset, `owner/name@revision` (`released_dataset` of the
+/// embedded `configs/hub.toml`): what `rh-score` scores against when neither `--dataset`
+/// nor `$RH_DATASET` is given.
+pub fn released_dataset() -> String {
+    Settings::parse(EMBEDDED_CONFIG, "configs/hub.toml")
+        .expect("the embedded configs/hub.toml parses (unit-tested)")
+        .released_dataset
+}
 
 /// The Hub's public address, used when `HF_ENDPOINT` is not set.
 pub const DEFAULT_ENDPOINT: &str = "https://huggingface.co";
@@ -73,6 +78,8 @@ pub struct Settings {
     pub download_timeout: Duration,
     /// Files downloaded at the same time.
     pub concurrent_downloads: usize,
+    /// The project's released dataset, `owner/name@revision`.
+    pub released_dataset: String,
 }
 
 #[derive(Deserialize)]
@@ -81,6 +88,7 @@ struct SettingsFile {
     metadata_timeout_s: f64,
     download_timeout_s: f64,
     concurrent_downloads: usize,
+    released_dataset: String,
 }
 
 fn seconds(what: &str, v: f64) -> Result<Duration, String> {
@@ -97,6 +105,16 @@ impl Settings {
     /// Parses a `hub.toml` text (`origin` names it in errors).
     pub fn parse(text: &str, origin: &str) -> Result<Settings, String> {
         let f: SettingsFile = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
+        let (repo, revision) = f
+            .released_dataset
+            .split_once('@')
+            .unwrap_or((&f.released_dataset, "main"));
+        if !is_repo_id(repo) || revision.is_empty() {
+            return Err(format!(
+                "{origin}: released_dataset must be owner/name[@revision], not '{}'",
+                f.released_dataset
+            ));
+        }
         Ok(Settings {
             metadata_timeout: seconds(
                 &format!("{origin}: metadata_timeout_s"),
@@ -107,6 +125,7 @@ impl Settings {
                 f.download_timeout_s,
             )?,
             concurrent_downloads: f.concurrent_downloads.clamp(1, 64),
+            released_dataset: f.released_dataset,
         })
     }
 
@@ -383,7 +402,11 @@ mod tests {
     #[test]
     fn repo_ids() {
         assert!(is_repo_id("Alan123/reacthuman-benchmark-scaled"));
-        assert!(is_repo_id(RELEASED_DATASET));
+        let released = released_dataset();
+        assert!(
+            is_repo_id(released.split_once('@').unwrap().0),
+            "{released}"
+        );
         assert!(is_repo_id("a/b.c_d"));
         assert!(!is_repo_id("name"));
         assert!(!is_repo_id("a/b/c"));
@@ -398,8 +421,14 @@ mod tests {
         let s = Settings::parse(EMBEDDED_CONFIG, "hub.toml").unwrap();
         assert_eq!(s.metadata_timeout, Duration::from_secs(10));
         assert_eq!(s.download_timeout, Duration::from_secs(10));
+        let text = "metadata_timeout_s = 1\ndownload_timeout_s = 1\nconcurrent_downloads = 1\n";
+        assert!(
+            Settings::parse(&format!("{text}released_dataset = \"a b\""), "x.toml")
+                .unwrap_err()
+                .contains("x.toml: released_dataset")
+        );
         assert!(Settings::parse(
-            "metadata_timeout_s = 0\ndownload_timeout_s = 1\nconcurrent_downloads = 1",
+            "metadata_timeout_s = 0\ndownload_timeout_s = 1\nconcurrent_downloads = 1\nreleased_dataset = \"a/b\"",
             "x.toml"
         )
         .unwrap_err()

@@ -56,6 +56,8 @@ pub struct BuildOptions {
     pub progress: bool,
     /// Seconds between progress lines when stderr is not a terminal.
     pub progress_every_s: f64,
+    /// The release this build is (`build --release`), recorded in `build.json`.
+    pub release: Option<String>,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -482,6 +484,7 @@ pub fn build(
     manifest.selections = opts.selections.clone();
     manifest.masks = opts.masks;
     manifest.render_adapter = render_adapter;
+    manifest.release = opts.release.clone();
     let out = &opts.out;
     std::fs::create_dir_all(out)
         .map_err(|e| BuildError::Input(format!("cannot write to --out {}: {e}", out.display())))?;

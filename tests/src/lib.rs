@@ -5,6 +5,7 @@
 //! programs sit one directory up.
 
 pub mod cdp;
+pub mod fake_hub;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -290,7 +290,7 @@ fn dataset_from_environment_and_missing_dataset() {
     let work = scratch("env");
     let p = work.join("p.jsonl");
     baseline(ds, "freeze", &p);
-    // No --dataset, no RH_DATASET: the released dataset from the Hub. Here the Hub is a
+    // No --dataset, no RH_DATASET: the project's release (configs/hub.toml). Here the Hub is a
     // closed loopback port and the HF cache is empty: exit 1 naming the repo and endpoint.
     let hf_home = scratch("env-hf-home");
     let closed = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
@@ -309,7 +309,7 @@ fn dataset_from_environment_and_missing_dataset() {
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("Alan123/reacthuman-benchmark-scaled") && err.contains(&endpoint),
+        err.contains("reacthuman/reacthuman (revision rh-release-v1)") && err.contains(&endpoint),
         "{err}"
     );
     // owner/name that is not a directory, offline with an empty cache: the same, no network.

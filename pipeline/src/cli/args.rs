@@ -79,6 +79,18 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Print a dataset's fingerprint: SHA-256 of its scene table, evaluation subset and
+    /// specs, the rendered media left out (the same on every render adapter), as the
+    /// `[fingerprint]` table of a release file. For a build of the release
+    /// (configs/release.toml, or $RH_RELEASE_CONFIG) also checks it against the release's
+    /// pins: exit 2 naming what differs.
+    Fingerprint {
+        /// Dataset directory built by `rh-pipeline build`.
+        dir: PathBuf,
+        /// Print the fingerprint and the check as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
     /// Tile one observation frame per family of a rendered dataset (the close-up at
     /// t = 0.30 s of each family's first scene) into one labelled PNG, to eyeball all
     /// families at once.
@@ -146,8 +158,20 @@ pub struct LlmArgs {
 pub struct BuildArgs {
     /// Number of scenes (four speed bands per scene group). With --descriptions it
     /// defaults to four per description (group g takes description g mod D).
-    #[arg(long, required_unless_present = "descriptions")]
+    #[arg(long, required_unless_present_any = ["descriptions", "release"])]
     pub n: Option<u64>,
+    /// Build the benchmark's canonical release (configs/release.toml, or --release-config):
+    /// its seed, scene count, families and render flags, after checking that the
+    /// configuration, catalog, label rule and prompt are the ones it pins (exit 2 naming
+    /// each that differs); the finished build's fingerprint is then checked against the
+    /// release's (exit 1 if it differs). With --no-render: its label-only part (the same
+    /// fingerprint; not the release to upload).
+    #[arg(long, conflicts_with_all = ["n", "seed", "families", "descriptions", "masks"])]
+    pub release: bool,
+    /// The release file of --release (default: $RH_RELEASE_CONFIG, else the embedded
+    /// configs/release.toml).
+    #[arg(long, value_name = "FILE", requires = "release")]
+    pub release_config: Option<PathBuf>,
     /// Plan the scene groups from these descriptions (a text file, one a line; blank
     /// lines and lines starting with # are skipped) instead of round-robin families.
     #[arg(long, value_name = "FILE")]

@@ -4,6 +4,7 @@
 use super::args::{parse_shard, BuildArgs, PlannerKind};
 use super::failure::{build_failure, input, print_json, println, Failure};
 use super::llm_planner::llm_planner;
+use super::release_command;
 use crate::build::{build, BuildOptions};
 use rh_catalog::Catalog;
 use rh_scenes::config::Config;
@@ -14,6 +15,8 @@ use rh_scenes::selection::{LexiconPlanner, Planner};
 pub fn run(args: BuildArgs, catalog: &Catalog, config: &Config) -> Result<(), Failure> {
     let BuildArgs {
         n,
+        release,
+        release_config,
         descriptions,
         planner,
         llm,
@@ -40,7 +43,21 @@ pub fn run(args: BuildArgs, catalog: &Catalog, config: &Config) -> Result<(), Fa
             crate::build::MAX_SCENES
         )));
     }
-    let seed = seed.unwrap_or(config.build.seed);
+    let release = match release {
+        true => Some(release_command::prepare(
+            release_config.as_deref(),
+            catalog,
+            config,
+        )?),
+        false => None,
+    };
+    let r = release.as_ref().map(|(r, _)| r);
+    let seed = r.map_or(seed.unwrap_or(config.build.seed), |r| r.seed);
+    let n = r.map(|r| r.n).or(n);
+    let families = r.map_or(families, |r| r.families.clone());
+    let (no_render, masks) = r.map_or((no_render, masks), |r| {
+        (no_render || !r.render, r.masks && !no_render)
+    });
     let selections = match &descriptions {
         None => None,
         Some(path) => {
@@ -59,7 +76,7 @@ pub fn run(args: BuildArgs, catalog: &Catalog, config: &Config) -> Result<(), Fa
     let n = match (n, &selections) {
         (Some(n), _) => n,
         (None, Some(s)) => 4 * s.len() as u64,
-        (None, None) => unreachable!("clap requires --n without --descriptions"),
+        (None, None) => unreachable!("clap requires --n without --descriptions or --release"),
     };
     let families = match &selections {
         Some(s) => {
@@ -88,8 +105,9 @@ pub fn run(args: BuildArgs, catalog: &Catalog, config: &Config) -> Result<(), Fa
         masks,
         progress: !quiet,
         progress_every_s: progress_every,
+        release: r.map(|r| r.id.clone()),
     };
-    build_and_print(&opts, catalog, config, json)
+    build_and_print(&opts, catalog, config, json, release.as_ref())
 }
 
 /// Reads a descriptions file: one a line; blank lines and `#` comments skipped.
@@ -136,8 +154,12 @@ fn build_and_print(
     catalog: &Catalog,
     config: &Config,
     json: bool,
+    release: Option<&(rh_dataset::release::Release, String)>,
 ) -> Result<(), Failure> {
     let summary = build(opts, catalog, config).map_err(build_failure)?;
+    if let Some((release, origin)) = release {
+        release_command::check_built(opts, release, origin)?;
+    }
     if json {
         print_json(&summary)?;
     } else {

@@ -11,6 +11,7 @@ pub mod failure;
 pub mod llm_planner;
 pub mod merge_command;
 pub mod plan_command;
+pub mod release_command;
 pub mod sheet_command;
 pub mod verify_command;
 
@@ -53,11 +54,15 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             revision,
             out,
         } => return download_command::run(repo, revision.as_deref(), out.as_deref()),
+        Command::Fingerprint { dir, json } => return release_command::fingerprint(dir, *json),
         _ => {}
     }
     let (catalog, config) = load(&cli)?;
     match cli.command {
-        Command::Merge { .. } | Command::Download { .. } | Command::Sheet { .. } => {
+        Command::Merge { .. }
+        | Command::Download { .. }
+        | Command::Sheet { .. }
+        | Command::Fingerprint { .. } => {
             unreachable!("handled above")
         }
         Command::Build(args) => build_command::run(args, &catalog, &config),

@@ -31,7 +31,7 @@ pub struct Cli {
 
     /// Dataset directory (data/*.parquet + specs/), or a Hugging Face Hub dataset id
     /// owner/name[@revision], downloaded once into the HF cache and then used offline.
-    /// Default: $RH_DATASET, else the released dataset (Alan123/reacthuman-benchmark-scaled).
+    /// Default: $RH_DATASET, else the project's release (`released_dataset` in configs/hub.toml).
     #[arg(long, value_name = "DIR|owner/name")]
     pub dataset: Option<String>,
 
