@@ -204,6 +204,12 @@ fn disposition<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) ->
         ))
         .map_err(e)?;
     let pts = disposition_points(r);
+    if pts.is_empty() {
+        let (x, y) = chart.backend_coord(&(50.0, 50.0));
+        let st = style(LABEL, BLACK, HPos::Center, VPos::Center);
+        let msg = "no model has scored both CATCH and DODGE scenes";
+        plot.draw(&Text::new(msg, (x, y), st)).map_err(e)?;
+    }
     for p in &pts {
         let c = color(p.model);
         if let Some([lo, hi]) = p.x_ci {
