@@ -85,11 +85,16 @@ pub fn freeze_by_band(r: &Report) -> String {
 }
 
 pub fn per_family(r: &Report) -> String {
+    let n = r
+        .models
+        .iter()
+        .flat_map(|m| m.by_family.iter().map(|f| f.expected));
     format!(
         "SAA per event family and model. {SAA} Each bar is labelled with its value; a 0% bar \
-         is drawn as a thin stub. {INTERVALS} n (expected scenes per model) is beside each \
-         family; with so few scenes per family the intervals are wide and differences \
-         between models within a family are rarely significant. {}",
+         is drawn as a thin stub. {INTERVALS} n (expected scenes per model and family, \
+         {}) is beside each family; at such n the intervals are wide, so compare models \
+         within a family with care. {}",
+        n_text(n),
         scope(r)
     )
 }
