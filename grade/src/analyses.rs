@@ -61,6 +61,10 @@ pub struct SpeedAnalysis {
     pub model: String,
     pub decisions: u64,
     pub freeze_rate_by_band: Vec<Option<f64>>,
+    /// Scored decisions per band (the freeze rate's denominators).
+    pub decisions_by_band: Vec<u64>,
+    /// 95% Wilson intervals of `freeze_rate_by_band`.
+    pub freeze_rate_by_band_ci: Vec<Option<[f64; 2]>>,
     pub saa_by_band: Vec<Option<f64>>,
     /// Scene groups with a scored decision at all four bands.
     pub complete_groups: u64,
@@ -221,6 +225,10 @@ pub(crate) fn speed_analysis(
         model: name.to_string(),
         decisions,
         freeze_rate_by_band: (0..4).map(|b| ratio(freeze[b], n_band[b])).collect(),
+        decisions_by_band: n_band.to_vec(),
+        freeze_rate_by_band_ci: (0..4)
+            .map(|b| crate::stats::wilson(freeze[b], n_band[b]))
+            .collect(),
         saa_by_band: (0..4).map(|b| ratio(saa[b], n_band[b])).collect(),
         complete_groups: complete,
         consistent_groups: consistent,

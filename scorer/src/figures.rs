@@ -1,23 +1,46 @@
-//! Figures (`--figures DIR`), each written as SVG and PNG with plotters:
-//! `disposition` (SAA on CATCH vs DODGE scenes, one point per model, dashed diagonal),
-//! `freeze_by_band` (share of NO_ACTION per speed band, speed-sweeping families),
-//! `per_family` (SAA per family and model), `safety_rules` (first-rule breakdown, legend
-//! below), and with `--execute` `outcomes` (caught / struck / missed / clear / not
+//! Figures (`--figures DIR`), each written as SVG, PNG and a caption (`NAME.caption.txt`,
+//! defining the metric, n and the intervals; [`captions`]) with plotters:
+//! `disposition` (SAA on CATCH vs DODGE scenes, one marker per model with 95% Wilson
+//! intervals both ways, dashed diagonal, a legend), `freeze_by_band` (share of NO_ACTION
+//! per speed band on the speed-sweeping families, a marker and line style per model, 95%
+//! Wilson intervals, n per band), `per_family` (SAA per family and model: bars with 95%
+//! Wilson intervals, value labels on white, n per family, 0% drawn as a stub),
+//! `safety_rules` (unsafe share per model split by first rule, its Wilson interval; no
+//! pooled row), and with `--execute` `outcomes` (caught / struck / missed / clear / not
 //! executed per model, and per model and ground-truth action, stacked). Percentage axes
-//! are labelled with whole numbers.
+//! run 0–100 and are labelled with whole numbers; no label overlaps another
+//! (`tests` checks the SVGs' text boxes).
 //!
-//! Text is rendered with `ab_glyph` from a font embedded in the binary (Hack, via the
-//! `epaint_default_fonts` crate), so no system fonts or fontconfig are needed.
+//! Text is drawn with `ab_glyph` from a font embedded in the binary (Hack, via the
+//! `epaint_default_fonts` crate), so no system fonts or fontconfig are needed; in the PNGs
+//! by [`png_text::GlyphText`] (plotters' own glyph placement split words).
+
+pub mod captions;
+mod parts;
+mod png_text;
+#[cfg(test)]
+mod tests;
 
 use crate::report::Report;
 use crate::safety_rule::SafetyRule;
 use anyhow::{anyhow, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, VPos};
 use std::path::Path;
 use std::sync::Once;
 
+use parts::{
+    boxed_label, draw_legend, draw_legend_below, error_bar, legend_rows, marker, split_legend,
+    style, Key, Rgb, ROW,
+};
+
 const FONT: &str = "sans-serif";
+// plotters' sizes: the SVG's font-size is size / 1.24 (a 16 → 12.9 px em).
+const TITLE: u32 = 22;
+const AXIS: u32 = 18;
+const TICK: u32 = 16;
+const LABEL: u32 = 16;
 
 fn register_font() {
     static ONCE: Once = Once::new();
@@ -52,50 +75,124 @@ fn color(i: usize) -> RGBColor {
     C[i % C.len()]
 }
 
-/// Splits off a legend column on the right, wide enough for the longest label.
-fn split_legend<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    items: &[(String, RGBColor)],
-) -> (DrawingArea<DB, Shift>, DrawingArea<DB, Shift>) {
-    let longest = items.iter().map(|i| i.0.chars().count()).max().unwrap_or(0);
-    let width = (40 + longest * 8).clamp(120, 460) as i32;
-    let (w, _) = root.dim_in_pixel();
-    root.split_horizontally(w as i32 - width)
+/// Dash (length, gap) in px of model `i`'s line; (0, 0) is solid.
+fn dash(i: usize) -> (u32, u32) {
+    [(0, 0), (10, 5), (3, 4), (16, 5), (7, 3), (2, 7)][i % 6]
 }
 
-fn draw_legend<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    items: &[(String, RGBColor)],
-) -> DrawResult {
-    for (i, (label, c)) in items.iter().enumerate() {
-        let y = 60 + 22 * i as i32;
-        area.draw(&Rectangle::new([(6, y), (20, y + 12)], c.filled()))
-            .map_err(e)?;
-        area.draw(&Text::new(label.clone(), (26, y - 1), (FONT, 12)))
-            .map_err(e)?;
+/// Per model the expected CATCH and DODGE scenes (the disposition's n).
+pub(crate) fn gt_counts(r: &Report) -> (Vec<u64>, Vec<u64>) {
+    let count = |g: &str| -> Vec<u64> {
+        r.models
+            .iter()
+            .map(|m| {
+                m.by_gt_action
+                    .iter()
+                    .find(|x| x.group == g)
+                    .map_or(0, |x| x.expected)
+            })
+            .collect()
+    };
+    (count("CATCH"), count("DODGE"))
+}
+
+/// One disposition marker: model, point and intervals in percent.
+struct DispPoint {
+    model: usize,
+    x: f64,
+    y: f64,
+    x_ci: Option<[f64; 2]>,
+    y_ci: Option<[f64; 2]>,
+}
+
+/// The disposition's points; those within 1.5 points of one another set 2.5 points
+/// apart sideways (the caption says so), so coinciding models stay visible.
+fn disposition_points(r: &Report) -> Vec<DispPoint> {
+    let row = |m: &crate::report::ModelReport, g: &str| {
+        m.by_gt_action.iter().find(|x| x.group == g).cloned()
+    };
+    let pct = |ci: Option<[f64; 2]>| ci.map(|[a, b]| [100.0 * a, 100.0 * b]);
+    let mut pts: Vec<DispPoint> = Vec::new();
+    for (i, m) in r.models.iter().enumerate() {
+        let (Some(c), Some(d)) = (row(m, "CATCH"), row(m, "DODGE")) else {
+            continue;
+        };
+        let (Some(x), Some(y)) = (c.saa, d.saa) else {
+            continue;
+        };
+        pts.push(DispPoint {
+            model: i,
+            x: 100.0 * x,
+            y: 100.0 * y,
+            x_ci: pct(c.saa_ci),
+            y_ci: pct(d.saa_ci),
+        });
     }
-    Ok(())
+    let mut group: Vec<usize> = (0..pts.len()).collect();
+    for i in 0..pts.len() {
+        for j in 0..i {
+            if (pts[i].x - pts[j].x).abs() < 1.5 && (pts[i].y - pts[j].y).abs() < 1.5 {
+                group[i] = group[j];
+                break;
+            }
+        }
+    }
+    let (xs, ys): (Vec<f64>, Vec<f64>) = pts.iter().map(|p| (p.x, p.y)).unzip();
+    for (i, p) in pts.iter_mut().enumerate() {
+        let members: Vec<usize> = (0..xs.len()).filter(|&j| group[j] == group[i]).collect();
+        let k = members.iter().position(|&j| j == i).unwrap_or(0) as f64;
+        let dx = (k - (members.len() as f64 - 1.0) / 2.0) * 2.5;
+        p.x = xs[i] + dx;
+        p.y = ys[i];
+        if let Some(ci) = &mut p.x_ci {
+            *ci = [ci[0] + dx, ci[1] + dx];
+        }
+    }
+    pts
 }
 
 fn disposition<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> DrawResult {
     root.fill(&WHITE).map_err(e)?;
-    let mut chart = ChartBuilder::on(root)
-        .caption("Disposition: SAA on CATCH vs DODGE scenes", (FONT, 20))
+    let (nc, nd) = gt_counts(r);
+    let same = |v: &[u64]| v.windows(2).all(|w| w[0] == w[1]);
+    let per_model_n = !(same(&nc) && same(&nd));
+    let items: Vec<(String, Key)> = r
+        .models
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let n = if per_model_n {
+                format!(" (n={}/{})", nc[i], nd[i])
+            } else {
+                String::new()
+            };
+            (format!("{}{n}", m.model), Key::Marker(i))
+        })
+        .collect();
+    let (plot, legend_area) = split_legend(root, &items);
+    let n_of = |v: &[u64]| match (per_model_n, v.first()) {
+        (false, Some(n)) => format!("; n = {n}"),
+        _ => String::new(),
+    };
+    let mut chart = ChartBuilder::on(&plot)
+        .caption("SAA on CATCH vs DODGE scenes", (FONT, TITLE))
         .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(55)
+        .x_label_area_size(50)
+        .y_label_area_size(60)
         // A margin beyond 0–100 %, so a marker in a corner is drawn whole.
-        .build_cartesian_2d(-6f64..106f64, -6f64..106f64)
+        .build_cartesian_2d(-5f64..105f64, -5f64..105f64)
         .map_err(e)?;
     chart
         .configure_mesh()
         .max_light_lines(0)
-        .x_desc("SAA on CATCH scenes (%)")
-        .y_desc("SAA on DODGE scenes (%)")
+        .x_labels(6)
+        .y_labels(6)
+        .x_desc(format!("SAA on CATCH scenes (%{})", n_of(&nc)))
+        .y_desc(format!("SAA on DODGE scenes (%{})", n_of(&nd)))
         .x_label_formatter(&percent_label)
         .y_label_formatter(&percent_label)
-        .label_style((FONT, 13))
-        .axis_desc_style((FONT, 14))
+        .label_style((FONT, TICK))
+        .axis_desc_style((FONT, AXIS))
         .draw()
         .map_err(e)?;
     chart
@@ -103,173 +200,215 @@ fn disposition<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) ->
             vec![(0.0, 0.0), (100.0, 100.0)],
             6,
             4,
-            BLACK.mix(0.6).stroke_width(1),
+            BLACK.mix(0.5).stroke_width(1),
         ))
         .map_err(e)?;
-    for (i, m) in r.models.iter().enumerate() {
-        let (Some(x), Some(y)) = (m.by_gt_action[0].saa, m.by_gt_action[1].saa) else {
-            continue;
-        };
-        let (x, y) = (100.0 * x, 100.0 * y);
-        let c = color(i);
-        chart
-            .draw_series(std::iter::once(Circle::new((x, y), 6, c.filled())))
-            .map_err(e)?;
-        let tx = if x > 75.0 { x - 22.0 } else { x + 1.5 };
-        chart
-            .draw_series(std::iter::once(Text::new(
-                format!(
-                    "{} (n={}/{})",
-                    m.model, m.by_gt_action[0].expected, m.by_gt_action[1].expected
-                ),
-                (tx, (y + 2.5).min(104.0)),
-                (FONT, 13).into_font().color(&c),
-            )))
-            .map_err(e)?;
+    let pts = disposition_points(r);
+    if pts.is_empty() {
+        let (x, y) = chart.backend_coord(&(50.0, 50.0));
+        let st = style(LABEL, BLACK, HPos::Center, VPos::Center);
+        let msg = "no model has scored both CATCH and DODGE scenes";
+        plot.draw(&Text::new(msg, (x, y), st)).map_err(e)?;
     }
+    for p in &pts {
+        let c = color(p.model);
+        if let Some([lo, hi]) = p.x_ci {
+            error_bar(
+                &plot,
+                chart.backend_coord(&(lo, p.y)),
+                chart.backend_coord(&(hi, p.y)),
+                c,
+            )?;
+        }
+        if let Some([lo, hi]) = p.y_ci {
+            error_bar(
+                &plot,
+                chart.backend_coord(&(p.x, lo)),
+                chart.backend_coord(&(p.x, hi)),
+                c,
+            )?;
+        }
+    }
+    for p in &pts {
+        marker(&plot, p.model, chart.backend_coord(&(p.x, p.y)), 7)?;
+    }
+    draw_legend(&legend_area, &items)?;
     root.present().map_err(e)?;
     Ok(())
 }
 
+const BANDS: [&str; 4] = ["slow", "normal", "fast", "very_fast"];
+
 fn freeze_by_band<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> DrawResult {
     root.fill(&WHITE).map_err(e)?;
-    let bands = ["slow", "normal", "fast", "very_fast"];
-    let legend_items: Vec<(String, RGBColor)> = r
-        .analyses
-        .speed
+    // One series per model; the pooled "ALL" row is not a model.
+    let series: Vec<_> = r.analyses.speed.iter().take(r.models.len()).collect();
+    let items: Vec<(String, Key)> = series
         .iter()
-        .filter(|s| s.model != "ALL")
         .enumerate()
-        .map(|(i, s)| (s.model.clone(), color(i)))
+        .map(|(i, s)| (s.model.clone(), Key::Line(i)))
         .collect();
-    let (plot, legend_area) = split_legend(root, &legend_items);
+    let (plot, legend_area) = split_legend(root, &items);
+    let band_n: Vec<String> = (0..4)
+        .map(|b| {
+            captions::n_text(
+                series
+                    .iter()
+                    .map(|s| s.decisions_by_band.get(b).copied().unwrap_or(0)),
+            )
+        })
+        .collect();
     let mut chart = ChartBuilder::on(&plot)
-        .caption("Freeze rate (NO_ACTION) by speed band", (FONT, 20))
+        .caption("Freeze rate (NO_ACTION) by speed band", (FONT, TITLE))
         .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(55)
-        .build_cartesian_2d(-0.3f64..3.3f64, -4f64..104f64)
+        .x_label_area_size(70)
+        .y_label_area_size(60)
+        .build_cartesian_2d(-0.4f64..3.4f64, -4f64..104f64)
         .map_err(e)?;
     chart
         .configure_mesh()
         .max_light_lines(0)
-        .x_labels(4)
-        .x_label_formatter(&|x| {
-            let i = x.round();
-            if (x - i).abs() < 1e-6 && (0.0..4.0).contains(&i) {
-                bands[i as usize].to_string()
-            } else {
-                String::new()
-            }
-        })
+        .disable_x_mesh()
+        .x_labels(0)
+        .y_labels(6)
         .y_label_formatter(&percent_label)
-        .x_desc("speed band (speed-sweeping families; models side by side)")
+        .x_desc("speed band (speed-sweeping families)")
         .y_desc("decisions that freeze (%)")
-        .label_style((FONT, 13))
-        .axis_desc_style((FONT, 14))
+        .label_style((FONT, TICK))
+        .axis_desc_style((FONT, AXIS))
         .draw()
         .map_err(e)?;
-    let series: Vec<_> = r
-        .analyses
-        .speed
-        .iter()
-        .filter(|s| s.model != "ALL")
-        .collect();
+    // The band names and their n under the axis, two lines each.
+    for (b, name) in BANDS.iter().enumerate() {
+        let (x, y) = chart.backend_coord(&(b as f64, -4.0));
+        let st = style(TICK, BLACK, HPos::Center, VPos::Top);
+        plot.draw(&Text::new(name.to_string(), (x, y + 6), st.clone()))
+            .map_err(e)?;
+        plot.draw(&Text::new(band_n[b].clone(), (x, y + 24), st))
+            .map_err(e)?;
+    }
     // Models side by side within each band, so equal rates (often 0 %) stay visible.
     let k = series.len().max(1) as f64;
     for (i, s) in series.iter().enumerate() {
         let c = color(i);
-        let dx = (i as f64 - (k - 1.0) / 2.0) * (0.5 / k).min(0.08);
-        let pts: Vec<(f64, f64)> = s
+        let dx = (i as f64 - (k - 1.0) / 2.0) * (0.6 / k).min(0.1);
+        let pts: Vec<(usize, f64, f64)> = s
             .freeze_rate_by_band
             .iter()
             .enumerate()
-            .filter_map(|(b, v)| v.map(|v| (b as f64 + dx, 100.0 * v)))
+            .filter_map(|(b, v)| v.map(|v| (b, b as f64 + dx, 100.0 * v)))
             .collect();
-        chart
-            .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
-            .map_err(e)?;
-        chart
-            .draw_series(pts.into_iter().map(|p| Circle::new(p, 4, c.filled())))
-            .map_err(e)?;
+        let line: Vec<(f64, f64)> = pts.iter().map(|p| (p.1, p.2)).collect();
+        match dash(i) {
+            (0, _) => chart
+                .draw_series(LineSeries::new(line, c.stroke_width(2)))
+                .map(|_| ())
+                .map_err(e)?,
+            (d, g) => chart
+                .draw_series(DashedLineSeries::new(line, d, g, c.stroke_width(2)))
+                .map(|_| ())
+                .map_err(e)?,
+        }
+        for &(b, x, _) in &pts {
+            if let Some(Some([lo, hi])) = s.freeze_rate_by_band_ci.get(b) {
+                let (a, z) = (
+                    chart.backend_coord(&(x, 100.0 * lo)),
+                    chart.backend_coord(&(x, 100.0 * hi)),
+                );
+                error_bar(&plot, a, z, c.mix(0.6).rgb_color())?;
+            }
+        }
+        for &(_, x, y) in &pts {
+            marker(&plot, i, chart.backend_coord(&(x, y)), 6)?;
+        }
     }
-    draw_legend(&legend_area, &legend_items)?;
+    draw_legend(&legend_area, &items)?;
     root.present().map_err(e)?;
     Ok(())
 }
+
+/// Pixel height of one bar of the per-family figure.
+const BAR_PX: u32 = 20;
 
 fn per_family<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> DrawResult {
     root.fill(&WHITE).map_err(e)?;
     let fams: Vec<&str> = r.dataset.families.iter().map(|s| s.as_str()).collect();
     let n = fams.len().max(1);
     let k = r.models.len().max(1);
-    let legend_items: Vec<(String, RGBColor)> = r
+    let items: Vec<(String, Key)> = r
         .models
         .iter()
         .enumerate()
-        .map(|(i, m)| (m.model.clone(), color(i)))
+        .map(|(i, m)| (m.model.clone(), Key::Swatch(color(i))))
         .collect();
-    let (plot, legend_area) = split_legend(root, &legend_items);
+    let (plot, legend_area) = split_legend(root, &items);
+    let names: Vec<String> = fams
+        .iter()
+        .enumerate()
+        .map(|(fi, f)| {
+            let counts = r
+                .models
+                .iter()
+                .map(|m| m.by_family.get(fi).map_or(0, |row| row.expected));
+            format!("{f} ({})", captions::n_text(counts))
+        })
+        .collect();
+    let longest = names.iter().map(|s| s.chars().count()).max().unwrap_or(0) as u32;
     let mut chart = ChartBuilder::on(&plot)
-        .caption("SAA per family", (FONT, 20))
+        .caption("SAA per family", (FONT, TITLE))
         .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(140)
-        // Room right of 100 % for the bars' labels.
-        .build_cartesian_2d(0f64..122f64, -0.5f64..(n as f64 - 0.5))
+        // Room right of 100 % for a bar's value label.
+        .margin_right(60)
+        .x_label_area_size(50)
+        .y_label_area_size(20 + longest * TICK * 62 / 100)
+        .build_cartesian_2d(0f64..100f64, -0.5f64..(n as f64 - 0.5))
         .map_err(e)?;
-    let names = fams.clone();
     chart
         .configure_mesh()
         .max_light_lines(0)
+        .x_labels(6)
         .y_labels(n + 1)
         .y_label_formatter(&|y| category_label(&names, *y))
         .disable_y_mesh()
-        .x_desc("SAA (%) — each bar labelled with its value and n (expected scenes)")
+        .x_desc("SAA (%), 95% Wilson intervals")
         .x_label_formatter(&percent_label)
-        .label_style((FONT, 12))
-        .axis_desc_style((FONT, 14))
+        .label_style((FONT, TICK))
+        .axis_desc_style((FONT, AXIS))
         .draw()
         .map_err(e)?;
-    let h = 0.8 / k as f64;
-    // Every bar is labelled "57% n=12", so a 0 % bar reads as zero, not as missing.
-    let font = ((h * 0.9 * 380.0 / n as f64) as u32).clamp(8, 12);
-    for (mi, m) in r.models.iter().enumerate() {
-        let labels: Vec<_> = m
-            .by_family
-            .iter()
-            .enumerate()
-            .filter(|(_, row)| row.expected > 0)
-            .map(|(fi, row)| {
-                let y0 = (n - 1 - fi) as f64 + 0.4 - (mi + 1) as f64 * h;
-                let v = row.saa.map_or(0.0, |v| 100.0 * v);
-                Text::new(
-                    format!("{v:.0}% n={}", row.expected),
-                    (v + 0.8, y0 + h * 0.9),
-                    (FONT, font).into_font().color(&color(mi)),
-                )
-            })
-            .collect();
-        chart.draw_series(labels).map_err(e)?;
-    }
+    let h = 0.84 / k as f64;
     for (mi, m) in r.models.iter().enumerate() {
         let c = color(mi);
-        let bars: Vec<_> = m
-            .by_family
-            .iter()
-            .enumerate()
-            .filter_map(|(fi, row)| {
-                let v = row.saa?;
-                let y0 = (n - 1 - fi) as f64 + 0.4 - (mi + 1) as f64 * h;
-                Some(Rectangle::new(
-                    [(0.0, y0), (100.0 * v, y0 + h * 0.9)],
-                    c.filled(),
-                ))
-            })
-            .collect();
-        chart.draw_series(bars).map_err(e)?;
+        for (fi, row) in m.by_family.iter().enumerate().take(n) {
+            if row.expected == 0 {
+                continue;
+            }
+            let y0 = (n - 1 - fi) as f64 + 0.42 - (mi + 1) as f64 * h;
+            let (y_top, y_bot, y_mid) = (y0 + h * 0.9, y0, y0 + h * 0.45);
+            let v = row.saa.map_or(0.0, |v| 100.0 * v);
+            // A 0 % bar is a stub a few pixels wide, so it reads as zero, not as missing.
+            let a = chart.backend_coord(&(0.0, y_top));
+            let b = chart.backend_coord(&(v, y_bot));
+            let b = (b.0.max(a.0 + 3), b.1);
+            plot.draw(&Rectangle::new([a, b], c.filled())).map_err(e)?;
+            let mut end = b.0;
+            if let Some([lo, hi]) = row.saa_ci {
+                let p = chart.backend_coord(&(100.0 * lo, y_mid));
+                let q = chart.backend_coord(&(100.0 * hi, y_mid));
+                error_bar(&plot, p, q, BLACK.mix(0.75).rgb_color())?;
+                end = end.max(q.0);
+            }
+            let yc = chart.backend_coord(&(0.0, y_mid)).1;
+            // Dark text: the bar's colour says the model, the label only the value.
+            boxed_label(
+                &plot,
+                &format!("{v:.0}%"),
+                (end + 6, yc),
+                RGBColor(40, 40, 40),
+            )?;
+        }
     }
-    draw_legend(&legend_area, &legend_items)?;
+    draw_legend(&legend_area, &items)?;
     root.present().map_err(e)?;
     Ok(())
 }
@@ -280,7 +419,7 @@ fn percent_rows_chart<'a, DB: DrawingBackend>(
     plot: &DrawingArea<DB, Shift>,
     caption: &str,
     names: &[String],
-    label_width: u32,
+    x_desc: &str,
 ) -> Result<
     ChartContext<
         'a,
@@ -289,23 +428,26 @@ fn percent_rows_chart<'a, DB: DrawingBackend>(
     >,
 > {
     let n = names.len().max(1);
+    let longest = names.iter().map(|s| s.chars().count()).max().unwrap_or(0) as u32;
     let mut chart = ChartBuilder::on(plot)
-        .caption(caption, (FONT, 20))
+        .caption(caption, (FONT, TITLE))
         .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(label_width)
+        .margin_right(110)
+        .x_label_area_size(50)
+        .y_label_area_size((20 + longest * TICK * 62 / 100).clamp(100, 480))
         .build_cartesian_2d(0f64..100f64, -0.5f64..(n as f64 - 0.5))
         .map_err(e)?;
     chart
         .configure_mesh()
         .max_light_lines(0)
+        .x_labels(6)
         .y_labels(n + 1)
         .y_label_formatter(&|y| category_label(names, *y))
         .disable_y_mesh()
-        .x_desc("decisions (%)")
+        .x_desc(x_desc)
         .x_label_formatter(&percent_label)
-        .label_style((FONT, 12))
-        .axis_desc_style((FONT, 14))
+        .label_style((FONT, TICK))
+        .axis_desc_style((FONT, AXIS))
         .draw()
         .map_err(e)?;
     Ok(chart)
@@ -313,78 +455,77 @@ fn percent_rows_chart<'a, DB: DrawingBackend>(
 
 fn safety_rules<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> DrawResult {
     root.fill(&WHITE).map_err(e)?;
-    let rows: Vec<_> = r.analyses.safety.iter().collect();
+    // One row per model; the pooled "ALL" breakdown mixes models and is left out.
+    let rows: Vec<_> = r.analyses.safety.iter().take(r.models.len()).collect();
     let n = rows.len().max(1);
     let names: Vec<String> = rows
         .iter()
-        .map(|s| format!("{} n={}", s.model, s.decisions))
+        .map(|s| format!("{} (n={})", s.model, s.decisions))
         .collect();
-    let legend_items: Vec<(String, RGBColor)> = SafetyRule::ALL
+    let items: Vec<(String, Key)> = SafetyRule::ALL
         .iter()
         .map(|r| {
             (
                 format!("{}: {}", r.as_str(), r.describe()),
-                color(r.index() + 3),
+                Key::Swatch(rule_color(*r)),
             )
         })
         .collect();
-    let (_, h) = root.dim_in_pixel();
-    let (plot, legend_area) = root.split_vertically(h as i32 - LEGEND_BELOW);
-    let mut chart = percent_rows_chart(
+    let (w, h) = root.dim_in_pixel();
+    let below = 12 + ROW * legend_rows(&items, w as i32, 20);
+    let (plot, legend_area) = root.split_vertically(h as i32 - below);
+    let chart = percent_rows_chart(
         &plot,
-        "Safety violations by first rule (% of decisions)",
+        "Unsafe decisions by first rule fired",
         &names,
-        140,
+        "decisions (%) where a safety rule fired, 95% Wilson interval of the total",
     )?;
     for (i, s) in rows.iter().enumerate() {
         let y = (n - 1 - i) as f64;
+        let d = s.decisions.max(1) as f64;
+        let mut before = 0u64;
+        for rule in SafetyRule::ALL {
+            let k = s.first_rule.get(rule);
+            if k > 0 {
+                let a = chart.backend_coord(&(100.0 * before as f64 / d, y + 0.32));
+                let b = chart.backend_coord(&(100.0 * (before + k) as f64 / d, y - 0.32));
+                plot.draw(&Rectangle::new([a, b], rule_color(rule).filled()))
+                    .map_err(e)?;
+            }
+            before += k;
+        }
+        let total = 100.0 * s.violations as f64 / d;
+        let mut end = chart.backend_coord(&(total, y)).0;
+        if let Some([lo, hi]) = crate::stats::wilson(s.violations, s.decisions) {
+            let p = chart.backend_coord(&(100.0 * lo, y));
+            let q = chart.backend_coord(&(100.0 * hi, y));
+            error_bar(&plot, p, q, BLACK)?;
+            end = end.max(q.0);
+        }
         let label = if s.decisions == 0 {
             "no decisions".to_string()
-        } else if s.violations == 0 {
-            "no violations".to_string()
         } else {
-            continue;
+            format!("{total:.0}% unsafe")
         };
-        chart
-            .draw_series(std::iter::once(Text::new(
-                label,
-                (1.0, y + 0.12),
-                (FONT, 12),
-            )))
-            .map_err(e)?;
+        boxed_label(
+            &plot,
+            &label,
+            (end + 6, chart.backend_coord(&(0.0, y)).1),
+            BLACK,
+        )?;
     }
-    for rule in SafetyRule::ALL {
-        let c = color(rule.index() + 3);
-        let bars: Vec<_> = rows
-            .iter()
-            .enumerate()
-            .filter(|(_, s)| s.decisions > 0)
-            .map(|(i, s)| {
-                let d = s.decisions as f64;
-                let before: u64 = SafetyRule::ALL[..rule.index()]
-                    .iter()
-                    .map(|r| s.first_rule.get(*r))
-                    .sum();
-                let x0 = 100.0 * before as f64 / d;
-                let x1 = x0 + 100.0 * s.first_rule.get(rule) as f64 / d;
-                let y = (n - 1 - i) as f64;
-                Rectangle::new([(x0, y - 0.35), (x1, y + 0.35)], c.filled())
-            })
-            .collect();
-        chart.draw_series(bars).map_err(e)?;
-    }
-    for (i, (label, c)) in legend_items.iter().enumerate() {
-        let x = 160 + 480 * (i as i32 % 2);
-        let y = 10 + 22 * (i as i32 / 2);
-        legend_area
-            .draw(&Rectangle::new([(x, y), (x + 14, y + 12)], c.filled()))
-            .map_err(e)?;
-        legend_area
-            .draw(&Text::new(label.clone(), (x + 20, y - 1), (FONT, 12)))
-            .map_err(e)?;
-    }
+    draw_legend_below(&legend_area, &items, 20)?;
     root.present().map_err(e)?;
     Ok(())
+}
+
+fn rule_color(r: SafetyRule) -> RGBColor {
+    [
+        RGBColor(127, 127, 127),
+        RGBColor(214, 39, 40),
+        RGBColor(148, 103, 189),
+        RGBColor(255, 127, 14),
+    ][r.index()]
 }
 
 /// Outcome segments of the `outcomes` figure: name, colour.
@@ -393,7 +534,7 @@ const OUTCOME_SEGMENTS: [(&str, RGBColor); 5] = [
     ("struck", RGBColor(214, 39, 40)),
     ("missed", RGBColor(255, 127, 14)),
     ("clear", RGBColor(120, 144, 156)),
-    ("not executed (R1)", RGBColor(215, 215, 215)),
+    ("not executed (R1)", RGBColor(200, 200, 200)),
 ];
 
 /// The `outcomes` figure's rows: per model its decisions, then per ground-truth action.
@@ -403,9 +544,9 @@ fn outcome_rows(x: &crate::execution::ExecutionReport) -> Vec<(String, [u64; 5])
     let mut rows = Vec::new();
     for m in &x.models {
         let n = |c: &Counts| seg(c).iter().sum::<u64>();
-        rows.push((format!("{} (all) n={}", m.model, n(&m.all)), seg(&m.all)));
+        rows.push((format!("{} (all, n={})", m.model, n(&m.all)), seg(&m.all)));
         for (gt, c) in &m.by_gt_action {
-            rows.push((format!("{}  gt {gt} n={}", m.model, n(c)), seg(c)));
+            rows.push((format!("{} gt {gt} (n={})", m.model, n(c)), seg(c)));
         }
     }
     rows
@@ -418,51 +559,40 @@ fn outcomes<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Report) -> Dr
     let rows = r.execution.as_ref().map(outcome_rows).unwrap_or_default();
     let n = rows.len().max(1);
     let names: Vec<String> = rows.iter().map(|(name, _)| name.clone()).collect();
-    let longest = names.iter().map(|s| s.chars().count()).max().unwrap_or(0);
-    let (_, h) = root.dim_in_pixel();
-    let (plot, legend_area) = root.split_vertically(h as i32 - 40);
-    let mut chart = percent_rows_chart(
+    let items: Vec<(String, Key)> = OUTCOME_SEGMENTS
+        .iter()
+        .map(|(l, c)| (l.to_string(), Key::Swatch(*c)))
+        .collect();
+    let (w, h) = root.dim_in_pixel();
+    let below = 12 + ROW * legend_rows(&items, w as i32, 20);
+    let (plot, legend_area) = root.split_vertically(h as i32 - below);
+    let chart = percent_rows_chart(
         &plot,
-        "Execution outcomes (% of decisions; per model and ground-truth action)",
+        "Execution outcomes per model and ground-truth action",
         &names,
-        (20 + longest * 7).clamp(140, 420) as u32,
+        "decisions (%)",
     )?;
     for (si, (_, c)) in OUTCOME_SEGMENTS.iter().enumerate() {
-        let bars: Vec<_> = rows
-            .iter()
-            .enumerate()
-            .filter_map(|(i, (_, counts))| {
-                let total: u64 = counts.iter().sum();
-                if total == 0 || counts[si] == 0 {
-                    return None;
-                }
-                let before: u64 = counts[..si].iter().sum();
-                let x0 = 100.0 * before as f64 / total as f64;
-                let x1 = x0 + 100.0 * counts[si] as f64 / total as f64;
-                let y = (n - 1 - i) as f64;
-                Some(Rectangle::new([(x0, y - 0.35), (x1, y + 0.35)], c.filled()))
-            })
-            .collect();
-        chart.draw_series(bars).map_err(e)?;
+        for (i, (_, counts)) in rows.iter().enumerate() {
+            let total: u64 = counts.iter().sum();
+            if total == 0 || counts[si] == 0 {
+                continue;
+            }
+            let before: u64 = counts[..si].iter().sum();
+            let x0 = 100.0 * before as f64 / total as f64;
+            let x1 = x0 + 100.0 * counts[si] as f64 / total as f64;
+            let y = (n - 1 - i) as f64;
+            let a = chart.backend_coord(&(x0, y + 0.35));
+            let b = chart.backend_coord(&(x1, y - 0.35));
+            plot.draw(&Rectangle::new([a, b], c.filled())).map_err(e)?;
+        }
     }
-    for (i, (label, c)) in OUTCOME_SEGMENTS.iter().enumerate() {
-        let x = 20 + 150 * i as i32;
-        legend_area
-            .draw(&Rectangle::new([(x, 10), (x + 14, 22)], c.filled()))
-            .map_err(e)?;
-        legend_area
-            .draw(&Text::new(label.to_string(), (x + 20, 9), (FONT, 12)))
-            .map_err(e)?;
-    }
+    draw_legend_below(&legend_area, &items, 20)?;
     root.present().map_err(e)?;
     Ok(())
 }
 
-/// Height of the legend strip under the safety-rule chart (two rows of two).
-const LEGEND_BELOW: i32 = 60;
-
-/// Tick label of a percentage axis: whole numbers ("10", not "10.0", which the bitmap
-/// font spaced as "10. 0").
+/// Tick label of a percentage axis: whole numbers ("10", not "10.0"), blank outside 0–100.
 fn percent_label(v: &f64) -> String {
     if (-1e-9..=100.0 + 1e-9).contains(v) {
         format!("{v:.0}")
@@ -471,25 +601,30 @@ fn percent_label(v: &f64) -> String {
     }
 }
 
-macro_rules! both {
-    ($dir:expr, $name:literal, $size:expr, $f:ident, $r:expr, $out:expr) => {{
-        let svg = $dir.join(concat!($name, ".svg"));
+/// Writes figure `$f` as `$name.svg`, `.png` and `.caption.txt` into `$dir`.
+macro_rules! figure {
+    ($dir:expr, $name:literal, $size:expr, $f:ident, $r:expr, $caption:expr, $out:expr) => {{
+        let (w, h) = $size;
         let mut text = String::new();
         {
-            let root = SVGBackend::with_string(&mut text, $size).into_drawing_area();
+            let root = SVGBackend::with_string(&mut text, (w, h)).into_drawing_area();
             $f(&root, $r)?;
         }
+        let svg = $dir.join(concat!($name, ".svg"));
         rh_contract::fsio::write_file(&svg, "a figure", text.as_bytes())?;
-        let png = $dir.join(concat!($name, ".png"));
-        let (w, h) = $size;
         let mut pixels = vec![0u8; w as usize * h as usize * 3];
         {
-            let root = BitMapBackend::with_buffer(&mut pixels, $size).into_drawing_area();
+            let bitmap = BitMapBackend::with_buffer(&mut pixels, (w, h));
+            let root = png_text::GlyphText::new(bitmap, epaint_default_fonts::HACK_REGULAR)
+                .into_drawing_area();
             $f(&root, $r)?;
         }
+        let png = $dir.join(concat!($name, ".png"));
         rh_contract::fsio::write_file(&png, "a figure", &png_bytes(&pixels, w, h)?)?;
-        $out.push(svg);
-        $out.push(png);
+        let txt = $dir.join(concat!($name, ".caption.txt"));
+        let caption = format!("{}\n", $caption);
+        rh_contract::fsio::write_file(&txt, "a figure caption", caption.as_bytes())?;
+        $out.extend([svg, png, txt]);
     }};
 }
 
@@ -503,24 +638,66 @@ fn png_bytes(pixels: &[u8], w: u32, h: u32) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// Writes every figure into `dir` (created if needed), each file whole or not at all
-/// (`rh_contract::fsio`); returns the files written.
+/// Writes every figure into `dir` (created if needed) as `NAME.svg`, `NAME.png` and
+/// `NAME.caption.txt`, each file whole or not at all (`rh_contract::fsio`); returns the
+/// files written.
 pub fn write_figures(r: &Report, dir: &Path) -> Result<Vec<std::path::PathBuf>> {
     register_font();
     std::fs::create_dir_all(dir)
         .map_err(|e| rh_contract::fsio::CannotWrite::new("the figures directory", dir, e))?;
     let mut out = Vec::new();
-    let fam_h = (140
-        + r.dataset.families.len().max(4) as u32 * (14 + 10 * r.models.len().clamp(1, 8) as u32))
-        .min(2400);
-    let safety_h = (160 + 40 * r.analyses.safety.len() as u32).max(320) + LEGEND_BELOW as u32;
-    both!(dir, "disposition", (640, 600), disposition, r, out);
-    both!(dir, "freeze_by_band", (900, 500), freeze_by_band, r, out);
-    both!(dir, "per_family", (1080, fam_h), per_family, r, out);
-    both!(dir, "safety_rules", (1000, safety_h), safety_rules, r, out);
+    let k = r.models.len().clamp(1, 10) as u32;
+    let fam_h = (130 + r.dataset.families.len().max(3) as u32 * (10 + BAR_PX * k)).clamp(360, 3000);
+    let rows_h = |rows: usize| (150 + 34 * rows as u32).max(300) + 70;
+    figure!(
+        dir,
+        "disposition",
+        (820, 600),
+        disposition,
+        r,
+        captions::disposition(r),
+        out
+    );
+    let cap = captions::freeze_by_band(r);
+    figure!(
+        dir,
+        "freeze_by_band",
+        (900, 540),
+        freeze_by_band,
+        r,
+        cap,
+        out
+    );
+    figure!(
+        dir,
+        "per_family",
+        (1000, fam_h),
+        per_family,
+        r,
+        captions::per_family(r),
+        out
+    );
+    let safety = (1000, rows_h(r.models.len()));
+    figure!(
+        dir,
+        "safety_rules",
+        safety,
+        safety_rules,
+        r,
+        captions::safety_rules(r),
+        out
+    );
     if let Some(x) = &r.execution {
-        let outcomes_h = (140 + 26 * outcome_rows(x).len() as u32).clamp(300, 2400);
-        both!(dir, "outcomes", (1000, outcomes_h), outcomes, r, out);
+        let size = (1000, rows_h(outcome_rows(x).len()).min(3000));
+        figure!(
+            dir,
+            "outcomes",
+            size,
+            outcomes,
+            r,
+            captions::outcomes(r),
+            out
+        );
     }
     Ok(out)
 }
@@ -533,60 +710,5 @@ fn category_label<S: AsRef<str>>(names: &[S], y: f64) -> String {
         names[names.len() - 1 - i as usize].as_ref().to_string()
     } else {
         String::new()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::baseline::{baseline_plan, majority_action, BaselineKind};
-    use crate::config::Config;
-    use crate::synthetic::{dataset_of, synth_rows};
-
-    #[test]
-    fn bars_carry_value_and_n_and_meshes_have_no_fine_grid() {
-        let ds = dataset_of(&synth_rows(80, 2));
-        let cfg = Config::default();
-        let maj = majority_action(&ds);
-        let mut text = String::new();
-        for s in ds.scenes.iter().filter(|s| s.valid) {
-            let plan = baseline_plan(BaselineKind::Oracle, s, maj, 0, &cfg);
-            text += &serde_json::json!({"scene_id": s.scene_id, "model": "oracle", "plan": plan})
-                .to_string();
-            // A model that never answers with a plan: SAA 0 % in every family.
-            text += &format!(
-                "\n{{\"scene_id\":\"{}\",\"model\":\"mute\",\"response\":\"no\"}}\n",
-                s.scene_id
-            );
-        }
-        let mut sc = crate::score::Scoring::new(&ds, &cfg);
-        sc.score_reader(std::io::Cursor::new(text.into_bytes()))
-            .unwrap();
-        let r = Report::build(&sc, "mem");
-        let dir = tempfile::tempdir().unwrap();
-        write_figures(&r, dir.path()).unwrap();
-        let svg = |name: &str| std::fs::read_to_string(dir.path().join(name)).unwrap();
-        let fam = svg("per_family.svg");
-        // One label per (model, family) bar; the mute model's 0 % bars say so.
-        let labels = fam.matches(" n=").count();
-        assert_eq!(labels, 2 * ds.families.len(), "{labels}");
-        assert!(fam.contains("0% n="), "a 0 % bar is labelled: {fam}");
-        assert!(svg("safety_rules.svg").contains("mute n="));
-        // Only the major mesh lines (plotters draws its fine "light" mesh, the 1 % graph
-        // paper, in black at opacity 0.1; the major lines at 0.2).
-        for f in [
-            "disposition",
-            "freeze_by_band",
-            "per_family",
-            "safety_rules",
-        ] {
-            let text = svg(&format!("{f}.svg"));
-            assert!(
-                text.contains("opacity=\"0.2\""),
-                "{f}: major mesh lines drawn"
-            );
-            assert!(!text.contains("opacity=\"0.1\""), "{f}: no fine mesh");
-        }
-        assert!(svg("disposition.svg").contains("oracle (n="));
     }
 }

@@ -4,8 +4,9 @@
 //! scripts/setup.sh) opens from file:// over the DevTools pipe: no console errors, one
 //! leaderboard row per model, sortable, a filter changes the number of listed scenes, a
 //! scene page's videos decode (readyState ≥ 2) and play in sync, and the planned-hands
-//! overlay is drawn. The screenshots in the README come from this test
-//! (`RH_UPDATE_SCREENSHOTS=1` writes them to docs/screenshots/).
+//! overlay is drawn; at 800 and 1400 px no page scrolls sideways and the counts of the
+//! board, its rows and the scene list agree. The screenshots in the README come from this
+//! test (`RH_UPDATE_SCREENSHOTS=1` writes them to docs/screenshots/).
 
 use rh_e2e::cdp::{chromium_path, Browser};
 use rh_e2e::run_ok;
@@ -304,12 +305,12 @@ fn html_site_opens_in_headless_chromium() {
     );
     assert!(dataset.join("README.md").exists());
 
-    // The scene list's colours have a legend: green is "no rule fired", not "correct".
+    // The scene list's colours have a legend: colour says correct, ⚠ says unsafe.
     b.goto(&url(&site, "scenes.html"));
     let legend = b.eval("document.getElementById('legend').textContent");
     let legend = legend.as_str().unwrap_or_default();
     assert!(
-        legend.contains("no safety rule fired") && legend.contains("not necessarily correct"),
+        legend.contains("correct (derived action = GT)") && legend.contains("a safety rule fired"),
         "{legend}"
     );
     // The leaderboard shows coverage and 95% intervals.
@@ -354,6 +355,17 @@ fn html_site_opens_in_headless_chromium() {
 
     let shots = Path::new(env!("CARGO_TARGET_TMPDIR")).join("screenshots");
     std::fs::create_dir_all(&shots).unwrap();
+    // At 800 and 1400 px: no page scrolls sideways and every count agrees.
+    for width in [800, 1400] {
+        let profile = tmp.path().join(format!("chromium-layout-{width}"));
+        let mut b = Browser::launch(&chromium, &profile, width, 2000);
+        layout_checks(&mut b, &site, width, scored, &scene, &shots);
+        assert!(
+            b.errors.is_empty(),
+            "{width} px: console errors: {:#?}",
+            b.errors
+        );
+    }
     std::fs::write(shots.join("leaderboard.png"), &shot_board).unwrap();
     std::fs::write(shots.join("scene.png"), &shot_scene).unwrap();
     std::fs::write(shots.join("leaderboard-execute-1400.png"), &shot_exec).unwrap();
@@ -364,6 +376,122 @@ fn html_site_opens_in_headless_chromium() {
         std::fs::write(docs.join("leaderboard.png"), &shot_board).unwrap();
         std::fs::write(docs.join("scene.png"), &shot_scene).unwrap();
     }
+}
+
+/// The pages at `width` px: nothing wider than the window, the counts of the board's note,
+/// its rows and the scene list the same (`scored`), the scene list's object names and
+/// thumbnails, the scene page's clock before Play and its previous / next links, and
+/// every header's definition link pointing at a definition. Screenshots go to `shots`.
+fn layout_checks(b: &mut Browser, site: &Path, width: u32, scored: u64, scene: &str, shots: &Path) {
+    let overflow = "[document.documentElement.scrollWidth, window.innerWidth]";
+    let fits = |b: &mut Browser, page: &str| {
+        let v = b.eval(overflow);
+        let (sw, iw) = (v[0].as_u64().unwrap(), v[1].as_u64().unwrap());
+        assert!(
+            sw <= iw,
+            "{page} at {width} px scrolls sideways: {sw} > {iw}"
+        );
+    };
+    b.goto(&url(site, "index.html"));
+    fits(b, "index.html");
+    let expected = b.eval("+document.getElementById('board-note').dataset.expected");
+    assert_eq!(
+        expected.as_u64(),
+        Some(scored),
+        "the board's note counts the scored scenes"
+    );
+    let note = b.eval("document.getElementById('board-note').textContent");
+    let note = note.as_str().unwrap_or_default().to_string();
+    assert!(note.contains(&format!("on {scored} scenes")), "{note}");
+    let answered = b.eval(
+        "[...document.querySelectorAll('#leaderboard tbody tr')].map(tr => tr.children[1].textContent.split('/')[1])",
+    );
+    for a in answered.as_array().unwrap() {
+        let n: u64 = a
+            .as_str()
+            .unwrap()
+            .trim_end_matches("incomplete")
+            .parse()
+            .unwrap();
+        assert_eq!(n, scored, "a row's expected scenes");
+    }
+    let defs = b.eval(
+        "[...document.querySelectorAll('#leaderboard a.def')].map(a => a.getAttribute('href')) \
+         .filter(h => !document.getElementById(h.slice(1)))",
+    );
+    assert_eq!(
+        defs.as_array().map(Vec::len),
+        Some(0),
+        "dangling definitions: {defs}"
+    );
+    let n_defs = b.eval("document.querySelectorAll('#leaderboard a.def').length");
+    assert!(
+        n_defs.as_u64().unwrap() >= 6,
+        "definition links in the headers"
+    );
+    let captions = b.eval("[...document.querySelectorAll('.figures figcaption .caption')].filter(c => c.textContent.length > 100).length");
+    assert_eq!(captions.as_u64(), Some(4), "every figure has its caption");
+    std::fs::write(shots.join(format!("board-{width}.png")), b.screenshot()).unwrap();
+
+    b.goto(&url(site, "scenes.html"));
+    fits(b, "scenes.html");
+    let total = b.eval("+document.getElementById('count').dataset.total");
+    assert_eq!(
+        total.as_u64(),
+        Some(scored),
+        "the scene list counts the scored scenes"
+    );
+    let listed = b.eval(
+        "[...document.querySelectorAll('#scene-list tbody tr')].map(tr => [tr.querySelector('small.sub') ? tr.querySelector('small.sub').textContent : '', \
+           !!tr.querySelector('td.thumb img')])",
+    );
+    for row in listed.as_array().unwrap() {
+        assert!(
+            !row[0].as_str().unwrap().is_empty(),
+            "an object name per scene: {listed}"
+        );
+        assert!(
+            row[1].as_bool().unwrap(),
+            "a thumbnail per scene (frames exist): {listed}"
+        );
+    }
+    let cells = b.eval("[document.querySelectorAll('td.dec.correct').length, document.querySelectorAll('td.dec.wrong').length]");
+    assert!(
+        cells[0].as_u64().unwrap() > 0 && cells[1].as_u64().unwrap() > 0,
+        "correct and wrong cells: {cells}"
+    );
+    let thumbs_shown = b.eval(
+        "[...document.querySelectorAll('td.thumb img')].filter(i => i.offsetWidth > 0).length",
+    );
+    if width >= 1400 {
+        assert!(
+            thumbs_shown.as_u64().unwrap() > 0,
+            "thumbnails shown at {width} px"
+        );
+    }
+    std::fs::write(shots.join(format!("scenes-{width}.png")), b.screenshot()).unwrap();
+
+    b.goto(&url(site, scene));
+    fits(b, scene);
+    let clock = b.eval("document.getElementById('clock').textContent");
+    assert!(
+        clock
+            .as_str()
+            .unwrap_or_default()
+            .starts_with("t = 0.000 s"),
+        "clock before Play: {clock}"
+    );
+    let links = b.eval(
+        "[!!document.getElementById('prev-scene') || !!document.querySelector('#prevnext .off'), \
+        !!document.getElementById('next-scene') || !!document.querySelector('#prevnext .off')]",
+    );
+    assert_eq!(links, serde_json::json!([true, true]), "previous / next");
+    let some_link = b.eval("document.querySelectorAll('#prev-scene, #next-scene').length");
+    assert!(
+        some_link.as_u64().unwrap() >= 1,
+        "a neighbour scene is linked"
+    );
+    std::fs::write(shots.join(format!("scene-{width}.png")), b.screenshot()).unwrap();
 }
 
 /// Rows of a dataset's `eval` config (pyarrow reads the Parquet footer).

@@ -53,40 +53,40 @@
         var a = el("a", { href: "scenes.html#model=" + encodeURIComponent(r.model) }, r.model);
         return el("span", null, el("i", { "class": "swatch", style: "background:" + color(i) }), a);
       }, sort: function (r) { return r.model; } },
-      { key: "decisions", label: "Answered", title: "expected scenes with a scored decision, of those expected",
+      { key: "decisions", label: "Answered", def: "coverage", title: "expected scenes with a scored decision, of those expected",
         fmt: function (r) {
           return el("span", { "class": r.complete ? "" : "incomplete" }, r.decisions + "/" + r.expected,
             r.complete ? null : el("small", { "class": "ci" }, "incomplete"));
         } },
-      { key: "unanswered", label: "Unans.", title: "expected scenes without a scored decision (lost or never asked): counted as failed, never as R1" },
-      { key: "lost", label: "Lost", title: "lost decisions (API errors): unanswered, never scored" },
-      { key: "saa", label: "SAA %", fmt: function (r) { return pctCi(r.saa, r.saa_ci); },
+      { key: "unanswered", label: "Unans.", opt: true, def: "coverage", title: "expected scenes without a scored decision (lost or never asked): counted as failed, never as R1" },
+      { key: "lost", label: "Lost", opt: true, def: "coverage", title: "lost decisions (API errors): unanswered, never scored" },
+      { key: "saa", label: "SAA %", def: "saa", fmt: function (r) { return pctCi(r.saa, r.saa_ci); },
         title: "derived action equals the ground truth, over the expected scenes (95% Wilson interval below)" },
-      { key: "balanced_accuracy", label: "Bal. acc %", fmt: function (r) { return pctCi(r.balanced_accuracy, r.balanced_accuracy_ci); },
+      { key: "balanced_accuracy", label: "Bal. acc %", def: "balanced", fmt: function (r) { return pctCi(r.balanced_accuracy, r.balanced_accuracy_ci); },
         title: "mean recall over CATCH, DODGE, NO_ACTION (95% bootstrap interval below)" },
-      { key: "safety", label: "Safety %", fmt: function (r) { return pctCi(r.safety, r.safety_ci); },
+      { key: "safety", label: "Safety %", def: "safety", fmt: function (r) { return pctCi(r.safety, r.safety_ci); },
         title: "no safety rule fired, over the expected scenes (95% Wilson interval below)" },
-      { key: "d_end_catch", label: "d_end CATCH (m)", f: function (x) { return num(x, 2); },
+      { key: "d_end_catch", label: "d_end CATCH (m)", def: "d_end", f: function (x) { return num(x, 2); },
         title: "final hands to impact point, over CATCH scenes (n in the next column)" },
-      { key: "d_end_catch_n", label: "n", title: "CATCH decisions with a d_end" },
-      { key: "aia", label: "AIA", f: function (x) { return num(x, 2); }, title: "action-intent alignment" },
-      { key: "hde_d_min_catch", label: "HDE d_min CATCH (m)", f: function (x) { return num(x, 2); },
+      { key: "d_end_catch_n", label: "n", opt: true, def: "d_end", title: "CATCH decisions with a d_end" },
+      { key: "aia", label: "AIA", def: "aia", f: function (x) { return num(x, 2); }, title: "action-intent alignment" },
+      { key: "hde_d_min_catch", label: "HDE d_min CATCH (m)", def: "hde", f: function (x) { return num(x, 2); },
         title: "hand-distance error: closest keyframe hands to impact point, CATCH scenes" },
-      { key: "hde_closing_catch", label: "HDE d₁−d_min (m)", f: function (x) { return num(x, 2); },
+      { key: "hde_closing_catch", label: "HDE d₁−d_min (m)", opt: true, def: "hde", f: function (x) { return num(x, 2); },
         title: "how far the hands close in after the first keyframe, CATCH scenes" }
     ];
     B.rules.forEach(function (rule, k) {
-      cols.push({ key: "r" + k, label: rule.id, title: "first rule " + rule.id + ": " + rule.text,
+      cols.push({ key: "r" + k, label: rule.id, opt: true, def: "safety", title: "first rule " + rule.id + ": " + rule.text,
         sort: function (r) { return r.first_rule[k]; }, fmt: function (r) { return String(r.first_rule[k]); } });
     });
-    if (pv) cols.push({ key: "prompt", label: "Prompt version", sort: function (r) { return r.prompt_versions.join(","); },
+    if (pv) cols.push({ key: "prompt", label: "Prompt version", opt: true, sort: function (r) { return r.prompt_versions.join(","); },
       fmt: function (r) { return r.prompt_versions.join(", ") || "—"; } });
     if (exec) {
       // --execute outcome rates (specification §12), present only when predictions were executed.
       var outcomes = {};
       rows.forEach(function (r) { Object.keys(r.execution || {}).forEach(function (k) { outcomes[k] = 1; }); });
       Object.keys(outcomes).sort().forEach(function (o) {
-        cols.push({ key: "x_" + o, label: o + " %", sort: function (r) { return r.execution ? r.execution[o] : null; },
+        cols.push({ key: "x_" + o, label: o + " %", opt: true, sort: function (r) { return r.execution ? r.execution[o] : null; },
           fmt: function (r) { return pct(r.execution ? r.execution[o] : null); } });
       });
     }
@@ -107,8 +107,10 @@
       thead.innerHTML = ""; tbody.innerHTML = "";
       var tr = el("tr");
       cols.forEach(function (c, ci) {
-        var th = el("th", { title: (c.title || c.label) + " (click to sort)", "data-col": c.key },
-          c.label + (ci === state.col ? (state.dir < 0 ? " ▼" : " ▲") : ""));
+        var th = el("th", { title: (c.title || c.label) + " (click to sort)", "data-col": c.key,
+          "class": c.opt ? "opt" : "" }, c.label + (ci === state.col ? (state.dir < 0 ? " ▼" : " ▲") : ""));
+        // The metric's definition, one click away.
+        if (c.def) th.appendChild(el("a", { "class": "def", href: "#def-" + c.def, title: "definition" }, "?"));
         th.addEventListener("click", function () {
           state.dir = state.col === ci ? -state.dir : (ci === 0 ? 1 : -1);
           state.col = ci;
@@ -121,18 +123,23 @@
         var r = rows[i], tr = el("tr", { "data-model": r.model });
         cols.forEach(function (c) {
           var v = c.fmt ? c.fmt(r, i) : (c.f ? c.f(r[c.key]) : String(r[c.key]));
-          tr.appendChild(el("td", null, v));
+          tr.appendChild(el("td", c.opt ? { "class": "opt" } : null, v));
         });
         tbody.appendChild(tr);
       });
     }
     draw();
     var C = B.coverage, incomplete = C.incomplete_models;
-    document.getElementById("board-note").textContent =
+    // Every count comes from the report: the scenes scored are its expected scenes (the
+    // dataset's valid scenes of its subset); `dataset.scenes` already excludes invalid ones.
+    var note = document.getElementById("board-note");
+    note.setAttribute("data-expected", String(C.expected_scenes));
+    note.textContent =
       rows.length + " model" + (rows.length === 1 ? "" : "s") + ", " + B.input.scored + " scored and " +
-      B.input.lost + " lost decisions from " + B.input.file + " on " + (B.dataset.scenes - B.dataset.invalid) +
-      " valid scenes (" + B.dataset.dir + "); rh-score " + B.version + ", action rule " + B.action_rule.version + ". " +
-      "Coverage: " + C.expected_scenes + " expected scenes per model (" + C.note + "); " +
+      B.input.lost + " lost decisions from " + B.input.file + " on " + C.expected_scenes + " scenes (" + C.note +
+      "; dataset " + B.dataset.dir + ": " + B.dataset.scenes + " valid scenes" +
+      (B.dataset.invalid ? ", " + B.dataset.invalid + " invalid, never scored" : "") + "); rh-score " + B.version +
+      ", action rule " + B.action_rule.version + ". Each model is scored on the same " + C.expected_scenes + " scenes; " +
       (C.answered_only ? "ANSWERED-ONLY VIEW: metrics over each model's answered scenes." :
         "metrics over the expected scenes, an unanswered scene counting as failed.") +
       (incomplete.length ? " Incomplete: " + incomplete.join(", ") + "." : "") +
@@ -141,7 +148,8 @@
       "d_end and HDE (hand-distance error: d_min, d₁−d_min over keyframes) are over CATCH scenes, where meeting " +
       "the object is the right action; the report (--markdown, --json) gives them per GT action, family and speed band. " +
       "R1–R4 count the first rule that fired: " + B.rules.map(function (r) { return r.id + " " + r.text; }).join("; ") + ". " +
-      "Intervals are 95%: Wilson for rates, seeded bootstrap over scenes for balanced accuracy.";
+      "Intervals are 95%: Wilson for rates, seeded bootstrap over scenes for balanced accuracy. " +
+      "In a narrow window the columns Unans., Lost, n, HDE d₁−d_min and R1–R4 are hidden. Every metric: Definitions below.";
   }
 
   // ---------------------------------------------------------------- scene browser
@@ -204,31 +212,44 @@
       var count = document.getElementById("count");
       count.textContent = list.length + " of " + X.scenes.length + " scenes";
       count.setAttribute("data-count", String(list.length));
+      count.setAttribute("data-total", String(X.scenes.length));
       var hash = Object.keys(f).filter(function (k) { return f[k]; })
         .map(function (k) { return k + "=" + encodeURIComponent(f[k]); });
       if (page > 0) hash.push("page=" + (page + 1));
       history.replaceState(null, "", hash.length ? "#" + hash.join("&") : location.pathname);
       var table = document.getElementById("scene-list");
       table.tHead.innerHTML = "";
-      var hr = el("tr", null, el("th", null, "scene"), el("th", null, "family"), el("th", null, "band"),
-        el("th", null, "GT"), el("th", null, "adv."));
+      var thumbs = (X.thumbs || []).length > 0;
+      var hr = el("tr", null, thumbs ? el("th", { "class": "thumb" }, "ego view") : null,
+        el("th", null, "scene · object"), el("th", null, "family · band"),
+        el("th", null, "GT"), el("th", { "class": "opt" }, "adv."));
       X.models.forEach(function (m, i) {
-        hr.appendChild(el("th", { title: m }, el("i", { "class": "swatch", style: "background:" + color(i) }), m));
+        hr.appendChild(el("th", { title: m, "class": "model" }, el("i", { "class": "swatch", style: "background:" + color(i) }), m));
       });
       table.tHead.appendChild(hr);
       var tbody = table.tBodies[0];
       tbody.innerHTML = "";
       list.slice(page * PAGE_SIZE, (page + 1) * PAGE_SIZE).forEach(function (s) {
+        var object = (X.objects || [])[s[6]] || "";
+        var thumb = s[7] != null && s[7] >= 0 ? "media/frames/" + s[0] + "/" + X.thumbs[s[7]] : null;
         var tr = el("tr", { "data-scene": s[0] },
-          el("td", null, el("a", { href: "scene.html#" + s[0] }, s[0])),
-          el("td", null, X.families[s[1]]), el("td", null, X.bands[s[2]] || "?"),
-          el("td", null, X.actions[s[3]]), el("td", null, s[4] ? "yes" : ""));
+          thumbs ? el("td", { "class": "thumb" }, thumb ? el("a", { href: "scene.html#" + s[0] },
+            el("img", { src: thumb, alt: object, loading: "lazy", width: "80", height: "45" })) : null) : null,
+          el("td", null, el("a", { href: "scene.html#" + s[0] }, s[0]), el("small", { "class": "sub" }, object)),
+          el("td", null, X.families[s[1]], el("small", { "class": "sub" }, X.bands[s[2]] || "?")),
+          el("td", null, X.actions[s[3]]), el("td", { "class": "opt" }, s[4] ? "yes" : ""));
         s[5].forEach(function (c, i) {
           var a = ACTION_CODES[c >> 4], bits = c & 15;
           var rules = X.rules.filter(function (r, k) { return bits & (1 << k); });
-          var cls = a === "none" ? "none" : a === "lost" ? "lost" : bits ? "unsafe" : "safe";
-          tr.appendChild(el("td", { "class": "dec " + cls, title: X.models[i] + ": " + a + (rules.length ? " (" + rules.join(", ") + ")" : "") },
-            SHORT[a] + (rules.length ? " " + rules.join(",") : "")));
+          // Colour says correct (derived action = GT) or wrong; the ⚠ mark says unsafe.
+          var answered = a !== "none" && a !== "lost";
+          var correct = answered && a === X.actions[s[3]];
+          var cls = !answered ? a : correct ? "correct" : "wrong";
+          var cell = el("td", { "class": "dec " + cls, title: X.models[i] + ": " + a + (answered ? (correct ? ", correct" : ", wrong") : "") +
+            (rules.length ? "; unsafe (" + rules.join(", ") + ")" : answered ? "; safe" : "") },
+            SHORT[a] + (answered ? (correct ? " ✓" : " ✗") : ""));
+          if (rules.length) cell.appendChild(el("span", { "class": "warn" }, " ⚠" + rules.join(",")));
+          tr.appendChild(cell);
         });
         tbody.appendChild(tr);
       });
@@ -302,9 +323,17 @@
     var now = null;
     traj.forEach(function (q) { if (q[0] <= time + 1e-6) now = q; });
     if (now) dotAt([now[1], now[2], now[3]], "#ffd400", 5 * s);
-    if (row.impact_point) dotAt(row.impact_point, "#ff2020", 9 * s, true);
+    // The impact point: a black-and-white target (no model's palette colour), so it never
+    // reads as a model's path.
+    if (row.impact_point) {
+      dotAt(row.impact_point, "#000000", 11 * s, true);
+      dotAt(row.impact_point, "#ffffff", 8 * s, true);
+    }
     var pose = row.observer_pose;
-    if (pose) path([[pose[0], pose[1], 0], [pose[0], pose[1], 1.32]], "rgba(255,255,255,0.9)", 3 * s);
+    if (pose) {
+      path([[pose[0], pose[1], 0], [pose[0], pose[1], 1.32]], "rgba(0,0,0,0.9)", 5 * s);
+      path([[pose[0], pose[1], 0], [pose[0], pose[1], 1.32]], "rgba(255,255,255,0.95)", 3 * s);
+    }
     var drawn = 0;
     S.models.forEach(function (m, i) {
       var d = m.decision;
@@ -327,6 +356,14 @@
     document.getElementById("scene-title").textContent =
       "Scene " + S.scene_id + ": " + row.family + ", " + row.speed_band + ", " + row.object_name;
     document.getElementById("scene-nav").textContent = row.description || "";
+    var pn = document.getElementById("prevnext");
+    if (pn) {
+      pn.appendChild(S.prev ? el("a", { href: "scene.html#" + S.prev, rel: "prev", id: "prev-scene" }, "◀ previous: " + S.prev)
+        : el("span", { "class": "off" }, "◀ first scene"));
+      pn.appendChild(el("a", { href: "scenes.html" }, "scene list"));
+      pn.appendChild(S.next ? el("a", { href: "scene.html#" + S.next, rel: "next", id: "next-scene" }, "next: " + S.next + " ▶")
+        : el("span", { "class": "off" }, "last scene ▶"));
+    }
     var cams = document.getElementById("cams");
     var videos = [], canvas = null, overheadCam = null;
     ["ego", "closeup", "overhead"].forEach(function (name) {
@@ -346,8 +383,9 @@
         stage.appendChild(canvas);
       }
       cams.appendChild(el("figure", null, stage, el("figcaption", null, name + (name === "overhead"
-        ? " + each model's planned hand path (its colour; ring: base at the end of the walk), hazard path (dashed), " +
-          "hazard now (yellow), impact point (red ring), observer (white bar)" : ""))));
+        ? " + each model's planned hand path (the model's colour, solid, dots at keyframes; ring: base at the end of " +
+          "the walk), hazard path (white dashed), hazard now (yellow dot), impact point (black-and-white target), " +
+          "observer (white bar)" : ""))));
     });
     var full = document.getElementById("full");
     if (S.media.full_event) {
@@ -361,12 +399,19 @@
     // The three observation videos play in sync, led by the first.
     var lead = videos[0], btn = document.getElementById("play"), scrub = document.getElementById("scrub");
     var clock = document.getElementById("clock");
+    var windowS = S.window_s != null ? Number(S.window_s) : null;
+    function showClock() {
+      var total = lead && lead.duration ? lead.duration : windowS;
+      clock.textContent = "t = " + time.toFixed(3) + " s" + (total ? " of " + Number(total).toFixed(2) + " s" : "");
+    }
+    showClock();
+    if (lead) lead.addEventListener("loadedmetadata", showClock);
     function tick() {
       if (!lead) return;
       time = lead.currentTime;
       videos.slice(1).forEach(function (v) { if (Math.abs(v.currentTime - time) > 0.03) v.currentTime = time; });
       if (lead.duration) scrub.value = String(Math.round(1000 * time / lead.duration));
-      clock.textContent = " t = " + time.toFixed(3) + " s";
+      showClock();
       redraw();
       if (!lead.paused) requestAnimationFrame(tick);
     }
@@ -437,11 +482,14 @@
       var cells;
       if (!d) cells = ["no prediction", "", "", "", "", "", "", "", ""];
       else if (d.status === "lost") cells = ["lost (API error)", "", "", "", "", "", "", "", d.prompt_version || ""];
-      else cells = [d.action || "R1 (no plan)", d.saa ? "✓" : "✗", d.rules.length ? d.rules.join(", ") : "safe",
+      else cells = [d.action || "R1 (no plan)", d.saa ? "✓" : "✗", d.rules.length ? "⚠ " + d.rules.join(", ") : "safe",
         d.intent || "", num(d.d_end, 2), num(d.d_min, 2), num(d.closing, 2), num(d.aia, 1), d.prompt_version || ""];
       if (!pv) cells = cells.slice(0, 8);
+      var answered = d && d.status !== "lost";
       cells.forEach(function (c, k) {
-        tr.appendChild(el("td", { "class": k === 3 && d && d.rules && d.rules.length ? "unsafe" : "" }, c));
+        var cls = k === 2 && d && d.rules && d.rules.length ? "unsafe"
+          : (k === 0 || k === 1) && answered ? (d.saa ? "correct" : "wrong") : "";
+        tr.appendChild(el("td", { "class": cls }, c));
       });
       if (exec) tr.appendChild(el("td", { "class": m.execution && m.execution.outcome === "struck" ? "unsafe" : "" },
         m.execution ? m.execution.outcome + (m.execution.struck_part ? " (" + m.execution.struck_part + ", " +
