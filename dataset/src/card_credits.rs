@@ -44,20 +44,23 @@ pub fn section(catalog: &Catalog, objects: &BTreeSet<String>) -> String {
     if list.is_empty() {
         return String::new();
     }
+    let objects_drawn = objects
+        .iter()
+        .filter(|id| {
+            catalog
+                .object(id)
+                .is_some_and(|o| rh_catalog::models::drawn_model(catalog, o).is_some())
+        })
+        .count();
+    let plural = |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
     let mut s = format!(
-        "**3D models.** {} catalog objects of this build are drawn with real meshes from \
-         Debian's asset packages (the colliders, and so the labels, are the catalog's \
-         primitive parts either way). The {} models used, with their creators and licences \
-         (CC-BY requires this attribution):\n\n| model | creator | licence | package | file |\n|---|---|---|---|---|\n",
-        objects
-            .iter()
-            .filter(|id| {
-                catalog
-                    .object(id)
-                    .is_some_and(|o| rh_catalog::models::drawn_model(catalog, o).is_some())
-            })
-            .count(),
-        list.len()
+        "**3D models.** {} of this build {} drawn with real meshes from Debian's asset \
+         packages (the colliders, and so the labels, are the catalog's primitive parts either \
+         way). The {} used, with their creators and licences (CC-BY requires this \
+         attribution):\n\n| model | creator | licence | package | file |\n|---|---|---|---|---|\n",
+        plural(objects_drawn, "catalog object", "catalog objects"),
+        if objects_drawn == 1 { "is" } else { "are" },
+        plural(list.len(), "model", "models"),
     );
     for c in &list {
         s.push_str(&format!(
