@@ -1119,3 +1119,75 @@ fn load_dir_on_a_missing_directory_names_the_path() {
     assert!(e.message.contains("cannot read"), "{e}");
     assert!(e.to_string().contains(&path), "{e}");
 }
+
+/// The embedded objects with one entry's model table edited by `edit`.
+fn with_model_edit(edit: impl Fn(&str) -> String) -> Result<Catalog, CatalogError> {
+    let objects = edit(OBJECTS_TOML);
+    assert_ne!(objects, OBJECTS_TOML, "the edit changed nothing");
+    Catalog::from_sources(("objects.toml", &objects), ("rooms.toml", ROOMS_TOML))
+}
+
+#[test]
+fn model_references_are_checked_and_adversarial_entries_take_their_look_alikes() {
+    let cat = catalog();
+    let hammer = obj(&cat, "hammer").model.clone().unwrap();
+    assert_eq!(hammer.package, "sweethome3d-furniture");
+    assert_eq!(hammer.sha256.len(), 64);
+    // An adversarial entry draws exactly its look-alike's model and names none itself.
+    let steel = obj(&cat, "steel_apple");
+    assert!(steel.model.is_none());
+    assert_eq!(
+        models::drawn_model(&cat, steel),
+        obj(&cat, "apple").model.as_ref()
+    );
+    let drawn = cat
+        .objects
+        .iter()
+        .filter(|o| models::drawn_model(&cat, o).is_some())
+        .count();
+    assert!(drawn >= 40, "{drawn}");
+    let short =
+        with_model_edit(|t| t.replacen(&hammer.sha256, &hammer.sha256[..60], 1)).unwrap_err();
+    assert_eq!(
+        (short.entry.as_deref(), short.field.as_deref()),
+        (Some("hammer"), Some("model.sha256")),
+        "{short}"
+    );
+    let licence = with_model_edit(|t| {
+        let at = t.find(&hammer.sha256).unwrap();
+        let end = at + t[at..].find("license = \"CC-BY-3.0\"").unwrap();
+        format!(
+            "{}license = \"proprietary\"{}",
+            &t[..end],
+            &t[end + "license = \"CC-BY-3.0\"".len()..]
+        )
+    })
+    .unwrap_err();
+    assert_eq!(licence.field.as_deref(), Some("model.license"), "{licence}");
+    let package = with_model_edit(|t| {
+        t.replacen(
+            "package = \"sweethome3d-furniture\"",
+            "package = \"no-such-package\"",
+            1,
+        )
+    })
+    .unwrap_err();
+    assert_eq!(package.field.as_deref(), Some("model.package"), "{package}");
+    // A model table on an adversarial entry is refused.
+    let adversarial = with_model_edit(|t| {
+        t.replacen(
+            "looks_like = \"apple\"\n",
+            &format!(
+                "looks_like = \"apple\"\n\n[objects.model]\npackage = \"sweethome3d-furniture\"\narchive = \"{}\"\npath = \"{}\"\nsha256 = \"{}\"\nname = \"x\"\ncreator = \"y\"\nlicense = \"CC0-1.0\"\n",
+                hammer.archive, hammer.path, hammer.sha256
+            ),
+            1,
+        )
+    })
+    .unwrap_err();
+    assert_eq!(
+        (adversarial.entry.as_deref(), adversarial.field.as_deref()),
+        (Some("steel_apple"), Some("model")),
+        "{adversarial}"
+    );
+}

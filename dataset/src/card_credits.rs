@@ -52,7 +52,8 @@ pub fn section(catalog: &Catalog, objects: &BTreeSet<String>) -> String {
                 .is_some_and(|o| rh_catalog::models::drawn_model(catalog, o).is_some())
         })
         .count();
-    let plural = |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+    let plural =
+        |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
     let mut s = format!(
         "**3D models.** {} of this build {} drawn with real meshes from Debian's asset \
          packages (the colliders, and so the labels, are the catalog's primitive parts either \

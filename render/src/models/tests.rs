@@ -1,3 +1,4 @@
+use super::fit::bounds_deviation;
 use super::*;
 use crate::models::obj::{MAT_TEXTURED, MAT_TEXTURED_GLOSSY};
 use rh_catalog::models::{ModelConfig, ModelRef};
@@ -152,10 +153,11 @@ fn the_bounds_check_refuses_a_model_whose_proportions_disagree_with_the_parts() 
             .0,
         0.0
     );
-    // Twice as tall as the parts want: z scaled 2^(-2/3) of the others' mean.
+    // Twice as tall as the parts want: axis scales 1, 1, 1/2, their mean 2^(-1/3), so z
+    // is off by 1 - 2^(-2/3) and x, y by 2^(1/3) - 1 (less).
     let (d, axis) = bounds_deviation([1.0, 1.0, 2.0], [1.0, 1.0, 1.0]).unwrap();
-    assert_eq!(axis, 0);
-    assert!((d - (2f64.powf(1.0 / 3.0) - 1.0)).abs() < 1e-9, "{d}");
+    assert_eq!(axis, 2);
+    assert!((d - (1.0 - 2f64.powf(-2.0 / 3.0))).abs() < 1e-9, "{d}");
     let dir = package_dir(BOX_OBJ);
     let m = load_model(&box_ref([0.0; 3]), "box", &config(dir.path())).unwrap();
     // A plate-shaped collider for a box standing 4:2:1: refused, naming the axis.
