@@ -12,6 +12,9 @@ apt_packages=(
   python3 python3-pip python3-venv
   chromium
   slurm-wlm munge
+  # Real meshes of catalog objects (issue 45): Sweet Home 3D's furniture libraries
+  # (OBJ/MTL models with textures, CC0 and CC-BY), read by rendered builds only.
+  sweethome3d-furniture
 )
 # Import names. The Python package's build and tests (scripts/test_python.sh) need
 # maturin, numpy, gymnasium and pytest; its wheel's own dependencies are numpy, pyarrow

@@ -4,6 +4,8 @@
 //! The catalog is embedded in the binaries, so a build needs no files at run time;
 //! `Catalog::load_dir` reads an edited copy instead.
 
+pub mod models;
+
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
@@ -146,6 +148,8 @@ struct RawObject {
     appearance: Appearance,
     #[serde(default)]
     looks_like: Option<String>,
+    #[serde(default)]
+    model: Option<models::ModelRef>,
 }
 
 /// A validated catalog object. `mass` and `density` are both resolved.
@@ -165,6 +169,8 @@ pub struct Object {
     pub parts: Vec<Part>,
     pub appearance: Appearance,
     pub looks_like: Option<String>,
+    /// The real mesh it is drawn with, if any (drawing only: the collider is `parts`).
+    pub model: Option<models::ModelRef>,
 }
 
 impl Object {
@@ -584,6 +590,9 @@ fn validate_objects(file: &str, raw: Vec<RawObject>) -> Result<Vec<Object>, Cata
         if let Some(c) = &o.appearance.secondary_color {
             check.color("appearance.secondary_color", c)?;
         }
+        if let Some(m) = &o.model {
+            models::check_model(&check, m, o.looks_like.is_some())?;
+        }
         objects.push(Object {
             id: o.id,
             name: o.name,
@@ -599,6 +608,7 @@ fn validate_objects(file: &str, raw: Vec<RawObject>) -> Result<Vec<Object>, Cata
             parts: o.parts,
             appearance: o.appearance,
             looks_like: o.looks_like,
+            model: o.model,
         });
     }
     check_look_alikes(file, &objects)?;

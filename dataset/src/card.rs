@@ -208,6 +208,8 @@ pub struct CardInput<'a> {
     pub data_files: &'a [String],
     /// Eval subset per-family counts, when this directory has the eval config.
     pub eval: Option<&'a BTreeMap<String, usize>>,
+    /// The credits of the 3D models drawn (`card_credits::section`; "" for none).
+    pub credits: &'a str,
 }
 
 /// The project's release, the paper's, and the release this build is (if one).
@@ -347,6 +349,10 @@ pub fn text(input: &CardInput) -> String {
         },
     );
 
+    if let (true, Some(note)) = (!input.credits.is_empty(), v.get_mut("render_note")) {
+        note.push_str("\n\n");
+        note.push_str(input.credits);
+    }
     v.insert("masks_note", masks_note(m.masks));
     v.insert("family_table", family_table(input, &counts, total_eval));
 

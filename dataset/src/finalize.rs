@@ -90,11 +90,19 @@ pub fn finalize(
     } else {
         None
     };
+    let credits = match (manifest.render, rh_catalog::Catalog::embedded()) {
+        (true, Ok(catalog)) => crate::card_credits::section(
+            &catalog,
+            &crate::card_credits::drawn_objects(out, &summary),
+        ),
+        _ => String::new(),
+    };
     let readme = card::text(&card::CardInput {
         manifest,
         rows: &summary,
         data_files: std::slice::from_ref(&data_file),
         eval: eval.as_ref(),
+        credits: &credits,
     });
     let path = out.join("README.md");
     table::write_atomic(&path, readme.as_bytes()).map_err(|e| internal(&path, e))?;

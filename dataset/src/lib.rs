@@ -22,6 +22,8 @@ pub mod camera_columns;
 #[cfg(feature = "write")]
 pub mod card;
 #[cfg(feature = "write")]
+pub mod card_credits;
+#[cfg(feature = "write")]
 pub mod card_teaser;
 #[cfg(feature = "write")]
 pub mod finalize;

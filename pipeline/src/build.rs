@@ -387,13 +387,17 @@ pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError
 /// Returns the banner to print and the adapter's record for `build.json`.
 type RenderCheck = Option<(String, rh_contract::adapter::RenderAdapter)>;
 
-fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<RenderCheck, BuildError> {
+fn check_render_stage(
+    opts: &BuildOptions,
+    catalog: &Catalog,
+    config: &Config,
+) -> Result<RenderCheck, BuildError> {
     if !opts.render {
         return Ok(None);
     }
     #[cfg(not(feature = "render"))]
     {
-        let _ = config;
+        let _ = (config, catalog);
         Err(BuildError::Input(
             "rendering was requested, but this rh-pipeline was built without the `render` \
              feature (cargo build --no-default-features): build with --no-render, or use a \
@@ -404,6 +408,11 @@ fn check_render_stage(opts: &BuildOptions, config: &Config) -> Result<RenderChec
     #[cfg(feature = "render")]
     {
         rh_render::memory::set_render_policy();
+        // Every model the catalog names: package installed, bytes as hashed, fits its parts.
+        rh_render::models::check_catalog(catalog, &config.render.models, |o| {
+            rh_scenes::families::object_parts(o)
+        })
+        .map_err(|e| BuildError::Input(format!("render stage: {e}")))?;
         let renderer =
             rh_render::Renderer::new(rh_render::RenderOptions::from_config(&config.render))
                 .map_err(|e| {
@@ -471,7 +480,7 @@ pub fn build(
     check_options(opts, catalog, config)?;
     // Fail before any work when there is nothing to render with; say what renders only
     // once there is something to render (not before "nothing to do").
-    let (render_banner, render_adapter) = check_render_stage(opts, config)?.unzip();
+    let (render_banner, render_adapter) = check_render_stage(opts, catalog, config)?.unzip();
     let mut manifest = Manifest::new(
         opts.seed,
         opts.n,

@@ -55,6 +55,7 @@ impl EgoCamera {
                 "ego camera image size {width}x{height}: each side must be 1..={MAX_SIDE} pixels"
             )));
         }
+        crate::models::set_config(&opts.models);
         Ok(EgoCamera {
             gpu: Gpu::new(opts.msaa, opts.msaa_cpu, opts.fxaa)?,
             width,

@@ -492,6 +492,14 @@ fn object_look_mesh(
     parts: &[rh_physics::spec::PartSpec],
 ) -> Option<Mesh> {
     let object = catalog.object(id)?;
+    // A real mesh where the catalog names one (loaded once per process; a rendered build
+    // checked every model before any work, so a failure here only reaches a caller that
+    // did not: it draws the recipe and says why).
+    match crate::models::drawn_mesh(catalog, object, parts, &crate::models::config()) {
+        Ok(Some(m)) => return Some(m),
+        Ok(None) => {}
+        Err(e) => crate::models::warn_once(&e),
+    }
     let source = catalog.appearance_source(object);
     let a = &source.appearance;
     let look = recipes::Look {

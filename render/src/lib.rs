@@ -27,6 +27,7 @@
 //! | `renderer` | [`Renderer`]: one scene's videos and frames, single frames, hazard masks |
 //! | `geometry` | the scene's meshes: static pieces, walls, moving bodies, ropes |
 //! | `recipes/` | how each catalog object looks (one table row per recipe) |
+//! | `models/` | real meshes of catalog objects: package archives, hash, OBJ/MTL, textures, triangle budget, fit onto the parts |
 //! | `observer` | the observer's humanoid mesh |
 //! | `lighting` | sun, ambient and the shadow map's projection |
 //! | `camera` | view-projection matrices (basis from `view::View`), full-event camera |
@@ -55,6 +56,7 @@ mod lighting;
 mod measure;
 pub mod memory;
 pub mod mesh;
+pub mod models;
 mod observer;
 pub mod recipes;
 mod regions;
@@ -108,6 +110,8 @@ pub struct RenderOptions {
     pub msaa_cpu: u32,
     /// FXAA-style post-process anti-aliasing wherever MSAA is off.
     pub fxaa: bool,
+    /// Real meshes of catalog objects (`[render.models]`).
+    pub models: rh_catalog::models::ModelConfig,
 }
 
 impl RenderOptions {
@@ -127,6 +131,7 @@ impl RenderOptions {
             msaa: c.msaa,
             msaa_cpu: c.msaa_cpu,
             fxaa: c.fxaa,
+            models: c.models.clone(),
         }
     }
 }
@@ -148,6 +153,7 @@ impl Default for RenderOptions {
             msaa: 4,
             msaa_cpu: 1,
             fxaa: true,
+            models: rh_catalog::models::ModelConfig::default(),
         }
     }
 }

@@ -201,7 +201,7 @@ fn kept_lines(faces: &[(usize, f32, Vec<Rgba>)], cells: [usize; 3], e: usize) ->
 pub type Paint<'a> = &'a dyn Fn(V3) -> Rgba;
 
 /// A mesh under construction; primitives are added in a local frame `xf`.
-#[derive(Default, Clone)]
+#[derive(Default, Clone, Debug)]
 pub struct Mesh {
     pub verts: Vec<Vertex>,
 }

@@ -62,6 +62,7 @@ impl Renderer {
     /// that FFmpeg has an H.264 encoder.
     pub fn new(opts: RenderOptions) -> Result<Renderer, RenderError> {
         encode::init().map_err(RenderError::Encode)?;
+        crate::models::set_config(&opts.models);
         let gpu = Gpu::new(opts.msaa, opts.msaa_cpu, opts.fxaa)?;
         Ok(Renderer {
             gpu,

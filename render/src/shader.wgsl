@@ -17,6 +17,9 @@ struct U {
 @group(0) @binding(0) var<uniform> u: U;
 @group(0) @binding(1) var shadow_tex: texture_depth_2d;
 @group(0) @binding(2) var shadow_smp: sampler_comparison;
+// Model textures (render/src/models): one image per layer.
+@group(0) @binding(3) var model_tex: texture_2d_array<f32>;
+@group(0) @binding(4) var model_smp: sampler;
 
 struct VIn {
     @location(0) pos: vec3<f32>,
@@ -108,7 +111,17 @@ fn shadow_factor(world: vec3<f32>, n: vec3<f32>, ndl: f32) -> f32 {
 @fragment
 fn fs_main(i: VOut) -> @location(0) vec4<f32> {
     var base = i.color.rgb;
-    let m = i.color.a;
+    var m = i.color.a;
+    // Textured model surfaces (codes 4, 5: plain, glossy): `color` carries the texture
+    // coordinates in rg and the array layer in b. Derivatives are taken for every
+    // fragment (uniform control flow), the level picked from them.
+    let duv_dx = dpdx(i.color.rg);
+    let duv_dy = dpdy(i.color.rg);
+    if (m > 3.5) {
+        let layer = i32(round(i.color.b));
+        base = textureSampleGrad(model_tex, model_smp, i.color.rg, layer, duv_dx, duv_dy).rgb;
+        m = select(0.0, 2.0, m > 4.5);
+    }
     if (u.ambient.w > 0.5 || m > 2.5) {
         return vec4<f32>(base, 1.0);
     }

@@ -221,6 +221,10 @@ pub struct RenderConfig {
     /// FXAA-style post-process anti-aliasing where MSAA is off (a CPU rasterizer).
     #[serde(default = "default_fxaa")]
     pub fxaa: bool,
+    /// Real meshes of catalog objects: triangle budget, bounds tolerance, textures,
+    /// package directory (`[render.models]`).
+    #[serde(default)]
+    pub models: rh_catalog::models::ModelConfig,
 }
 
 fn default_fxaa() -> bool {

@@ -4,10 +4,10 @@
 mod copy;
 mod readback;
 use readback::StaticImage;
-mod setup;
-
 mod ids;
 mod moving;
+mod setup;
+mod textures;
 
 use super::cells::{rect_area, rect_union, rects_meet};
 use super::mesh::Vertex;
@@ -119,6 +119,7 @@ pub struct Gpu {
     /// Shadow map of the fixed casters only (see [`Gpu::cache_static`]).
     static_shadow: wgpu::Texture,
     shadow_sampler: wgpu::Sampler,
+    model_textures: textures::ModelTextures,
     shadow_uniform: wgpu::Buffer,
     shadow_bind: wgpu::BindGroup,
     /// Post-process anti-aliasing (`crate::fxaa`) of lit frames: MSAA is off and it is
@@ -155,6 +156,7 @@ impl Gpu {
     /// same triangles in reverse order (`Gpu::reversed`, for the equal-depth re-shade).
     pub fn set_static(&mut self, verts: &[Vertex]) {
         debug_assert_eq!(verts.len() % 3, 0, "a triangle list");
+        self.model_textures.sync(&self.queue);
         self.ensure_capacity(std::mem::size_of_val(verts) as u64 * 3);
         self.queue
             .write_buffer(&self.vbuf, 0, bytemuck::cast_slice(verts));
@@ -192,6 +194,7 @@ impl Gpu {
                 self.vcap
             )));
         }
+        self.model_textures.sync(&self.queue);
         if !verts.is_empty() {
             self.queue.write_buffer(
                 &self.vbuf,
@@ -295,6 +298,14 @@ impl Gpu {
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: wgpu::BindingResource::Sampler(&self.shadow_sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&self.model_textures.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::Sampler(&self.model_textures.sampler),
                 },
             ],
         });

@@ -1,5 +1,6 @@
 //! Opening the GPU and building the render pipelines (`Gpu::new`).
 
+use super::textures;
 use super::*;
 use rh_contract::adapter::RenderAdapter;
 
@@ -146,6 +147,8 @@ fn bind_group_layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::Bi
                 ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
                 count: None,
             },
+            textures::layout_entries()[0],
+            textures::layout_entries()[1],
         ],
     });
     (shadow_bgl, main_bgl)
@@ -477,6 +480,7 @@ impl Gpu {
         });
         let vcap = 1 << 20;
         let vbuf = vertex_buffer(&device, vcap);
+        let model_textures = textures::ModelTextures::new(&device);
         Ok(Gpu {
             device,
             queue: shared.queue,
@@ -493,6 +497,7 @@ impl Gpu {
             shadow_view,
             static_shadow,
             shadow_sampler: shared.shadow_sampler,
+            model_textures,
             shadow_uniform,
             shadow_bind,
             fxaa: fxaa && shared.samples == 1,
