@@ -42,6 +42,7 @@
 
 mod camera;
 mod cells;
+mod decor;
 mod ego;
 pub mod encode;
 #[cfg(not(feature = "video"))]
