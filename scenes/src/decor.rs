@@ -8,7 +8,8 @@
 //! * the observer's free disc: `labels.escape_distance` (every escape walk the labels
 //!   consider) plus `[decor] observer_clearance_m` (the body's width and the arms'
 //!   reach to the side) around where the observer stands — also more than the reach
-//!   envelope's `labels.reach_radius`;
+//!   envelope's `labels.reach_radius` (a piece hung above the standing body's head, no
+//!   walk meets: there the reach radius plus `clearance_m` is kept clear);
 //! * every camera's line of sight to the hazard at every video frame (the segment from
 //!   the camera to the hazard's centre, widened by the hazard's bounding radius and
 //!   `clearance_m`), so decor never hides the hazard from the model or a validator.
@@ -58,6 +59,9 @@ impl Default for DecorConfig {
 
 /// How far a piece may reach into its wall (m): a window's or door's frame is set in it.
 const WALL_SLACK: f64 = 0.03;
+
+/// How far above the observer's head a piece hangs clear of every escape walk (m).
+const OVERHEAD_GAP: f64 = 0.1;
 
 /// An axis-aligned box, `[min, max]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -165,7 +169,14 @@ impl Keepout<'_> {
     fn clear(&self, b: &Aabb, collides: bool) -> bool {
         self.runs.iter().all(|(spec, sim)| {
             let o = &spec.observer;
-            (!collides || b.distance_xy(o.x, o.y) >= self.observer_radius)
+            // Above the standing body (a wall cabinet, a shelf) no escape walk meets a
+            // piece, only the hands could: there the reach envelope is kept clear.
+            let radius = if b.min[2] >= o.height + OVERHEAD_GAP {
+                spec.labels.reach_radius + self.clearance
+            } else {
+                self.observer_radius
+            };
+            (!collides || b.distance_xy(o.x, o.y) >= radius)
                 && self.bodies_clear(spec, sim, b)
                 && self.sight_clear(spec, sim, b)
         })
