@@ -232,3 +232,63 @@ fn validate_piece(file: &str, p: &DecorPiece) -> Result<(), CatalogError> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Catalog;
+
+    #[test]
+    fn every_room_type_lists_four_pieces_of_furniture_and_an_opening() {
+        let c = Catalog::embedded().unwrap();
+        for room in &c.rooms {
+            let pieces: Vec<_> = c.decor.for_room(&room.id).collect();
+            let furniture: std::collections::BTreeSet<_> = pieces
+                .iter()
+                .filter(|p| p.is_furniture())
+                .map(|p| p.id.as_str())
+                .collect();
+            assert!(furniture.len() >= 4, "{}: {furniture:?}", room.id);
+            assert!(
+                pieces.iter().any(|p| p.mount == Mount::Opening),
+                "{}",
+                room.id
+            );
+        }
+        // Windows and doors are drawn only; furniture collides.
+        assert!(!c.decor.piece("door").unwrap().collides());
+        assert!(c.decor.piece("sofa").unwrap().collides());
+        assert_eq!(
+            c.decor.piece("sofa").unwrap().footprint(),
+            [-0.95, 0.95, 0.85]
+        );
+    }
+
+    #[test]
+    fn a_bad_entry_is_named_with_its_field() {
+        let text = DECOR_TOML.replace("color = \"#e8e4dc\"", "color = \"beige\"");
+        let e = Decor::parse("decor.toml", &text, None).unwrap_err();
+        assert_eq!(e.entry.as_deref(), Some("kitchen_counter"));
+        assert_eq!(e.field.as_deref(), Some("parts[0].color"));
+        let text = DECOR_TOML.replace("\"tv_stand\", \"bookcase\"", "\"tv_stand\", \"piano\"");
+        let e = Decor::parse("decor.toml", &text, None).unwrap_err();
+        assert_eq!(
+            (e.entry.as_deref(), e.field.as_deref()),
+            (Some("living_room"), Some("pieces"))
+        );
+        assert!(e.message.contains("piano"), "{e}");
+        let e = Decor::parse("decor.toml", DECOR_TOML, Some(&["kitchen"])).unwrap_err();
+        assert_eq!(e.field.as_deref(), Some("room"), "{e}");
+    }
+
+    #[test]
+    fn stairs_alone_host_stair_tumble() {
+        let c = Catalog::embedded().unwrap();
+        let rooms: Vec<_> = c
+            .rooms_for_family("stair_tumble")
+            .map(|r| r.id.as_str())
+            .collect();
+        assert_eq!(rooms, ["hallway"]);
+        assert!(c.room("kitchen").unwrap().hosts("object_drop"));
+    }
+}
