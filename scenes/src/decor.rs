@@ -92,17 +92,6 @@ impl Aabb {
         let dy = (self.min[1] - y).max(y - self.max[1]).max(0.0);
         dx.hypot(dy)
     }
-    fn touches_sphere(&self, c: Vec3, r: f64) -> bool {
-        let d2: f64 = (0..3)
-            .map(|k| {
-                (self.min[k] - c[k])
-                    .max(c[k] - self.max[k])
-                    .max(0.0)
-                    .powi(2)
-            })
-            .sum();
-        d2 < r * r
-    }
     /// Whether the segment `a`–`b` passes through the box (slab test).
     fn cut_by(&self, a: Vec3, b: Vec3) -> bool {
         let (mut t0, mut t1) = (0.0f64, 1.0f64);
@@ -157,65 +146,93 @@ fn add(a: Vec3, b: Vec3) -> Vec3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
-/// What a group's event needs kept clear, over all its bands.
-struct Keepout<'a> {
-    runs: &'a [(SceneSpec, Simulation)],
+/// Steps per box of a moving body's swept space (its bounding spheres' box over them).
+const SWEEP_CHUNK: usize = 8;
+
+/// What a group's event needs kept clear, over all its bands, as boxes and segments.
+struct Keepout {
+    /// Every event body's parts at t0 and each moving body's swept space, widened by
+    /// the clearance.
+    taken: Vec<Aabb>,
+    /// Per band: the observer's position and height, and the reach radius.
+    observers: Vec<([f64; 2], f64, f64)>,
+    /// Every camera's sight line to the hazard at every video frame, and how far around
+    /// it to keep clear.
+    sight: Vec<(Vec3, Vec3, f64)>,
     clearance: f64,
     observer_radius: f64,
 }
 
-impl Keepout<'_> {
+impl Keepout {
+    fn of(runs: &[(SceneSpec, Simulation)], clearance: f64, observer_radius: f64) -> Keepout {
+        let mut k = Keepout {
+            taken: Vec::new(),
+            observers: Vec::new(),
+            sight: Vec::new(),
+            clearance,
+            observer_radius,
+        };
+        for (spec, sim) in runs {
+            let o = &spec.observer;
+            k.observers
+                .push(([o.x, o.y], o.height, spec.labels.reach_radius));
+            for body in spec.bodies.iter().filter(|b| b.role != BodyRole::Decor) {
+                k.taken.extend(
+                    body.parts
+                        .iter()
+                        .map(|p| part_box(p, body.position, body.rotation).grown(clearance)),
+                );
+            }
+            k.sweep(spec, sim);
+            let r = spec.bodies[spec.hazard].bounding_radius() + clearance;
+            let frames = (0..)
+                .map(|f| spec.frame_step(f))
+                .take_while(|&step| step <= sim.steps());
+            for step in frames {
+                let h = sim.hazard_com(step);
+                k.sight
+                    .extend(spec.cameras.iter().map(|c| (c.position, h, r)));
+            }
+        }
+        k
+    }
+
+    /// Each moving body's bounding spheres over the run, a box per `SWEEP_CHUNK` steps.
+    fn sweep(&mut self, spec: &SceneSpec, sim: &Simulation) {
+        let n = sim.dynamic_bodies.len();
+        let steps: Vec<usize> = (0..=sim.steps() as usize).collect();
+        for (slot, &bi) in sim.dynamic_bodies.iter().enumerate() {
+            let r = spec.bodies[bi].bounding_radius() + self.clearance;
+            for chunk in steps.chunks(SWEEP_CHUNK) {
+                let boxes = chunk.iter().map(|&step| {
+                    let c = sim.states[step * n + slot].position.map(f64::from);
+                    Aabb { min: c, max: c }.grown(r)
+                });
+                self.taken.extend(boxes.reduce(Aabb::union));
+            }
+        }
+    }
+
     /// Whether a piece occupying `b` (colliding or not) leaves the event alone.
     fn clear(&self, b: &Aabb, collides: bool) -> bool {
-        self.runs.iter().all(|(spec, sim)| {
-            let o = &spec.observer;
-            // Above the standing body (a wall cabinet, a shelf) no escape walk meets a
-            // piece, only the hands could: there the reach envelope is kept clear.
-            let radius = if b.min[2] >= o.height + OVERHEAD_GAP {
-                spec.labels.reach_radius + self.clearance
-            } else {
-                self.observer_radius
-            };
-            (!collides || b.distance_xy(o.x, o.y) >= radius)
-                && self.bodies_clear(spec, sim, b)
-                && self.sight_clear(spec, sim, b)
-        })
-    }
-
-    fn bodies_clear(&self, spec: &SceneSpec, sim: &Simulation, b: &Aabb) -> bool {
-        let grown = b.grown(self.clearance);
-        let at_rest = spec
-            .bodies
-            .iter()
-            .filter(|body| body.role != BodyRole::Decor)
-            .flat_map(|body| {
-                body.parts
-                    .iter()
-                    .map(|p| part_box(p, body.position, body.rotation))
-            });
-        if at_rest.into_iter().any(|p| p.overlaps(&grown)) {
-            return false;
-        }
-        let n = sim.dynamic_bodies.len();
-        sim.dynamic_bodies.iter().enumerate().all(|(slot, &bi)| {
-            let r = spec.bodies[bi].bounding_radius() + self.clearance;
-            (0..=sim.steps()).all(|step| {
-                let s = &sim.states[step as usize * n + slot];
-                !b.touches_sphere(s.position.map(f64::from), r)
+        let observers_clear = || {
+            self.observers.iter().all(|&([x, y], height, reach)| {
+                // Above the standing body (a wall cabinet, a shelf) no escape walk meets a
+                // piece, only the hands could: there the reach envelope is kept clear.
+                let radius = if b.min[2] >= height + OVERHEAD_GAP {
+                    reach + self.clearance
+                } else {
+                    self.observer_radius
+                };
+                b.distance_xy(x, y) >= radius
             })
-        })
-    }
-
-    fn sight_clear(&self, spec: &SceneSpec, sim: &Simulation, b: &Aabb) -> bool {
-        let r = spec.bodies[spec.hazard].bounding_radius() + self.clearance;
-        let grown = b.grown(r);
-        let frames = (0..)
-            .map(|f| spec.frame_step(f))
-            .take_while(|&step| step <= sim.steps());
-        frames.into_iter().all(|step| {
-            let h = sim.hazard_com(step);
-            spec.cameras.iter().all(|c| !grown.cut_by(c.position, h))
-        })
+        };
+        (!collides || observers_clear())
+            && self.taken.iter().all(|t| !t.overlaps(b))
+            && self
+                .sight
+                .iter()
+                .all(|&(eye, at, r)| !b.grown(r).cut_by(eye, at))
     }
 }
 
@@ -312,11 +329,8 @@ pub fn furnish(runs: &mut [(SceneSpec, Simulation)], catalog: &Catalog, config: 
     for i in (1..pieces.len()).rev() {
         pieces.swap(i, rng.random_range(0..=i));
     }
-    let keepout = Keepout {
-        runs,
-        clearance: cfg.clearance_m,
-        observer_radius: first.labels.escape_distance + cfg.observer_clearance_m,
-    };
+    let observer_radius = first.labels.escape_distance + cfg.observer_clearance_m;
+    let keepout = Keepout::of(runs, cfg.clearance_m, observer_radius);
     let mut placed: Vec<(BodySpec, Aabb)> = Vec::new();
     for (index, piece) in pieces.into_iter().enumerate() {
         let [x0, x1, _] = piece.footprint();
