@@ -11,6 +11,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 use std::path::Path;
 
+pub mod decor;
+pub use decor::Decor;
+
 /// The seventeen event families (specification §4), in their canonical order (the data contract's).
 pub use rh_contract::FAMILIES;
 
@@ -219,6 +222,8 @@ struct RawRoom {
     floor_color: String,
     #[serde(default)]
     families: Vec<String>,
+    #[serde(default)]
+    stairs: bool,
 }
 
 /// A validated room.
@@ -239,13 +244,19 @@ pub struct Room {
     pub shelf_height: [f64; 2],
     pub wall_color: String,
     pub floor_color: String,
-    /// Families this room hosts; empty means all.
+    /// Families this room hosts; empty means all (but `stair_tumble` only where `stairs`).
     pub families: Vec<String>,
+    /// Whether the room has a staircase (the only rooms `stair_tumble` happens in).
+    pub stairs: bool,
 }
+
+/// The family that needs a room with stairs (`Room::stairs`).
+pub const STAIRS_FAMILY: &str = "stair_tumble";
 
 impl Room {
     pub fn hosts(&self, family: &str) -> bool {
-        self.families.is_empty() || self.families.iter().any(|f| f == family)
+        (self.families.is_empty() || self.families.iter().any(|f| f == family))
+            && (family != STAIRS_FAMILY || self.stairs)
     }
 }
 
@@ -266,6 +277,8 @@ struct RoomsFile {
 pub struct Catalog {
     pub objects: Vec<Object>,
     pub rooms: Vec<Room>,
+    /// What furnishes each room type (`decor.toml`).
+    pub decor: Decor,
     object_index: BTreeMap<String, usize>,
     room_index: BTreeMap<String, usize>,
 }
@@ -294,7 +307,20 @@ impl Catalog {
         };
         let (objects_name, objects) = read("objects.toml")?;
         let (rooms_name, rooms) = read("rooms.toml")?;
-        Catalog::from_sources((&objects_name, &objects), (&rooms_name, &rooms))
+        let mut catalog = Catalog::from_sources((&objects_name, &objects), (&rooms_name, &rooms))?;
+        // A directory without its own decor.toml furnishes its rooms with the embedded one
+        // (rooms it does not list stay bare).
+        if dir.join("decor.toml").exists() {
+            let (decor_name, decor) = read("decor.toml")?;
+            catalog.decor = catalog.decor_from(&decor_name, &decor)?;
+        }
+        Ok(catalog)
+    }
+
+    /// Parses `decor.toml` text against this catalog's rooms.
+    pub fn decor_from(&self, file: &str, text: &str) -> Result<Decor, CatalogError> {
+        let ids: Vec<&str> = self.rooms.iter().map(|r| r.id.as_str()).collect();
+        Decor::parse(file, text, Some(&ids))
     }
 
     /// Parses and validates catalog text; `(file name, text)` pairs name the sources in errors.
@@ -317,12 +343,19 @@ impl Catalog {
             .enumerate()
             .map(|(i, r)| (r.id.clone(), i))
             .collect();
-        Ok(Catalog {
+        let mut catalog = Catalog {
             objects,
             rooms,
+            decor: Decor::default(),
             object_index,
             room_index,
-        })
+        };
+        // The embedded decor, for the rooms of these sources it lists.
+        let ids: Vec<&str> = catalog.rooms.iter().map(|r| r.id.as_str()).collect();
+        let mut decor = Decor::parse("catalog/data/decor.toml", decor::DECOR_TOML, None)?;
+        decor.rooms.retain(|room, _| ids.contains(&room.as_str()));
+        catalog.decor = decor;
+        Ok(catalog)
     }
 
     pub fn object(&self, id: &str) -> Option<&Object> {
@@ -739,6 +772,7 @@ fn validate_rooms(file: &str, raw: Vec<RawRoom>) -> Result<Vec<Room>, CatalogErr
             wall_color: r.wall_color,
             floor_color: r.floor_color,
             families: r.families,
+            stairs: r.stairs,
         });
     }
     if rooms.is_empty() {

@@ -13,11 +13,13 @@ pub struct Obstacles {
 }
 
 impl Obstacles {
+    /// The spec's fixed bodies but its decor: decor is placed clear of every camera's
+    /// sight line to the hazard (`rh_scenes::decor`), so it never blocks these queries.
     pub fn of(spec: &SceneSpec) -> Obstacles {
         let parts = spec
             .bodies
             .iter()
-            .filter(|b| b.kind == BodyKind::Fixed)
+            .filter(|b| b.kind == BodyKind::Fixed && b.role != crate::spec::BodyRole::Decor)
             .flat_map(|b| {
                 let body_pose = Pose::from_parts(v3(b.position), rot(b.rotation));
                 posed_parts(&b.parts)

@@ -126,6 +126,10 @@ pub enum BodyRole {
     Support,
     /// Other moving objects (triggers, neighbours in a row).
     Prop,
+    /// Furniture, fixtures, windows and doors that furnish the room (specification §3,
+    /// "Decor"): fixed, placed clear of the event; `catalog_id` names the decor piece.
+    /// A decor body without parts (a window, a door in the wall plane) is drawn only.
+    Decor,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -141,6 +141,12 @@ fn insert_bodies(
                 .can_sleep(false),
         }
         .pose(Pose::from_parts(v3(b.position), rot(b.rotation)));
+        if b.parts.is_empty() {
+            // Drawn only (a window, a door in the wall plane: decor without a collider).
+            body_handles.push(world.bodies.insert(builder));
+            collider_handles.push(ColliderHandle::invalid());
+            continue;
+        }
         let mut collider = collider_for(&b.parts)
             .friction(b.friction as Real)
             .restitution(b.restitution as Real)

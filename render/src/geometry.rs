@@ -163,11 +163,11 @@ impl SceneGeometry {
             .enumerate()
             .filter(|(_, b)| b.kind == BodyKind::Fixed)
         {
-            let mesh = match body
-                .catalog_id
-                .as_deref()
-                .and_then(|id| object_look_mesh(catalog, id, &body.parts))
-            {
+            let look = || {
+                let id = body.catalog_id.as_deref()?;
+                object_look_mesh(catalog, id, &body.parts)
+            };
+            let mesh = match crate::decor::decor_mesh(catalog, body).or_else(look) {
                 Some(m) => m,
                 None => {
                     let mut m = Mesh::new();
@@ -181,6 +181,10 @@ impl SceneGeometry {
             fixed_ids.push((from as u32..statics.len() as u32, instance::body(bi)));
             pieces.extend(piece(&statics, from));
         }
+        // Render-only scenery (brackets, hooks, a lit burner): drawn with the fixed bodies.
+        let from = statics.len();
+        crate::decor::scenery(spec).transformed_into(&Xf::ID, &mut statics);
+        pieces.extend(piece(&statics, from));
         let fixed = 0..statics.len() as u32;
         let o = &spec.observer;
         let (obody, ohead) = observer_mesh(o.height, o.pelvis_z, o.shoulder_z);

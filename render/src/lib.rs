@@ -43,6 +43,7 @@
 
 mod camera;
 mod cells;
+mod decor;
 mod ego;
 pub mod encode;
 #[cfg(not(feature = "video"))]

@@ -18,8 +18,8 @@ pub(super) struct Lighting {
     /// The same in the sun's clip space (x and y alike): how far from a caster's
     /// footprint in the shadow map a point's shading may depend on it: the lookup point's
     /// largest normal offset (`SHADOW_NORMAL_OFFSET` + `SHADOW_SLOPE_OFFSET` texels, at
-    /// most that far along either clip axis), and the four bilinear taps, which read
-    /// texels whose centres lie within 1.5 texels of it on each axis; half a texel spare
+    /// most that far along either clip axis), and the 3×3 bilinear taps, which read
+    /// texels whose centres lie within 2 texels of it on each axis; half a texel spare
     /// for rounding (`tiles::SurfaceTiles`).
     pub shadow_reach_light: f64,
 }
@@ -49,7 +49,7 @@ impl Lighting {
         // The light matrix scales x and y by 1 / light_radius: a texel is 2 / SHADOW_SIZE.
         let texel_clip = 2.0 / gpu::SHADOW_SIZE as f64;
         let shadow_reach_light =
-            (SHADOW_NORMAL_OFFSET + SHADOW_SLOPE_OFFSET * texel) / light_radius + 2.0 * texel_clip;
+            (SHADOW_NORMAL_OFFSET + SHADOW_SLOPE_OFFSET * texel) / light_radius + 2.5 * texel_clip;
         Lighting {
             light_vp,
             sun_dir: [dir[0] as f32, dir[1] as f32, dir[2] as f32, 0.0],
@@ -117,7 +117,7 @@ const SHADOW_NORMAL_OFFSET: f64 = 0.025;
 /// The shader's largest slope-scaled extra normal offset, in shadow-map texels (on
 /// surfaces the light grazes).
 const SHADOW_SLOPE_OFFSET: f64 = 2.5;
-/// How far (texels) the shader's filter reads from the lookup point: four bilinear
-/// taps half a texel off diagonally each read one more texel: 1.5 texels per axis,
-/// 1.5·√2 along the diagonal, which 2.5 bounds.
-const SHADOW_PCF_TEXELS: f64 = 2.5;
+/// How far (texels) the shader's filter reads from the lookup point: a 3×3 grid of
+/// bilinear taps one texel apart, each reading one more texel: 2 texels per axis,
+/// 2·√2 along the diagonal, which 3 bounds.
+const SHADOW_PCF_TEXELS: f64 = 3.0;

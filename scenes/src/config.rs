@@ -273,6 +273,8 @@ struct RawConfig {
     eval: crate::eval_subset::EvalConfig,
     #[serde(default)]
     probes: ProbeConfig,
+    #[serde(default)]
+    decor: crate::decor::DecorConfig,
 }
 
 /// The whole, validated build configuration (`Deserialize` reads back the copy a build
@@ -297,6 +299,9 @@ pub struct Config {
     /// Adversarial probe pairs and their twins (absent in manifests of older builds: none).
     #[serde(default)]
     pub probes: ProbeConfig,
+    /// How rooms are furnished (`decor`; absent in manifests of older builds: bare rooms).
+    #[serde(default)]
+    pub decor: crate::decor::DecorConfig,
     /// Set by the driver for the groups of an adversarial probe pair (`twins`): their
     /// intent (`intent::Intent::for_object`) is this catalog object's, the pair's benign
     /// member, whichever object they show. Not part of any file.
@@ -352,6 +357,7 @@ impl Config {
             aim: raw.aim,
             eval: raw.eval,
             probes: raw.probes,
+            decor: raw.decor,
             aimed_as: None,
             pushed_as: None,
             source: name.to_string(),

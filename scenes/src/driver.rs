@@ -298,23 +298,30 @@ fn needs_aim(spec: &SceneSpec, config: &Config) -> bool {
 }
 
 /// Frames one set of cameras for a group's bands and labels and validates each band.
-fn label_group(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> Vec<SceneResult> {
-    framed_group(runs, config)
+fn label_group(
+    runs: Vec<(SceneSpec, Simulation)>,
+    catalog: &Catalog,
+    config: &Config,
+) -> Vec<SceneResult> {
+    framed_group(runs, catalog, config)
         .map(|(spec, sim)| label_scene(spec, sim, config))
         .collect()
 }
 
-/// A group's bands with one set of cameras framed for all of them.
+/// A group's bands with one set of cameras framed for all of them, then the room
+/// furnished clear of the event and of those cameras' sight of it (`decor::furnish`).
 fn framed_group(
-    runs: Vec<(SceneSpec, Simulation)>,
+    mut runs: Vec<(SceneSpec, Simulation)>,
+    catalog: &Catalog,
     config: &Config,
 ) -> impl Iterator<Item = (SceneSpec, Simulation)> {
     let bands: Vec<(&SceneSpec, &Simulation)> = runs.iter().map(|(s, m)| (s, m)).collect();
     let framed = cameras::frame_group(&bands, &config.validators.framing()).unwrap_or_default();
-    runs.into_iter().map(move |(mut spec, sim)| {
+    for (spec, _) in runs.iter_mut() {
         spec.cameras = framed.clone();
-        (spec, sim)
-    })
+    }
+    crate::decor::furnish(&mut runs, catalog, config);
+    runs.into_iter()
 }
 
 /// Simulates one spec (plain and counterfactual), frames its cameras (as a group of
@@ -388,6 +395,7 @@ fn hazard_trajectory(spec: &SceneSpec, sim: &Simulation) -> Vec<[f32; 4]> {
 fn label_aimed(
     runs: Vec<(SceneSpec, Simulation)>,
     aims: Vec<crate::aim::Aim>,
+    catalog: &Catalog,
     config: &Config,
     last: bool,
 ) -> Vec<SceneResult> {
@@ -396,12 +404,12 @@ fn label_aimed(
         let mut posed = runs.clone();
         crate::aim::apply(&mut posed, &aim);
         if !debug {
-            match label_group_if_valid(posed, config) {
+            match label_group_if_valid(posed, catalog, config) {
                 Some(results) => return results,
                 None => continue,
             }
         }
-        let results = label_group(posed, config);
+        let results = label_group(posed, catalog, config);
         if results.iter().all(|r| r.verdicts.all()) {
             return results;
         }
@@ -412,9 +420,9 @@ fn label_aimed(
         );
     }
     if last {
-        label_group(runs, config)
+        label_group(runs, catalog, config)
     } else {
-        label_group_counting(runs, config)
+        label_group_counting(runs, catalog, config)
     }
 }
 
@@ -426,9 +434,13 @@ fn label_aimed(
 /// would say, so their verdicts stay `true` (and `Rejections` does not count them) and
 /// its labels are the plain run's (no strike); an attempt that passes them all gets
 /// `label_group`'s results.
-fn label_group_counting(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> Vec<SceneResult> {
+fn label_group_counting(
+    runs: Vec<(SceneSpec, Simulation)>,
+    catalog: &Catalog,
+    config: &Config,
+) -> Vec<SceneResult> {
     let mut checked = Vec::with_capacity(runs.len());
-    for (spec, sim) in framed_group(runs, config) {
+    for (spec, sim) in framed_group(runs, catalog, config) {
         let family =
             families::get(&spec.family).expect("randomize only emits implemented families");
         let verdicts = crate::validate::unlabelled(&spec, &sim, family, &config.validators);
@@ -467,10 +479,11 @@ fn label_group_counting(runs: Vec<(SceneSpec, Simulation)>, config: &Config) -> 
 /// verdict true); only a rejected pose costs less.
 fn label_group_if_valid(
     runs: Vec<(SceneSpec, Simulation)>,
+    catalog: &Catalog,
     config: &Config,
 ) -> Option<Vec<SceneResult>> {
     let mut framed_runs = Vec::with_capacity(runs.len());
-    for (spec, sim) in framed_group(runs, config) {
+    for (spec, sim) in framed_group(runs, catalog, config) {
         let family =
             families::get(&spec.family).expect("randomize only emits implemented families");
         let verdicts = crate::validate::unlabelled(&spec, &sim, family, &config.validators);
@@ -702,7 +715,7 @@ fn produce_attempts(
             continue;
         }
         let last = attempt + 1 == config.validators.max_attempts;
-        results = label_aimed(runs, aims, config, last);
+        results = label_aimed(runs, aims, catalog, config, last);
         if results.iter().all(|r| r.verdicts.all()) {
             break;
         }

@@ -16,6 +16,7 @@ pub mod balance;
 pub mod cameras;
 pub mod config;
 pub mod counterfactual;
+pub mod decor;
 pub mod driver;
 pub mod ego;
 pub mod eval_subset;
