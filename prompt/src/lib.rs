@@ -12,5 +12,5 @@ pub mod messages;
 mod scenes;
 
 pub use config::{canonical_generation, Generation, PromptConfig};
-pub use messages::{canonical, prompt_hash, BuiltPrompt, UserPart};
+pub use messages::{canonical, prompt_hash, BuiltPrompt, PromptError, UserPart};
 pub use scenes::select_scenes;

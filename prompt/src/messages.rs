@@ -10,6 +10,35 @@ use rh_contract::camera::HeadCamera;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
+/// Why a scene's prompt cannot be built.
+#[derive(Debug, thiserror::Error)]
+pub enum PromptError {
+    /// An observation frame is not on disk (a label-only build has none).
+    #[error(
+        "missing observation frame {} (was the dataset built with rendering? \
+         `rh-pipeline build` without --no-render writes frames/)",
+        .0.display()
+    )]
+    MissingFrame(PathBuf),
+    /// A frame that cannot be read or encoded, a spec without its head camera, an unknown
+    /// setting: the message names the file or the setting.
+    #[error("{0}")]
+    Invalid(String),
+}
+
+impl From<String> for PromptError {
+    fn from(message: String) -> PromptError {
+        PromptError::Invalid(message)
+    }
+}
+
+/// For callers whose errors are text (the export's examples).
+impl From<PromptError> for String {
+    fn from(e: PromptError) -> String {
+        e.to_string()
+    }
+}
+
 /// One scene's messages, ready to send.
 #[derive(Debug, Clone)]
 pub struct BuiltPrompt {
@@ -253,14 +282,15 @@ pub fn user_parts(cfg: &PromptConfig, camera: &HeadCamera) -> Vec<UserPart> {
 }
 
 /// The frame file of a [`UserPart::Frame`], or an error naming it when it is missing.
-pub fn frame_file(dir: &Path, scene_id: &str, camera: &str, t: f64) -> Result<PathBuf, String> {
+pub fn frame_file(
+    dir: &Path,
+    scene_id: &str,
+    camera: &str,
+    t: f64,
+) -> Result<PathBuf, PromptError> {
     let path = dir.join(frame_rel_path(scene_id, camera, t));
     if !path.is_file() {
-        return Err(format!(
-            "missing observation frame {} (was the dataset built with rendering? \
-             `rh-pipeline build` without --no-render writes frames/)",
-            path.display()
-        ));
+        return Err(PromptError::MissingFrame(path));
     }
     Ok(path)
 }
@@ -276,7 +306,7 @@ pub fn subsampling_of(cfg: &PromptConfig) -> Result<turbojpeg::Subsamp, String> 
 }
 
 /// The messages for one scene of the dataset at `dir`.
-pub fn build(cfg: &PromptConfig, dir: &Path, scene_id: &str) -> Result<BuiltPrompt, String> {
+pub fn build(cfg: &PromptConfig, dir: &Path, scene_id: &str) -> Result<BuiltPrompt, PromptError> {
     let cpu0 = thread_cpu_s();
     let sub = subsampling_of(cfg)?;
     let camera = crate::camera::scene_camera(dir, scene_id)?;
@@ -324,7 +354,7 @@ pub fn canonical(
     cfg: &PromptConfig,
     dir: &Path,
     scene_id: &str,
-) -> Result<(Value, String), String> {
+) -> Result<(Value, String), PromptError> {
     let built = build(cfg, dir, scene_id)?;
     let hash = prompt_hash(&built.messages);
     Ok((built.messages, hash))

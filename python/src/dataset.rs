@@ -300,12 +300,9 @@ impl NativeDataset {
             self.scene(&scene_id)?;
             let cfg = rh_prompt::PromptConfig::load(None)?;
             let (messages, hash) =
-                rh_prompt::canonical(&cfg, &self.ds.dir, &scene_id).map_err(|e| {
-                    if e.starts_with("missing observation frame") {
-                        Error::NotFound(e)
-                    } else {
-                        Error::Value(e)
-                    }
+                rh_prompt::canonical(&cfg, &self.ds.dir, &scene_id).map_err(|e| match e {
+                    rh_prompt::PromptError::MissingFrame(_) => Error::NotFound(e.to_string()),
+                    rh_prompt::PromptError::Invalid(m) => Error::Value(m),
                 })?;
             Ok((messages.to_string(), hash))
         })

@@ -89,7 +89,8 @@ pub fn check_price(model: &str, max_cost: Option<f64>, price: Option<config::Pri
 /// estimate of the whole run's tokens and cost ([`estimate`]).
 pub fn dry_run(opts: &PredictOptions, scenes: &[String]) -> Result<serde_json::Value> {
     let scene_id = scenes.first().map(String::as_str).unwrap_or_default();
-    let built = prompt::build(&opts.prompt, &opts.dataset, scene_id).map_err(|e| InputError(e))?;
+    let built =
+        prompt::build(&opts.prompt, &opts.dataset, scene_id).map_err(|e| InputError(e.into()))?;
     let est = estimate::estimate(
         &built.messages,
         scenes.len(),

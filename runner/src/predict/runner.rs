@@ -159,7 +159,7 @@ fn prepare_scene(
 ) -> tokio::task::JoinHandle<(String, Result<prompt::BuiltPrompt, String>)> {
     let (p, dir) = (opts.prompt.clone(), opts.dataset.clone());
     tokio::task::spawn_blocking(move || {
-        let built = prompt::build(&p, &dir, &scene);
+        let built = prompt::build(&p, &dir, &scene).map_err(String::from);
         (scene, built)
     })
 }
