@@ -458,10 +458,16 @@ mod tests {
         .unwrap();
         let err = build(&cfg, d.path(), "ffffffff").unwrap_err();
         assert!(matches!(err, PromptError::MissingFrame(_)), "{err}");
-        assert!(err.to_string().contains("missing observation frame"), "{err}");
+        assert!(
+            err.to_string().contains("missing observation frame"),
+            "{err}"
+        );
         let err = build(&cfg, d.path(), "eeeeeeee").unwrap_err();
         assert!(matches!(err, PromptError::Invalid(_)), "{err}");
-        assert!(err.to_string().contains("cannot read the scene's spec"), "{err}");
+        assert!(
+            err.to_string().contains("cannot read the scene's spec"),
+            "{err}"
+        );
     }
 
     /// [`test_frame`] as `frame.png` in a new temporary directory.
