@@ -563,7 +563,7 @@ mod tests {
             let st = std::process::Command::new(std::env::current_exe().unwrap())
                 .args([
                     "--exact",
-                    "predict::prompt::tests::encode_child",
+                    "messages::tests::encode_child",
                     "--ignored",
                 ])
                 .env(CHILD_ENV, format!("{}\n{}", f.display(), out.display()))
