@@ -3,8 +3,9 @@
 //! call), synced, then renamed onto its path. One mechanism for bytes in memory
 //! ([`write_atomic`], or [`write_file`] whose error names the file), for a stream
 //! ([`AtomicFile`]: write, then [`AtomicFile::commit`]), for a file another library writes
-//! ([`Unsynced::at`]: write to [`Unsynced::temp`], then [`Unsynced::commit`]) and for a file
-//! whose slow fsync runs off the caller's path ([`write_unsynced`]).
+//! ([`Unsynced::at`]: write to [`Unsynced::temp`], then [`Unsynced::commit`]), for a stream
+//! several owners write ([`SharedFile`]) and for a file whose slow fsync runs off the
+//! caller's path ([`write_unsynced`]).
 //!
 //! A failed write leaves the previous file as it was and removes the temporary one; it
 //! is a [`CannotWrite`] naming the file, which both programs exit with
@@ -230,9 +231,79 @@ impl Unsynced {
     }
 }
 
+/// A file written whole or not at all ([`AtomicFile`]) through a writer
+/// another owner holds (the scoring's decision lines): a failed write is an `io::Error`
+/// carrying a `CannotWrite` naming the file; [`SharedFile::commit`] puts it in place.
+#[derive(Clone)]
+pub struct SharedFile {
+    file: std::sync::Arc<std::sync::Mutex<Option<AtomicFile>>>,
+    what: &'static str,
+    path: std::path::PathBuf,
+}
+
+impl SharedFile {
+    pub fn create(path: &Path, what: &'static str) -> Result<SharedFile, CannotWrite> {
+        let file = AtomicFile::create(path).map_err(|e| CannotWrite::new(what, path, e))?;
+        Ok(SharedFile {
+            file: std::sync::Arc::new(std::sync::Mutex::new(Some(file))),
+            what,
+            path: path.to_path_buf(),
+        })
+    }
+
+    fn fail(&self, e: std::io::Error) -> std::io::Error {
+        std::io::Error::other(CannotWrite::new(self.what, &self.path, e))
+    }
+
+    fn with<T>(&self, f: impl FnOnce(&mut AtomicFile) -> std::io::Result<T>) -> std::io::Result<T> {
+        let mut guard = self.file.lock().unwrap_or_else(|p| p.into_inner());
+        match guard.as_mut() {
+            Some(file) => f(file).map_err(|e| self.fail(e)),
+            None => Err(self.fail(std::io::Error::other("already closed"))),
+        }
+    }
+
+    /// Syncs and renames the file into place.
+    pub fn commit(&self) -> Result<(), CannotWrite> {
+        let file = self.file.lock().unwrap_or_else(|p| p.into_inner()).take();
+        match file {
+            Some(f) => f
+                .commit()
+                .map_err(|e| CannotWrite::new(self.what, &self.path, e)),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Write for SharedFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.with(|f| f.write(buf))
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.with(|f| f.flush())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_shared_file_appears_whole_on_commit_only() {
+        let dir = std::env::temp_dir().join(format!("rh-shared-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("lines.jsonl");
+        let f = SharedFile::create(&path, "the lines").unwrap();
+        let mut other = f.clone();
+        other.write_all(b"one\n").unwrap();
+        assert!(!path.exists());
+        f.commit().unwrap();
+        assert_eq!(fs::read(&path).unwrap(), b"one\n");
+        let e = other.write_all(b"two\n").unwrap_err();
+        assert!(e.to_string().contains("already closed"), "{e}");
+        fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn writes_whole_files_and_leaves_no_temporary() {

@@ -2,8 +2,8 @@
 //! predictions (`preds.jsonl`), derives each plan's action with the versioned action rule,
 //! scores the five metrics of specification §11 against a dataset's ground truth, aggregates them,
 //! and reproduces the paper's analyses; [`api::score`] is the one scoring sequence. No
-//! simulator, renderer, LLM client or network: those, the figures and the site are
-//! rh-score's.
+//! simulator, renderer, LLM client or network: those are rh-execute's, rh-runner's and
+//! rh-locate's, the figures and the site rh-report's.
 //!
 //! Pipeline of one run: [`dataset::Dataset::load`] reads `DIR/data/*.parquet` (columns
 //! by name; a missing or mistyped column is an input error naming file and column) →

@@ -198,7 +198,7 @@ pub fn oracle_plan(scene: &Scene, hints: Option<&OracleHints>, cfg: &Config) -> 
 }
 
 /// The physics check of the oracle's dodges, which needs the simulator
-/// (`rh_score::execution::physics_dodges_of`): for the valid DODGE scenes among `scenes`
+/// (`rh_execute::physics_dodges_of`): for the valid DODGE scenes among `scenes`
 /// whose spec replays (`keys`), the escape walks that replace a heuristic dodge (from
 /// `hints`) the executor finds struck, by scene id.
 pub type DodgeCheck = fn(

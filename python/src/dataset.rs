@@ -1,14 +1,14 @@
 //! `reacthuman._native.NativeDataset`: a loaded dataset and the calls that need one
-//! (score, classify, prompt, execute). Every call goes to the scorer (`rh_score`) or the
+//! (score, classify, prompt, execute). Every call goes to the scorer's crates (`rh_grade`, `rh_execute`, `rh_prompt`) or the
 //! physics (`rh_physics`) library; nothing here decides a number.
 
 use crate::errors::{run, Error, Result};
 use pyo3::prelude::*;
+use rh_grade::dataset::{ReplayKey, Scene, Subset};
+use rh_grade::fast_map::FastMap;
+use rh_grade::plan::{plan_from_text, plan_from_value, Plan, PlanError};
+use rh_grade::{Config, Dataset};
 use rh_physics::execute::Replay;
-use rh_score::dataset::{ReplayKey, Scene, Subset};
-use rh_score::fast_map::FastMap;
-use rh_score::plan::{plan_from_text, plan_from_value, Plan, PlanError};
-use rh_score::{Config, Dataset};
 use serde_json::{json, Value};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -23,7 +23,7 @@ pub struct NativeDataset {
     replays: Mutex<HashMap<String, Arc<Replay>>>,
 }
 
-/// Resolves a directory or Hub id (`rh_score::dataset::resolve_dir`), a missing one being
+/// Resolves a directory or Hub id (`rh_locate::resolve_dir`), a missing one being
 /// `FileNotFoundError`.
 fn resolve(path: &str) -> Result<PathBuf> {
     let p = Path::new(path);
@@ -39,10 +39,10 @@ fn resolve(path: &str) -> Result<PathBuf> {
         return Err(Error::NotFound(format!(
             "{}: no data/ folder; {}",
             p.display(),
-            rh_score::dataset_diagnosis::missing_parquet_message(p)
+            rh_grade::dataset_diagnosis::missing_parquet_message(p)
         )));
     }
-    Ok(rh_score::dataset::resolve_dir(Some(path.to_string()))?)
+    Ok(rh_locate::resolve_dir(Some(path.to_string()))?)
 }
 
 /// `owner/name` with one slash (the Hub's dataset id shape).
@@ -70,7 +70,7 @@ pub fn parse_plan(text: &str, cfg: &Config) -> Result<Plan> {
     // model text, so they reach the plan's sanity check (`absurd_number`).
     let v: Value = match serde_json::from_str(text) {
         Ok(v) => v,
-        Err(e) => rh_score::plan::quote_nonfinite(text)
+        Err(e) => rh_grade::plan::quote_nonfinite(text)
             .and_then(|t| serde_json::from_str(&t).ok())
             .ok_or_else(|| Error::Value(format!("plan is not valid JSON: {e}")))?,
     };
@@ -95,7 +95,7 @@ fn neutral_scene() -> Scene {
         looks_like: None,
         adversarial: false,
         twin_scene_id: None,
-        gt_action: rh_score::Action::NoAction,
+        gt_action: rh_grade::Action::NoAction,
         dangerous: false,
         danger_present: false,
         impact_point: None,
@@ -133,12 +133,12 @@ impl NativeDataset {
         let keys = match self.keys.get() {
             Some(k) => k,
             None => {
-                let k = rh_score::dataset::read_replay_keys(&self.ds.dir)?;
+                let k = rh_grade::dataset::read_replay_keys(&self.ds.dir)?;
                 self.keys.get_or_init(|| k)
             }
         };
-        let key = rh_score::execution::replay_key(keys, scene_id)?;
-        let (r, _) = rh_score::execution::checked_replay(&self.ds.dir, key, scene_id)?;
+        let key = rh_execute::replay_key(keys, scene_id)?;
+        let (r, _) = rh_execute::checked_replay(&self.ds.dir, key, scene_id)?;
         let r = Arc::new(r);
         self.replays
             .lock()
@@ -157,7 +157,7 @@ impl NativeDataset {
     fn new(py: Python<'_>, path: &str, allow_incomplete: bool) -> PyResult<Self> {
         run(py, || {
             let dir = resolve(path)?;
-            rh_score::dataset::check_finished(&dir, allow_incomplete)?;
+            rh_grade::dataset::check_finished(&dir, allow_incomplete)?;
             Ok(NativeDataset {
                 ds: Dataset::load(&dir)?,
                 cfg: Config::default(),
@@ -181,13 +181,13 @@ impl NativeDataset {
     /// Scene ids of the eval subset (sorted), or None when the dataset has none.
     fn eval_ids(&self, py: Python<'_>) -> PyResult<Option<Vec<String>>> {
         run(py, || {
-            let ids = rh_score::dataset::eval_scene_ids(&self.ds.dir)?;
+            let ids = rh_grade::dataset::eval_scene_ids(&self.ds.dir)?;
             Ok(ids.map(|s| s.into_iter().collect()))
         })
     }
 
     /// The scenes `rh-score predict --subset S [--limit N]` runs, in its order: the valid
-    /// scenes of the subset in dataset order (`rh_score::predict::select_scenes`).
+    /// scenes of the subset in dataset order (`rh_prompt::select_scenes`).
     #[pyo3(signature = (subset, limit=None))]
     fn predict_scenes(
         &self,
@@ -197,7 +197,7 @@ impl NativeDataset {
     ) -> PyResult<Vec<String>> {
         run(py, || {
             let s = self::subset(Some(&subset))?.expect("a named subset");
-            Ok(rh_score::predict::select_scenes(&self.ds, s, limit)?)
+            Ok(rh_prompt::select_scenes(&self.ds, s, limit)?)
         })
     }
 
@@ -230,7 +230,7 @@ impl NativeDataset {
         })
     }
 
-    /// The JSON report of `rh-score PREDS --dataset DIR --json -` (`rh_score::api`): from
+    /// The JSON report of `rh-score PREDS --dataset DIR --json -` (`rh_grade::api`): from
     /// a file (`path`) or JSON Lines text (`text`, reported as `name`).
     #[pyo3(signature = (path=None, text=None, name="<list>", subset=None, answered_only=false))]
     fn score(
@@ -253,13 +253,13 @@ impl NativeDataset {
                             p.display()
                         )));
                     }
-                    rh_score::api::Preds::Path(p)
+                    rh_grade::api::Preds::Path(p)
                 }
-                (None, Some(t)) => rh_score::api::Preds::Text { name, text: t },
+                (None, Some(t)) => rh_grade::api::Preds::Text { name, text: t },
                 _ => return Err(Error::Value("give the predictions as path or text".into())),
             };
             let report =
-                rh_score::api::score_report(&self.ds, &self.cfg, subset, answered_only, preds)?;
+                rh_grade::api::score_report(&self.ds, &self.cfg, subset, answered_only, preds)?;
             serde_json::to_string(&report).map_err(|e| Error::Internal(e.to_string()))
         })
     }
@@ -272,9 +272,9 @@ impl NativeDataset {
     fn decisions(&self, py: Python<'_>, text: String, subset: Option<String>) -> PyResult<String> {
         run(py, || {
             let subset = self::subset(subset.as_deref())?;
-            let expected = rh_score::coverage::Expected::resolve(&self.ds, subset)?;
+            let expected = rh_grade::coverage::Expected::resolve(&self.ds, subset)?;
             let mut out = Vec::new();
-            rh_score::Scoring::new(&self.ds, &self.cfg)
+            rh_grade::Scoring::new(&self.ds, &self.cfg)
                 .with_expected(expected)
                 .with_decisions_output(Box::new(&mut out))
                 .score_reader(std::io::Cursor::new(text.as_bytes()))?;
@@ -298,17 +298,12 @@ impl NativeDataset {
     fn prompt(&self, py: Python<'_>, scene_id: String) -> PyResult<(String, String)> {
         run(py, || {
             self.scene(&scene_id)?;
-            let cfg = rh_score::predict::config::PromptConfig::load(None)?;
+            let cfg = rh_prompt::PromptConfig::load(None)?;
             let (messages, hash) =
-                rh_score::predict::prompt::canonical(&cfg, &self.ds.dir, &scene_id).map_err(
-                    |e| {
-                        if e.starts_with("missing observation frame") {
-                            Error::NotFound(e)
-                        } else {
-                            Error::Value(e)
-                        }
-                    },
-                )?;
+                rh_prompt::canonical(&cfg, &self.ds.dir, &scene_id).map_err(|e| match e {
+                    rh_prompt::PromptError::MissingFrame(_) => Error::NotFound(e.to_string()),
+                    rh_prompt::PromptError::Invalid(m) => Error::Value(m),
+                })?;
             Ok((messages.to_string(), hash))
         })
     }
@@ -318,8 +313,7 @@ impl NativeDataset {
         run(py, || {
             let plan = parse_plan(&plan, &self.cfg)?;
             let replay = self.replay(&scene_id)?;
-            let outcome =
-                replay.execute(&rh_score::execution::exec_plan(&plan), &self.cfg.execution);
+            let outcome = replay.execute(&rh_execute::exec_plan(&plan), &self.cfg.execution);
             serde_json::to_string(&outcome).map_err(|e| Error::Internal(e.to_string()))
         })
     }
@@ -330,7 +324,7 @@ pub fn classify_json(cfg: &Config, plan: &str, scene: Option<&Scene>) -> Result<
     let plan = parse_plan(plan, cfg)?;
     let neutral = neutral_scene();
     let scene = scene.unwrap_or(&neutral);
-    let (action, k) = rh_score::action_rule::classify(&plan, scene, cfg);
+    let (action, k) = rh_grade::action_rule::classify(&plan, scene, cfg);
     let v = json!({
         "action": action.as_str(),
         "rule_version": cfg.action_rule.version,

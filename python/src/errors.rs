@@ -32,9 +32,9 @@ pub enum Error {
 pub type Result<T> = std::result::Result<T, Error>;
 
 impl From<anyhow::Error> for Error {
-    /// The scorer's input errors (`rh_score::InputError`) are bad input; the rest internal.
+    /// The scorer's input errors (`rh_grade::InputError`) are bad input; the rest internal.
     fn from(e: anyhow::Error) -> Error {
-        if rh_score::error::is_input_error(&e) {
+        if rh_grade::error::is_input_error(&e) {
             Error::Value(format!("{e:#}"))
         } else {
             Error::Internal(format!("{e:#}"))

@@ -1,5 +1,6 @@
 //! The native module of the `reacthuman` Python package (issue 26): a thin PyO3 layer
-//! over the scorer (`rh_score`) and the physics (`rh_physics`). The Python side
+//! over the grading core (`rh_grade`), the executor (`rh_execute`), the canonical prompt
+//! (`rh_prompt`) and the physics (`rh_physics`). The Python side
 //! (`python/reacthuman/`) holds the public API, the Gymnasium environment and the docs.
 //!
 //! * [`dataset`] — `NativeDataset`: load, score, classify, prompt, execute;
@@ -22,7 +23,7 @@ use pyo3::prelude::*;
 #[pyfunction]
 fn classify_plan(py: Python<'_>, plan: String) -> PyResult<String> {
     errors::run(py, || {
-        dataset::classify_json(&rh_score::Config::default(), &plan, None)
+        dataset::classify_json(&rh_grade::Config::default(), &plan, None)
     })
 }
 
@@ -30,8 +31,8 @@ fn classify_plan(py: Python<'_>, plan: String) -> PyResult<String> {
 #[pyfunction]
 fn versions() -> PyResult<(String, String, String)> {
     errors::guard(|| {
-        let cfg = rh_score::Config::default();
-        let prompt = rh_score::predict::config::PromptConfig::load(None)?;
+        let cfg = rh_grade::Config::default();
+        let prompt = rh_prompt::PromptConfig::load(None)?;
         Ok((
             cfg.action_rule.version.clone(),
             cfg.execution.version.clone(),
@@ -45,8 +46,8 @@ fn versions() -> PyResult<(String, String, String)> {
 #[pyfunction]
 fn generation_config() -> PyResult<String> {
     errors::guard(|| {
-        let cfg = rh_score::predict::config::PredictConfig::load(None)?;
-        serde_json::to_string(&cfg.generation).map_err(|e| errors::Error::Internal(e.to_string()))
+        let generation = rh_prompt::canonical_generation()?;
+        serde_json::to_string(&generation).map_err(|e| errors::Error::Internal(e.to_string()))
     })
 }
 
@@ -54,7 +55,7 @@ fn generation_config() -> PyResult<String> {
 #[pyfunction]
 fn execution_config() -> PyResult<String> {
     errors::guard(|| {
-        serde_json::to_string(&rh_score::Config::default().execution)
+        serde_json::to_string(&rh_grade::Config::default().execution)
             .map_err(|e| errors::Error::Internal(e.to_string()))
     })
 }

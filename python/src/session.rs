@@ -132,11 +132,7 @@ impl NativeSession {
 pub fn plan_action(dataset: &NativeDataset, plan: &str, period: f64, j: u32) -> PyResult<Vec<f64>> {
     guard(|| {
         let p = parse_plan(plan, &dataset.cfg)?;
-        Ok(flat(&plan_command(
-            &rh_score::execution::exec_plan(&p),
-            period,
-            j,
-        )))
+        Ok(flat(&plan_command(&rh_execute::exec_plan(&p), period, j)))
     })
 }
 

@@ -302,16 +302,6 @@ pub struct Config {
     /// How rooms are furnished (`decor`; absent in manifests of older builds: bare rooms).
     #[serde(default)]
     pub decor: crate::decor::DecorConfig,
-    /// Set by the driver for the groups of an adversarial probe pair (`twins`): their
-    /// intent (`intent::Intent::for_object`) is this catalog object's, the pair's benign
-    /// member, whichever object they show. Not part of any file.
-    #[serde(skip)]
-    pub aimed_as: Option<String>,
-    /// Set by the driver for the groups of a twin pair (label rule v6): every launch is the
-    /// push that gives this catalog object (the pair's benign member) the layout's
-    /// velocities, whichever object the group shows. Not part of any file.
-    #[serde(skip)]
-    pub pushed_as: Option<String>,
     /// Where the configuration came from (for messages; not part of its content).
     #[serde(skip)]
     pub source: String,
@@ -358,8 +348,6 @@ impl Config {
             eval: raw.eval,
             probes: raw.probes,
             decor: raw.decor,
-            aimed_as: None,
-            pushed_as: None,
             source: name.to_string(),
         };
         config.validate(name, labels_name)?;

@@ -4,15 +4,16 @@
 //! [`run_group`] is the one place the stages are chained; `build` runs groups in
 //! parallel and writes what it returns.
 
+use crate::aim::AimConfig;
 use crate::cameras;
-use crate::config::Config;
+use crate::config::{Config, ValidatorConfig};
 pub use crate::counterfactual::{
     counterfactual_options, counterfactual_run, first_near_step, full_event_simulation,
     may_touch_observer,
 };
 use crate::families;
 use crate::label::{label, Labels};
-use crate::randomize::{randomize, RandomizeError, SceneKey};
+use crate::randomize::{randomize_as, RandomizeError, SceneKey, StandIn};
 use crate::selection::{plan_group_with, replan_group};
 use crate::twins;
 use crate::validate::{validate, Verdicts, VALIDATOR_COLUMNS};
@@ -122,10 +123,10 @@ pub fn produce_planned_group(
     } else {
         adversarial
     };
-    probe_config.aimed_as = Some(benign.id.clone());
-    if slot.pair.twin {
-        probe_config.pushed_as = Some(benign.id.clone());
-    }
+    let stand_in = StandIn {
+        aimed_as: Some(benign.id.clone()),
+        pushed_as: slot.pair.twin.then(|| benign.id.clone()),
+    };
     // Both groups of a pair build the whole pair (deterministic): the probe's four bands
     // and, for a twin pair, the twins labelled — once per process ([`PROBES`]).
     let probe_count = if slot.pair.twin { 4 } else { count };
@@ -136,7 +137,7 @@ pub fn produce_planned_group(
             count: probe_count,
         };
         let (mut probe, rejections) =
-            probe_group_counted(&selection, bands, catalog, &probe_config)
+            probe_group_counted(&selection, bands, catalog, &probe_config, &stand_in)
                 .map_err(|e| e.to_string())?;
         let twins = slot.pair.twin.then(|| {
             let label = |spec, sim| label_scene(spec, sim, config);
@@ -236,7 +237,11 @@ fn replanned_group(
             first_index: g * 4,
             count,
         };
-        let attempts = Attempts { bands, require_aim };
+        let attempts = Attempts {
+            bands,
+            require_aim,
+            stand_in: &StandIn::default(),
+        };
         let produced = produce_attempts(&selection, &attempts, catalog, config, memo)
             .map_err(|e| e.to_string())?;
         match &produced {
@@ -261,7 +266,10 @@ fn replanned_group(
         let Some(results) = produce(replan, require_aim, &mut total)? else {
             continue;
         };
-        let unaimed = require_aim && results.first().is_some_and(|r| needs_aim(&r.spec, config));
+        let unaimed = require_aim
+            && results
+                .first()
+                .is_some_and(|r| needs_aim(&r.spec, &config.aim));
         if valid(&results) && !unaimed {
             return Ok((results, total));
         }
@@ -289,10 +297,10 @@ fn replanned_group(
 /// Whether a spec's event still waits to be aimed (label rule v5): the driver aims it
 /// (`aim::driver_aimed`) at the hands or the body, and no aimed pose (`aim::apply`)
 /// stands in it.
-fn needs_aim(spec: &SceneSpec, config: &Config) -> bool {
+fn needs_aim(spec: &SceneSpec, aim: &AimConfig) -> bool {
     use crate::intent::Intent;
     matches!(
-        crate::aim::driver_aimed(spec, &config.aim),
+        crate::aim::driver_aimed(spec, aim),
         Some(Intent::Hands | Intent::Body)
     ) && !crate::aim::posed_by_aim(spec)
 }
@@ -339,7 +347,7 @@ pub fn label_scene(spec: SceneSpec, sim: Simulation, config: &Config) -> SceneRe
     let family = families::get(&spec.family).expect("randomize only emits implemented families");
     let labels = counterfactual_labels(&spec, &sim);
     let verdicts = validate(&spec, &sim, family, &config.validators, &labels);
-    scene_result(spec, sim, labels, verdicts, config)
+    scene_result(spec, sim, labels, verdicts, &config.validators)
 }
 
 /// The labels of a simulated spec: the counterfactual run where the hazard may touch
@@ -355,9 +363,9 @@ fn scene_result(
     sim: Simulation,
     labels: Labels,
     verdicts: Verdicts,
-    config: &Config,
+    validators: &ValidatorConfig,
 ) -> SceneResult {
-    let until_within = config.validators.frame_check_until_within;
+    let until_within = validators.frame_check_until_within;
     let trajectory = hazard_trajectory(&spec, &sim);
     SceneResult {
         ego_motion_px: crate::ego::ego_motion_px(&spec, &sim),
@@ -468,7 +476,9 @@ fn label_group_counting(
     }
     labelled
         .into_iter()
-        .map(|(spec, sim, labels, verdicts)| scene_result(spec, sim, labels, verdicts, config))
+        .map(|(spec, sim, labels, verdicts)| {
+            scene_result(spec, sim, labels, verdicts, &config.validators)
+        })
         .collect()
 }
 
@@ -510,7 +520,9 @@ fn label_group_if_valid(
     Some(
         labelled
             .into_iter()
-            .map(|(spec, sim, labels, verdicts)| scene_result(spec, sim, labels, verdicts, config))
+            .map(|(spec, sim, labels, verdicts)| {
+                scene_result(spec, sim, labels, verdicts, &config.validators)
+            })
             .collect(),
     )
 }
@@ -563,7 +575,11 @@ pub fn produce_group_counted(
         first_index,
         count,
     };
-    produce_requiring(selection, bands, catalog, config, &[false])
+    let tries = Tries {
+        require_aim: &[false],
+        stand_in: &StandIn::default(),
+    };
+    produce_requiring(selection, bands, catalog, config, tries)
 }
 
 /// A probe group's bands: attempts whose event cannot be aimed are redrawn (`require_aim`,
@@ -575,8 +591,13 @@ fn probe_group_counted(
     bands: Bands,
     catalog: &Catalog,
     config: &Config,
+    stand_in: &StandIn,
 ) -> Result<(Vec<SceneResult>, Rejections), RandomizeError> {
-    produce_requiring(selection, bands, catalog, config, &[true, false])
+    let tries = Tries {
+        require_aim: &[true, false],
+        stand_in,
+    };
+    produce_requiring(selection, bands, catalog, config, tries)
 }
 
 /// A group's scenes `first_index .. first_index + count` of build `build_seed`.
@@ -587,6 +608,14 @@ struct Bands {
     count: u64,
 }
 
+/// How [`produce_requiring`] tries a group: `require_aim` as each of these in turn, the
+/// group laid out as `stand_in` says.
+#[derive(Clone, Copy)]
+struct Tries<'a> {
+    require_aim: &'a [bool],
+    stand_in: &'a StandIn,
+}
+
 /// [`produce_attempts`] with `require_aim` as each of `tries` in turn (sharing plain runs)
 /// until one produces the group.
 fn produce_requiring(
@@ -594,12 +623,16 @@ fn produce_requiring(
     bands: Bands,
     catalog: &Catalog,
     config: &Config,
-    tries: &[bool],
+    tries: Tries,
 ) -> Result<(Vec<SceneResult>, Rejections), RandomizeError> {
     let mut memo = SimMemo::default();
-    for &require_aim in tries {
-        let attempts = Attempts { bands, require_aim };
-        let memo = (tries.len() > 1).then_some(&mut memo);
+    for &require_aim in tries.require_aim {
+        let attempts = Attempts {
+            bands,
+            require_aim,
+            stand_in: tries.stand_in,
+        };
+        let memo = (tries.require_aim.len() > 1).then_some(&mut memo);
         if let Some(produced) = produce_attempts(selection, &attempts, catalog, config, memo)? {
             return Ok(produced);
         }
@@ -607,11 +640,12 @@ fn produce_requiring(
     Ok(Default::default())
 }
 
-/// Which scenes [`produce_attempts`] produces: the group's `bands`; with `require_aim`,
-/// unaimed attempts are redrawn unlabelled.
-struct Attempts {
+/// Which scenes [`produce_attempts`] produces: the group's `bands`, laid out as
+/// `stand_in` says; with `require_aim`, unaimed attempts are redrawn unlabelled.
+struct Attempts<'a> {
     bands: Bands,
     require_aim: bool,
+    stand_in: &'a StandIn,
 }
 
 /// Plain runs kept by spec (its JSON text), so that a plan produced again simulates
@@ -655,6 +689,7 @@ fn produce_attempts(
             count,
         },
         require_aim,
+        stand_in,
     } = *attempts;
     let mut results = Vec::new();
     let mut rejections = Rejections::default();
@@ -662,11 +697,12 @@ fn produce_attempts(
     for attempt in 0..config.validators.max_attempts {
         rejections.attempts += 1;
         let mut band_run = |index: u64| -> Result<(SceneSpec, Simulation), RandomizeError> {
-            let spec = randomize(
+            let spec = randomize_as(
                 selection,
                 &SceneKey::new(build_seed, index, attempt),
                 catalog,
                 config,
+                stand_in,
             )?;
             // Simulate what the file will say: a JSON round trip is exact (serde_json
             // float_roundtrip), and this makes "replay equals build" hold by construction.
@@ -685,7 +721,7 @@ fn produce_attempts(
         let fastest = band_run(first_index + count - 1)?;
         let unaimable = require_aim
             && count > 1
-            && needs_aim(&fastest.0, config)
+            && needs_aim(&fastest.0, &config.aim)
             && crate::aim::aims(std::slice::from_ref(&fastest), &config.aim).is_empty();
         let mut runs = Vec::with_capacity(count as usize);
         if !unaimable {
@@ -703,7 +739,9 @@ fn produce_attempts(
         } else {
             crate::aim::aims(&runs, &config.aim)
         };
-        if require_aim && aims.is_empty() && runs.first().is_some_and(|(s, _)| needs_aim(s, config))
+        if require_aim
+            && aims.is_empty()
+            && runs.first().is_some_and(|(s, _)| needs_aim(s, &config.aim))
         {
             unaimed += 1;
             // Also when the attempts run out first: no scene was labelled.

@@ -60,12 +60,35 @@ pub fn implemented_families() -> String {
         .join(", ")
 }
 
+/// Who the groups of an adversarial probe pair are laid out as (`twins`): set by the
+/// driver for one group's attempts — runtime state, not policy, so not in any config.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct StandIn {
+    /// Their intent (`intent::Intent::for_object`) is this catalog object's, the pair's
+    /// benign member, whichever object they show.
+    pub aimed_as: Option<String>,
+    /// Label rule v6, twin pairs: every launch is the push that gives this catalog object
+    /// (the pair's benign member) the layout's velocities, whichever object is shown.
+    pub pushed_as: Option<String>,
+}
+
 /// Lays out the scene `key` of the group planned as `selection`.
 pub fn randomize(
     selection: &Selection,
     key: &SceneKey,
     catalog: &Catalog,
     config: &Config,
+) -> Result<SceneSpec, RandomizeError> {
+    randomize_as(selection, key, catalog, config, &StandIn::default())
+}
+
+/// [`randomize`] for a group laid out as `stand_in` says (an adversarial probe pair's).
+pub fn randomize_as(
+    selection: &Selection,
+    key: &SceneKey,
+    catalog: &Catalog,
+    config: &Config,
+    stand_in: &StandIn,
 ) -> Result<SceneSpec, RandomizeError> {
     let family =
         families::get(&selection.family).ok_or_else(|| RandomizeError::FamilyNotImplemented {
@@ -94,7 +117,7 @@ pub fn randomize(
     let far_observer =
         seeds::stream(seed, 0, "observer").random_bool(config.build.far_observer_share);
     // An adversarial probe pair's groups are aimed as its benign member would be (`twins`).
-    let aimed_as = config
+    let aimed_as = stand_in
         .aimed_as
         .as_deref()
         .and_then(|id| catalog.object(id))
@@ -114,7 +137,7 @@ pub fn randomize(
         ),
     };
     let mut layout = family.sample(&input, &mut seeds::stream(seed, key.attempt, "placement"));
-    let pushed_as = config
+    let pushed_as = stand_in
         .pushed_as
         .as_deref()
         .and_then(|id| catalog.object(id))

@@ -407,3 +407,59 @@ fn dev_dependencies_change_no_feature_of_the_built_dependencies() {
         changed.join("\n")
     );
 }
+
+/// The packages `package` links (normal dependencies, every level), from `cargo tree`.
+fn linked_packages(package: &str) -> BTreeSet<String> {
+    let out = cargo(&[
+        "tree",
+        "-p",
+        package,
+        "--offline",
+        "--prefix",
+        "none",
+        "-e",
+        "normal",
+        "-f",
+        "{p}",
+    ]);
+    out.lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .map(str::to_string)
+        .collect()
+}
+
+/// The scorer's seams (ARCHITECTURE.md, "Code map"): the grading core links no
+/// simulator, renderer, FFmpeg, JPEG encoder, HTTP client or async runtime, and the Python
+/// package none of the model runner, the report writers or the execution videos.
+#[test]
+fn the_grading_core_and_the_python_package_link_only_their_crates() {
+    let heavy = [
+        "rapier3d",
+        "wgpu",
+        "ffmpeg-next",
+        "turbojpeg",
+        "reqwest",
+        "tokio",
+    ];
+    let core = linked_packages("rh-grade");
+    assert!(
+        core.contains("rh-contract") && core.contains("arrow"),
+        "{core:?}"
+    );
+    let found: Vec<&&str> = heavy.iter().filter(|h| core.contains(**h)).collect();
+    assert!(found.is_empty(), "rh-grade links {found:?}");
+    let python = linked_packages("rh-python");
+    assert!(
+        python.contains("rh-execute") && python.contains("rh-prompt"),
+        "{python:?}"
+    );
+    let not_python = [
+        "rh-runner",
+        "rh-report",
+        "rh-execute-videos",
+        "rh-llm",
+        "rh-score",
+    ];
+    let found: Vec<&&str> = not_python.iter().filter(|h| python.contains(**h)).collect();
+    assert!(found.is_empty(), "rh-python links {found:?}");
+}

@@ -12,8 +12,8 @@
 //!   so rescoring the same predictions executes nothing again.
 //!
 //! This module is the executor's plain data (what is waiting, how a run went, the
-//! report); running plans, the replay check and the videos are rh-score's
-//! (`rh_score::execution`), which links the simulator.
+//! report); running plans and the replay check are rh-execute's, which links the
+//! simulator, and the videos rh-execute-videos'.
 
 pub mod report;
 

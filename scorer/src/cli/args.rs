@@ -2,8 +2,8 @@
 //! read by the command modules ([`super::score_command`], [`super::baseline_command`],
 //! [`super::predict_command`]).
 
-use crate::baseline::BaselineKind;
 use clap::{Parser, Subcommand};
+use rh_grade::baseline::BaselineKind;
 use std::path::PathBuf;
 
 #[derive(Parser, Debug)]
@@ -119,7 +119,7 @@ pub struct Cli {
     /// or every valid scene (default: eval when the dataset has an eval/ subset, else all).
     /// Decisions on other scenes are dropped (`outside_subset`).
     #[arg(long, value_enum)]
-    pub subset: Option<crate::dataset::Subset>,
+    pub subset: Option<rh_grade::dataset::Subset>,
 
     /// Metrics over each model's answered scenes only (unanswered scenes left out instead
     /// of counted as failed); the report says so.
@@ -183,17 +183,14 @@ pub enum Cmd {
     /// canonical prompt (configs/prompt.toml) and write preds.jsonl. Resumes: run it again
     /// with the same arguments after a crash, a kill or --max-cost and it does only what is
     /// missing.
-    #[cfg(feature = "predict")]
     Predict(Box<PredictArgs>),
     /// Write a dataset's scenes as fine-tuning data: a Hugging Face dataset in TRL's
     /// conversational format (`datasets.load_dataset(OUT)`), the canonical prompt with the
     /// oracle's plan as the answer (sft) or paired with a plan the benchmark scores as
     /// wrong (preference). Rendered builds carry the observation frames; label-only builds
     /// give text-only examples. Streams the table: memory does not grow with its size.
-    #[cfg(feature = "predict")]
     Export(Box<ExportArgs>),
     /// Write a synthetic dataset with the rh-pipeline column contract (tests).
-    #[cfg(feature = "synthetic")]
     #[command(hide = true)]
     MakeFixture {
         #[arg(long)]
@@ -208,7 +205,6 @@ pub enum Cmd {
     },
 }
 
-#[cfg(feature = "predict")]
 #[derive(clap::Args, Debug)]
 pub struct PredictArgs {
     /// Dataset directory (data/*.parquet + frames/) or Hub dataset id owner/name[@revision].
@@ -234,7 +230,7 @@ pub struct PredictArgs {
     pub api_key_env: String,
     /// Which scenes: the balanced eval subset or every valid scene.
     #[arg(long, value_enum, default_value = "eval")]
-    pub subset: crate::dataset::Subset,
+    pub subset: rh_grade::dataset::Subset,
     /// Only the first N scenes of the subset (dataset order).
     #[arg(long, value_name = "N")]
     pub limit: Option<usize>,
@@ -296,7 +292,6 @@ pub struct PredictArgs {
     pub quiet: bool,
 }
 
-#[cfg(feature = "predict")]
 #[derive(clap::Args, Debug)]
 pub struct ExportArgs {
     /// Dataset directory (data/*.parquet, and frames/ for images) or Hub dataset id
@@ -314,11 +309,11 @@ pub struct ExportArgs {
     /// sft: `messages` (system, user, assistant); preference: `prompt`, `chosen`,
     /// `rejected` (DPO).
     #[arg(long, value_enum, default_value = "sft")]
-    pub format: crate::export::Format,
+    pub format: rh_runner::export::Format,
     /// Which valid scenes: train (outside the eval subset, so the benchmark's scenes stay
     /// unseen), eval (the subset) or all.
     #[arg(long, value_enum, default_value = "train")]
-    pub split: crate::export::Split,
+    pub split: rh_runner::export::Split,
     /// Text-only examples even when the dataset has frames.
     #[arg(long)]
     pub text_only: bool,

@@ -1,9 +1,9 @@
 //! `rh-score baseline KIND`: reference predictions for every scene, on stdout.
 
 use super::output::load_config;
-use crate::baseline::{write_baseline, BaselineKind};
-use crate::Dataset;
 use anyhow::Result;
+use rh_grade::baseline::{write_baseline, BaselineKind};
+use rh_grade::Dataset;
 use std::path::Path;
 
 /// Writes baseline `kind`'s predictions (model name `model`, default `baseline-KIND`) for
@@ -20,10 +20,7 @@ pub fn run(
     let model = model.unwrap_or_else(|| format!("baseline-{}", kind.name()));
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
-    #[cfg(feature = "execute")]
-    let check: Option<rh_grade::oracle::DodgeCheck> = Some(crate::execution::physics_dodges_of);
-    #[cfg(not(feature = "execute"))]
-    let check = None;
+    let check: Option<rh_grade::oracle::DodgeCheck> = Some(rh_execute::physics_dodges_of);
     match write_baseline(kind, &ds, seed, &model, &cfg, check, &mut out) {
         Err(e) => {
             let kind = e

@@ -1,11 +1,11 @@
-//! `rh-score export`: a dataset's scenes as fine-tuning data (`crate::export`).
+//! `rh-score export`: a dataset's scenes as fine-tuning data (`rh_runner::export`).
 
 use super::args::ExportArgs;
 use super::dataset_arg::resolve_dataset;
 use super::output::{load_config, print_out};
-use crate::export::{run as export, ExportOptions};
-use crate::predict::config::PromptConfig;
 use anyhow::Result;
+use rh_prompt::PromptConfig;
+use rh_runner::export::{run as export, ExportOptions};
 
 /// Writes the export and prints its summary (a line, or JSON with `--json`).
 pub fn run(a: ExportArgs) -> Result<()> {
@@ -17,6 +17,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
         text_only: a.text_only,
         prompt: PromptConfig::load(None)?,
         config: load_config(a.config.as_deref())?,
+        dodge_check: Some(rh_execute::physics_dodges_of),
     };
     let summary = export(&opts)?;
     if a.json {

@@ -1,9 +1,9 @@
 //! `rh-score leaderboard FILE...`: results files merged into one board
-//! ([`crate::leaderboard::merge`]), printed and written in the forms asked for.
+//! ([`rh_report::leaderboard::merge`]), printed and written in the forms asked for.
 
 use super::output::print_out;
-use crate::leaderboard::{merge, render};
 use anyhow::Result;
+use rh_report::leaderboard::{merge, render};
 use std::path::{Path, PathBuf};
 
 /// Merges `files`; writes `--html`, `--markdown`; prints the table (or JSON with `--json`).

@@ -1,23 +1,21 @@
 //! `rh-score`'s command line: the arguments ([`args`]) and one module per command, each
 //! with one entry point `run` over the parsed arguments; [`main`] is the binary.
-//! Exit status: 0 success, 2 bad input or usage ([`crate::error::InputError`]), 3 an
+//! Exit status: 0 success, 2 bad input or usage ([`rh_grade::error::InputError`]), 3 an
 //! output that cannot be written ([`rh_contract::fsio::CannotWrite`]), 1 internal error.
 
 pub mod args;
 pub mod baseline_command;
 pub mod dataset_arg;
-#[cfg(feature = "predict")]
 pub mod export_command;
 pub mod leaderboard_command;
 pub mod output;
-#[cfg(feature = "predict")]
 pub mod predict_command;
 pub mod score_command;
 
-use crate::error::{is_cannot_write, is_input_error};
 use anyhow::Result;
 use args::{Cli, Cmd};
 use clap::Parser;
+use rh_grade::error::{is_cannot_write, is_input_error};
 use std::process::ExitCode;
 
 /// Runs the command `cli` names.
@@ -41,18 +39,17 @@ pub fn run(cli: Cli) -> Result<()> {
             markdown,
             json,
         }) => leaderboard_command::run(&files, html.as_deref(), markdown.as_deref(), json),
-        #[cfg(feature = "predict")]
         Some(Cmd::Predict(a)) => predict_command::run(*a),
-        #[cfg(feature = "predict")]
         Some(Cmd::Export(a)) => export_command::run(*a),
-        #[cfg(feature = "synthetic")]
         Some(Cmd::MakeFixture { out, n, seed, drop }) => {
             if !(1..=1_000_000).contains(&n) {
-                return Err(crate::error::InputError(format!("--n {n}: must be 1-1000000")).into());
+                return Err(
+                    rh_grade::error::InputError(format!("--n {n}: must be 1-1000000")).into(),
+                );
             }
-            let rows = crate::synthetic::synth_rows(n, seed);
+            let rows = rh_grade::synthetic::synth_rows(n, seed);
             let drop: Vec<&str> = drop.iter().map(String::as_str).collect();
-            crate::synthetic::write_dataset(&out, &rows, &drop)?;
+            rh_grade::synthetic::write_dataset(&out, &rows, &drop)?;
             output::print_out(&format!(
                 "wrote {n} synthetic scenes to {}\n",
                 out.display()

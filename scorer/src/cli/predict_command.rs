@@ -1,17 +1,17 @@
-//! `rh-score predict`: runs a model over a dataset ([`crate::predict`]) with the options
+//! `rh-score predict`: runs a model over a dataset (`rh_runner::predict`) with the options
 //! of [`PredictArgs`].
 
 use super::args::PredictArgs;
 use super::dataset_arg::resolve_dataset;
 use super::output::print_out;
-use crate::error::InputError;
-use crate::Dataset;
 use anyhow::Result;
+use rh_grade::error::InputError;
+use rh_grade::Dataset;
 
 /// `rh-score predict`: the runner's options from the arguments, then a dry run or the run,
 /// and what happened on stderr (the summary as JSON on stdout with `--json`).
 pub fn run(a: PredictArgs) -> Result<()> {
-    use crate::predict::config::{Generation, PredictConfig, Price, PromptConfig};
+    use rh_runner::predict::config::{Generation, PredictConfig, Price, PromptConfig};
     let cfg = PredictConfig::load(a.config.as_deref())?;
     let prompt = PromptConfig::load(a.prompt.as_deref())?;
     let mut client = cfg
@@ -33,12 +33,12 @@ pub fn run(a: PredictArgs) -> Result<()> {
     if let Some(r) = a.max_retries {
         client.max_retries = r;
     }
-    crate::predict::config::check_client(&client, "--concurrency/--timeout/--max-retries:")?;
+    rh_runner::predict::config::check_client(&client, "--concurrency/--timeout/--max-retries:")?;
     let generation = Generation {
         temperature: a.temperature.unwrap_or(cfg.generation.temperature),
         max_tokens: a.max_tokens.unwrap_or(cfg.generation.max_tokens),
     };
-    crate::predict::config::check_generation(&generation, "--temperature/--max-tokens:")?;
+    rh_runner::predict::config::check_generation(&generation, "--temperature/--max-tokens:")?;
     for (flag, v) in [("--price-in", a.price_in), ("--price-out", a.price_out)] {
         if v.is_some_and(|p| !(p.is_finite() && p >= 0.0)) {
             return Err(InputError(format!(
@@ -58,7 +58,7 @@ pub fn run(a: PredictArgs) -> Result<()> {
             output: o.or(t.map(|p| p.output)).unwrap_or(0.0),
         }),
     };
-    crate::predict::check_price(&a.model, a.max_cost, price)?;
+    rh_runner::predict::check_price(&a.model, a.max_cost, price)?;
     if price.is_none() && !a.dry_run {
         rh_contract::note!(
             "rh-score predict: no price for model {:?} in the price table: its cost counts as $0 (give --price-in/--price-out for a real figure)",
@@ -67,8 +67,8 @@ pub fn run(a: PredictArgs) -> Result<()> {
     }
     let dataset = resolve_dataset(a.dataset.clone(), a.allow_incomplete)?;
     let ds = Dataset::load(&dataset)?;
-    let scenes = crate::predict::select_scenes(&ds, a.subset, a.limit)?;
-    let opts = crate::predict::PredictOptions {
+    let scenes = rh_prompt::select_scenes(&ds, a.subset, a.limit)?;
+    let opts = rh_runner::predict::PredictOptions {
         dataset,
         model: a.model.clone(),
         out: a.out.clone().unwrap_or_default(),
@@ -91,7 +91,7 @@ pub fn run(a: PredictArgs) -> Result<()> {
         progress_every_s: cfg.run.progress_every_s,
     };
     if a.dry_run {
-        let req = crate::predict::dry_run(&opts, &scenes)?;
+        let req = rh_runner::predict::dry_run(&opts, &scenes)?;
         let e = &req["estimate"];
         rh_contract::note!(
             "rh-score predict --dry-run: {} scenes ≈ {} input tokens ({} a scene) + at most {} output tokens; cost {}",
@@ -106,7 +106,7 @@ pub fn run(a: PredictArgs) -> Result<()> {
         );
         return print_out(&(serde_json::to_string_pretty(&req)? + "\n"));
     }
-    let s = crate::predict::run(&opts, &scenes)?;
+    let s = rh_runner::predict::run(&opts, &scenes)?;
     if a.json {
         print_out(&(serde_json::to_string_pretty(&s)? + "\n"))?;
     } else {

@@ -1,20 +1,21 @@
-//! `rh-score PREDS`: scoring a predictions file ([`crate::score::Scoring`]), the report
-//! ([`crate::report::Report`]), `--execute` ([`crate::execute_scored::execute_scored`]) and the
+//! `rh-score PREDS`: scoring a predictions file ([`rh_grade::score::Scoring`]), the report
+//! ([`rh_grade::report::Report`]), `--execute` ([`rh_execute::execute_scored`]) and the
 //! output files and terminal tables the arguments ask for.
 
 use super::args::Cli;
 use super::dataset_arg::resolve_dataset;
-use super::output::{load_config, print_out, write_file, SharedFile};
-use crate::error::InputError;
-use crate::{Dataset, Report};
+use super::output::{load_config, print_out, write_file};
 use anyhow::{Context, Result};
+use rh_contract::fsio::SharedFile;
+use rh_grade::error::InputError;
+use rh_grade::{Dataset, Report};
 use std::path::Path;
 
 /// `rh-score PREDS --dataset DIR`: scores, then writes each report asked for.
 pub fn run(cli: Cli) -> Result<()> {
     let cfg = load_config(cli.config.as_deref())?;
     if cli.explain {
-        print_out(&crate::explain::explain(&cfg))?;
+        print_out(&rh_grade::explain::explain(&cfg))?;
         if cli.preds.is_none() {
             return Ok(());
         }
@@ -28,12 +29,6 @@ pub fn run(cli: Cli) -> Result<()> {
     if cli.html.is_some() && preds.as_os_str() == "-" {
         return Err(InputError(
             "--html reads the predictions twice (per-decision details for the scene pages): give a file, not stdin".into(),
-        )
-        .into());
-    }
-    if cli.execute && !cfg!(feature = "execute") {
-        return Err(InputError(
-            "--execute: this rh-score was built without the `execute` feature (no simulator); build it with default features (cargo build --release -p rh-score)".into(),
         )
         .into());
     }
@@ -52,8 +47,8 @@ pub fn run(cli: Cli) -> Result<()> {
     };
     let open = decisions
         .clone()
-        .map(|d| -> crate::api::OpenDecisions { Box::new(move || Ok(Box::new(d))) });
-    let opts = crate::api::ScoreOptions {
+        .map(|d| -> rh_grade::api::OpenDecisions { Box::new(move || Ok(Box::new(d))) });
+    let opts = rh_grade::api::ScoreOptions {
         subset: cli.subset,
         answered_only: cli.answered_only,
         decisions: open,
@@ -61,43 +56,59 @@ pub fn run(cli: Cli) -> Result<()> {
         compare: cli.compare.as_ref().map(|p| [p[0].clone(), p[1].clone()]),
     };
     let source = if preds.as_os_str() == "-" {
-        crate::api::Preds::Stdin
+        rh_grade::api::Preds::Stdin
     } else {
-        crate::api::Preds::Path(&preds)
+        rh_grade::api::Preds::Path(&preds)
     };
-    let crate::api::Scored {
+    let rh_grade::api::Scored {
         mut scoring,
         mut report,
-    } = crate::api::score(&ds, &cfg, source, opts)?;
+    } = rh_grade::api::score(&ds, &cfg, source, opts)?;
     if cli.results.is_some() {
         // A clash of results file names is found before any output is written.
-        crate::results::check_file_names(scoring.models.iter().map(|m| m.name.as_str()))?;
+        rh_report::results::check_file_names(scoring.models.iter().map(|m| m.name.as_str()))?;
     }
     if cli.execute {
         let cache = (!cli.no_exec_cache).then(|| {
             cli.exec_cache
                 .clone()
-                .unwrap_or_else(crate::execution::default_cache_dir)
+                .unwrap_or_else(rh_execute::default_cache_dir)
         });
         let videos = cli
             .execute_videos
             .as_deref()
-            .map(|dir| crate::execution::VideoRequest {
+            .map(|dir| rh_execute::VideoRequest {
                 dir,
                 scenes: cli.video_scenes.as_deref(),
                 tiled_scene: cli.tiled_scene.as_deref(),
                 progress: !cli.quiet,
             });
-        report.execution = Some(crate::execute_scored::execute_scored(
+        #[cfg(feature = "videos")]
+        let mut draw = |pending: &[_], outcomes: &[_], names: &[_]| match &videos {
+            Some(req) => rh_execute_videos::draw_and_note(&ds, pending, outcomes, names, &cfg, req),
+            None => Ok(()),
+        };
+        #[cfg(not(feature = "videos"))]
+        let mut draw = |_: &[rh_execute::Pending],
+                        _: &[Option<rh_contract::execution::Outcome>],
+                        _: &[String]| {
+            Ok(()) // --execute-videos was refused above
+        };
+        report.execution = Some(rh_execute::execute_scored(
             &mut scoring,
             &ds,
             &cfg,
             cache.as_deref(),
-            videos,
+            videos
+                .is_some()
+                .then_some(&mut draw as rh_execute::DrawVideos),
         )?);
     }
     let identity = match cli.results {
-        Some(_) => Some(crate::results::DatasetIdentity::of(&ds, &scoring.expected)?),
+        Some(_) => Some(rh_report::results::DatasetIdentity::of(
+            &ds,
+            &scoring.expected,
+        )?),
         None => None,
     };
     drop(scoring);
@@ -105,9 +116,9 @@ pub fn run(cli: Cli) -> Result<()> {
         d.commit()?;
     }
     if let (Some(dir), Some(identity)) = (&cli.results, &identity) {
-        let scoring_id = crate::results::ScoringIdentity::of(&cfg, cli.answered_only);
-        let files = crate::results::results_files(&report, identity, &scoring_id);
-        for p in crate::results::write_results(dir, &files)? {
+        let scoring_id = rh_report::results::ScoringIdentity::of(&cfg, cli.answered_only);
+        let files = rh_report::results::results_files(&report, identity, &scoring_id);
+        for p in rh_report::results::write_results(dir, &files)? {
             rh_contract::note!("rh-score: results file {}", p.display());
         }
     }
@@ -120,7 +131,7 @@ fn write_reports(
     cli: &Cli,
     report: &Report,
     ds: &Dataset,
-    cfg: &crate::Config,
+    cfg: &rh_grade::Config,
     preds: &Path,
 ) -> Result<()> {
     let json_stdout = cli.json.as_deref() == Some(Path::new("-"));
@@ -133,32 +144,40 @@ fn write_reports(
         }
     }
     if let Some(p) = &cli.csv {
-        write_file(p, "the CSV report", &crate::tables::csv(report))?;
+        write_file(p, "the CSV report", &rh_grade::tables::csv(report))?;
         if let Some(e) = &report.execution {
             // Outcome rates have other columns: their own file beside it, FILE.execution.csv.
             let q = p.with_extension("execution.csv");
-            write_file(&q, "the execution CSV", &crate::execution::report::csv(e))?;
+            write_file(
+                &q,
+                "the execution CSV",
+                &rh_grade::execution::report::csv(e),
+            )?;
         }
     }
     if let Some(p) = &cli.markdown {
-        write_file(p, "the Markdown report", &crate::tables::markdown(report))?;
+        write_file(
+            p,
+            "the Markdown report",
+            &rh_grade::tables::markdown(report),
+        )?;
     }
     if let Some(d) = &cli.figures {
-        crate::figures::write_figures(report, d)?;
+        rh_report::figures::write_figures(report, d)?;
     }
     let site = match &cli.html {
-        Some(dir) => Some(crate::html::write_site(report, ds, cfg, preds, dir)?),
+        Some(dir) => Some(rh_report::html::write_site(report, ds, cfg, preds, dir)?),
         None => None,
     };
     if !cli.quiet && !json_stdout {
-        print_out(&crate::tables::terminal(report))?;
+        print_out(&rh_grade::tables::terminal(report))?;
         if let Some(e) = &report.execution {
-            print_out(&crate::execution::report::terminal(e, 50))?;
+            print_out(&rh_grade::execution::report::terminal(e, 50))?;
         }
     } else if let Some(e) = &report.execution {
         // The disagreements are always listed (on stderr when stdout is taken).
         if !e.disagreements.is_empty() {
-            rh_contract::note_part!("{}", crate::execution::report::terminal(e, 50));
+            rh_contract::note_part!("{}", rh_grade::execution::report::terminal(e, 50));
         }
     }
     if let Some(site) = site {
@@ -176,6 +195,6 @@ fn write_reports(
             index.display()
         );
     }
-    rh_contract::note_part!("{}", crate::refusal::stderr_notes(report));
+    rh_contract::note_part!("{}", rh_grade::refusal::stderr_notes(report));
     Ok(())
 }
