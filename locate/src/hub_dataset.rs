@@ -45,7 +45,7 @@ pub fn resolve_dir(arg: Option<String>) -> Result<PathBuf> {
                 Ok(Some(note)) => rh_contract::note!("rh-score: {note}"),
                 Ok(None) => {}
                 Err(e) => {
-                    let paper = crate::dataset_diagnosis::paper_scene_folders(&snapshot.path);
+                    let paper = rh_grade::dataset_diagnosis::paper_scene_folders(&snapshot.path);
                     return Err(InputError(match paper {
                         0 => e,
                         _ => format!("{e} ({paper} scene folders <family>/<family>__dN_vM/: the paper's metadata-only layout)"),

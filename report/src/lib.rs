@@ -11,7 +11,7 @@ use rh_grade::synthetic;
 #[allow(unused_imports)]
 use rh_grade::{
     action_rule, aia, baseline, config, coverage, dataset, error, execution, metrics, preds,
-    report, safety_rule, score, text_table,
+    report, safety_rule, score, stats, text_table,
 };
 
 pub mod figures;
