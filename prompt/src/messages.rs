@@ -561,11 +561,7 @@ mod tests {
         {
             let out = d.path().join(format!("child{i}.jpg"));
             let st = std::process::Command::new(std::env::current_exe().unwrap())
-                .args([
-                    "--exact",
-                    "messages::tests::encode_child",
-                    "--ignored",
-                ])
+                .args(["--exact", "messages::tests::encode_child", "--ignored"])
                 .env(CHILD_ENV, format!("{}\n{}", f.display(), out.display()))
                 .env(force, "1")
                 .stdout(std::process::Stdio::null())
