@@ -274,7 +274,7 @@ struct RawConfig {
     #[serde(default)]
     probes: ProbeConfig,
     #[serde(default)]
-    decor: crate::decor::DecorConfig,
+    decor: DecorConfig,
 }
 
 /// The whole, validated build configuration (`Deserialize` reads back the copy a build
@@ -301,7 +301,7 @@ pub struct Config {
     pub probes: ProbeConfig,
     /// How rooms are furnished (`decor`; absent in manifests of older builds: bare rooms).
     #[serde(default)]
-    pub decor: crate::decor::DecorConfig,
+    pub decor: DecorConfig,
     /// Where the configuration came from (for messages; not part of its content).
     #[serde(skip)]
     pub source: String,
@@ -747,6 +747,32 @@ pub struct ProbePair {
 
 fn yes() -> bool {
     true
+}
+
+/// `[decor]` of `configs/default.toml` (how rooms are furnished, `decor::furnish`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DecorConfig {
+    /// Whether rooms are furnished at all.
+    pub enabled: bool,
+    /// Gap kept between a piece and the space the event's bodies take (m).
+    pub clearance_m: f64,
+    /// Kept clear around the observer beyond the escape walks' length (m).
+    pub observer_clearance_m: f64,
+    /// Positions drawn for a piece before it is left out.
+    pub tries: u32,
+}
+
+impl Default for DecorConfig {
+    /// Absent in the manifests of older builds: no decor.
+    fn default() -> Self {
+        DecorConfig {
+            enabled: false,
+            clearance_m: 0.25,
+            observer_clearance_m: 0.45,
+            tries: 8,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -31,31 +31,7 @@ use rh_physics::spec::{
 };
 use serde::{Deserialize, Serialize};
 
-/// `[decor]` of `configs/default.toml`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct DecorConfig {
-    /// Whether rooms are furnished at all.
-    pub enabled: bool,
-    /// Gap kept between a piece and the space the event's bodies take (m).
-    pub clearance_m: f64,
-    /// Kept clear around the observer beyond the escape walks' length (m).
-    pub observer_clearance_m: f64,
-    /// Positions drawn for a piece before it is left out.
-    pub tries: u32,
-}
-
-impl Default for DecorConfig {
-    /// Absent in the manifests of older builds: no decor.
-    fn default() -> Self {
-        DecorConfig {
-            enabled: false,
-            clearance_m: 0.25,
-            observer_clearance_m: 0.45,
-            tries: 8,
-        }
-    }
-}
+pub use crate::config::DecorConfig;
 
 /// How far a piece may reach into its wall (m): a window's or door's frame is set in it.
 const WALL_SLACK: f64 = 0.03;
