@@ -23,13 +23,12 @@
 use crate::config::Config;
 use rand::RngExt;
 use rh_catalog::decor::DecorPiece;
-use rh_catalog::{Catalog, ShapeKind};
+use rh_catalog::Catalog;
 use rh_physics::seeds;
 use rh_physics::simulate::Simulation;
 use rh_physics::spec::{
     quat, BodyKind, BodyRole, BodySpec, PartSpec, SceneSpec, ShapeSpec, Vec3, IDENTITY,
 };
-use serde::{Deserialize, Serialize};
 
 pub use crate::config::DecorConfig;
 
@@ -232,22 +231,7 @@ fn piece_body(piece: &DecorPiece, index: usize, position: Vec3, yaw: f64) -> (Bo
         .parts
         .iter()
         .map(|p| PartSpec {
-            shape: match p.shape {
-                ShapeKind::Box => ShapeSpec::Box {
-                    half_extents: [p.size[0] / 2.0, p.size[1] / 2.0, p.size[2] / 2.0],
-                },
-                ShapeKind::Sphere => ShapeSpec::Sphere {
-                    radius: p.size[0] / 2.0,
-                },
-                ShapeKind::Cylinder => ShapeSpec::Cylinder {
-                    half_height: p.size[1] / 2.0,
-                    radius: p.size[0] / 2.0,
-                },
-                ShapeKind::Capsule => ShapeSpec::Capsule {
-                    half_height: (p.size[1] - p.size[0]).max(0.0) / 2.0,
-                    radius: p.size[0] / 2.0,
-                },
-            },
+            shape: crate::families::spec_shape(p.shape, &p.size),
             offset: p.offset,
             rotation: IDENTITY,
         })

@@ -147,28 +147,34 @@ pub fn get(name: &str) -> Option<&'static dyn Family> {
 // ---------------------------------------------------------------------------
 // Shared building blocks for samplers.
 
+/// A catalog part's shape (full extents, as `objects.toml` and `decor.toml` give them)
+/// as a spec shape (half extents, radii); a capsule's length is end to end.
+pub fn spec_shape(shape: ShapeKind, size: &[f64]) -> ShapeSpec {
+    match shape {
+        ShapeKind::Box => ShapeSpec::Box {
+            half_extents: [size[0] / 2.0, size[1] / 2.0, size[2] / 2.0],
+        },
+        ShapeKind::Sphere => ShapeSpec::Sphere {
+            radius: size[0] / 2.0,
+        },
+        ShapeKind::Cylinder => ShapeSpec::Cylinder {
+            half_height: size[1] / 2.0,
+            radius: size[0] / 2.0,
+        },
+        ShapeKind::Capsule => ShapeSpec::Capsule {
+            half_height: (size[1] - size[0]).max(0.0) / 2.0,
+            radius: size[0] / 2.0,
+        },
+    }
+}
+
 /// Converts catalog parts into spec parts.
 pub fn object_parts(object: &Object) -> Vec<PartSpec> {
     object
         .parts
         .iter()
         .map(|p| PartSpec {
-            shape: match p.shape {
-                ShapeKind::Box => ShapeSpec::Box {
-                    half_extents: [p.size[0] / 2.0, p.size[1] / 2.0, p.size[2] / 2.0],
-                },
-                ShapeKind::Sphere => ShapeSpec::Sphere {
-                    radius: p.size[0] / 2.0,
-                },
-                ShapeKind::Cylinder => ShapeSpec::Cylinder {
-                    half_height: p.size[1] / 2.0,
-                    radius: p.size[0] / 2.0,
-                },
-                ShapeKind::Capsule => ShapeSpec::Capsule {
-                    half_height: (p.size[1] - p.size[0]) / 2.0,
-                    radius: p.size[0] / 2.0,
-                },
-            },
+            shape: spec_shape(p.shape, &p.size),
             offset: p.offset,
             rotation: IDENTITY,
         })
