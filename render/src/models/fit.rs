@@ -9,7 +9,7 @@
 
 use super::LoadedModel;
 use crate::mesh::{Mesh, Vertex, Xf, V3};
-use rh_physics::spec::{PartSpec, ShapeSpec};
+use rh_physics::spec::PartSpec;
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FitError {
@@ -36,18 +36,7 @@ pub fn parts_box(parts: &[PartSpec]) -> (V3, V3) {
     let mut lo = [f32::MAX; 3];
     let mut hi = [f32::MIN; 3];
     for p in parts {
-        let h: V3 = match p.shape {
-            ShapeSpec::Box { half_extents } => half_extents.map(|v| v as f32),
-            ShapeSpec::Sphere { radius } => [radius as f32; 3],
-            ShapeSpec::Cylinder {
-                half_height,
-                radius,
-            } => [radius as f32, radius as f32, half_height as f32],
-            ShapeSpec::Capsule {
-                half_height,
-                radius,
-            } => [radius as f32, radius as f32, (half_height + radius) as f32],
-        };
+        let h: V3 = crate::recipes::part_half(p);
         let xf = Xf::from_quat(p.rotation, p.offset);
         for k in 0..3 {
             // Half extent of the rotated box along world axis k.

@@ -27,7 +27,8 @@ pub struct Look<'a> {
     pub parts: &'a [PartSpec],
 }
 
-fn part_half(p: &PartSpec) -> V3 {
+/// Half extents of one part's own axis-aligned box (in the part's frame).
+pub(crate) fn part_half(p: &PartSpec) -> V3 {
     match p.shape {
         ShapeSpec::Box { half_extents: h } => h.map(|v| v as f32),
         ShapeSpec::Sphere { radius } => [radius as f32; 3],
