@@ -223,6 +223,8 @@ struct RawRoom {
     #[serde(default)]
     families: Vec<String>,
     #[serde(default)]
+    excludes: Vec<String>,
+    #[serde(default)]
     stairs: bool,
 }
 
@@ -246,6 +248,8 @@ pub struct Room {
     pub floor_color: String,
     /// Families this room hosts; empty means all (but `stair_tumble` only where `stairs`).
     pub families: Vec<String>,
+    /// Families this room is too small for (a throw the room cannot hold).
+    pub excludes: Vec<String>,
     /// Whether the room has a staircase (the only rooms `stair_tumble` happens in).
     pub stairs: bool,
 }
@@ -256,6 +260,7 @@ pub const STAIRS_FAMILY: &str = "stair_tumble";
 impl Room {
     pub fn hosts(&self, family: &str) -> bool {
         (self.families.is_empty() || self.families.iter().any(|f| f == family))
+            && !self.excludes.iter().any(|f| f == family)
             && (family != STAIRS_FAMILY || self.stairs)
     }
 }
@@ -758,6 +763,7 @@ fn validate_rooms(file: &str, raw: Vec<RawRoom>) -> Result<Vec<Room>, CatalogErr
         check.color("wall_color", &r.wall_color)?;
         check.color("floor_color", &r.floor_color)?;
         check.families("families", &r.families)?;
+        check.families("excludes", &r.excludes)?;
         rooms.push(Room {
             id: r.id,
             name: r.name,
@@ -772,6 +778,7 @@ fn validate_rooms(file: &str, raw: Vec<RawRoom>) -> Result<Vec<Room>, CatalogErr
             wall_color: r.wall_color,
             floor_color: r.floor_color,
             families: r.families,
+            excludes: r.excludes,
             stairs: r.stairs,
         });
     }

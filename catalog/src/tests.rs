@@ -1074,6 +1074,26 @@ fn a_room_restricted_to_some_families_hosts_only_those() {
     assert_eq!(cat.rooms_for_family("object_drop").count(), 0);
 }
 
+#[test]
+fn a_room_too_small_for_a_family_excludes_it() {
+    let rooms = format!("{ROOMS_OK}excludes = [\"thrown_object\"]\n");
+    let cat = Catalog::from_sources(
+        ("objects.toml", &object_entry("block", &[])),
+        ("rooms.toml", &rooms),
+    )
+    .unwrap();
+    let lab = cat.room("lab").unwrap();
+    assert!(lab.hosts("door_swing") && !lab.hosts("thrown_object"));
+    assert_eq!(cat.rooms_for_family("thrown_object").count(), 0);
+    let bad = format!("{ROOMS_OK}excludes = [\"juggling\"]\n");
+    let e = Catalog::from_sources(
+        ("objects.toml", &object_entry("block", &[])),
+        ("rooms.toml", &bad),
+    )
+    .expect_err("an unknown family must fail");
+    assert_names(&e, "rooms.toml", Some("lab"), Some("excludes"), "juggling");
+}
+
 // ------------------------------------------------------------------ loading from a directory
 
 fn temp_dir(tag: &str) -> PathBuf {

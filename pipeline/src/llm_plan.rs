@@ -283,7 +283,7 @@ mod tests {
         let c = Catalog::embedded().unwrap();
         let ok = validate(
             &c,
-            "Sure: {\"family\": \"thrown_object\", \"object_id\": \"steel_apple\", \"room_id\": \"kitchen\"}",
+            "Sure: {\"family\": \"bouncing_object\", \"object_id\": \"steel_apple\", \"room_id\": \"kitchen\"}",
         )
         .unwrap();
         assert_eq!(ok.1, "steel_apple");

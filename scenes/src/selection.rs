@@ -526,11 +526,11 @@ mod tests {
         let c = catalog();
         let p = LexiconPlanner::new(&c);
         let s = p
-            .plan("A steel apple is thrown at the robot in the kitchen", 1)
+            .plan("A steel apple bounces toward the robot in the kitchen", 1)
             .unwrap();
         assert_eq!(
             (s.object_id.as_str(), s.family.as_str(), s.room_id.as_str()),
-            ("steel_apple", "thrown_object", "kitchen")
+            ("steel_apple", "bouncing_object", "kitchen")
         );
         // The longest name wins: "steel apple" over "apple".
         let s = p.plan("an apple rolls off the counter", 1).unwrap();

@@ -185,7 +185,7 @@ fn cupped_hands() -> ExecPlan {
     }
 }
 
-/// A thrown-object scene (gym, tennis ball) without gravity, its hazard replaced by a box
+/// A thrown-object scene (gym, soccer ball) without gravity, its hazard replaced by a box
 /// slab of `half` extents and `mass` kg at `position`, turned with the observer and flying
 /// at `velocity` from t = 0 without spin or bounce.
 fn flung_slab(
@@ -197,7 +197,7 @@ fn flung_slab(
     let config = Config::embedded().unwrap();
     let selection = Selection {
         family: "thrown_object".into(),
-        object_id: "tennis_ball".into(),
+        object_id: "soccer_ball".into(),
         room_id: "gym".into(),
         description: None,
         planner: None,

@@ -388,6 +388,79 @@ fn pendulum_small_angle_period_matches_the_physical_pendulum() {
     }
 }
 
+/// A heavy, tall piece starts far enough past balance that even the slowest band (no
+/// push) tips visibly in the window: its top travels `MIN_TOP_TRAVEL_M` by Δ, by the
+/// edge pendulum's equation of motion; and in the simulation too (within 20%).
+#[test]
+fn the_slowest_furniture_band_tips_visibly_in_the_window() {
+    use families::furniture_tip::{front_edge, least_past_balance, tilt_after, MIN_TOP_TRAVEL_M};
+    let catalog = Catalog::embedded().unwrap();
+    let objects: Vec<_> = catalog.objects_for_family("furniture_tip").collect();
+    assert!(
+        objects.iter().any(|o| least_past_balance(o, 0.0) > 0.02),
+        "some piece needs more"
+    );
+    for object in objects {
+        let past = least_past_balance(object, 0.0).max(0.006);
+        let (_, balance) = front_edge(object);
+        let height = families::top_offset(object) + families::bottom_offset(object);
+        let travel = (tilt_after(object, past, 0.0, 0.6) - balance - past) * height;
+        assert!(
+            travel >= MIN_TOP_TRAVEL_M - 1e-6,
+            "{}: {travel} m",
+            object.id
+        );
+    }
+    for r in scenes("furniture_tip", 3)
+        .into_iter()
+        .filter(|r| r.spec.speed_value == 0.0)
+    {
+        let sim = plain(&r.spec);
+        let tilt = |k: u32| {
+            families::up_z(sim.hazard_state(k).rotation)
+                .clamp(-1.0, 1.0)
+                .acos()
+        };
+        let k = r.spec.decision_step();
+        let travel = (tilt(k) - tilt(0)) * r.spec.family_params["height_m"];
+        assert!(
+            travel >= 0.8 * MIN_TOP_TRAVEL_M,
+            "{}: {travel} m",
+            r.spec.selection.object_id
+        );
+    }
+}
+
+/// Every room that hosts throws holds the fastest band's throw for `MIN_FLIGHT_S` (the
+/// throw is redrawn until it does), so it never arrives too soon to react; the rooms too
+/// small for it (4.5 × 4 m) do not host the family.
+#[test]
+fn every_throw_lasts_long_enough_to_react() {
+    use families::thrown_object::MIN_FLIGHT_S;
+    let catalog = Catalog::embedded().unwrap();
+    assert!(!catalog.room("bedroom").unwrap().hosts("thrown_object"));
+    assert!(!catalog.room("hallway").unwrap().hosts("thrown_object"));
+    let rooms: Vec<_> = catalog.rooms_for_family("thrown_object").collect();
+    assert!(rooms.len() >= 6);
+    for room in rooms {
+        for index in [3, 7, 11, 15, 19] {
+            let spec = custom_scene(
+                "thrown_object",
+                "bowling_ball",
+                &room.id,
+                [5.2, 5.8, 6.4, 7.4],
+                index,
+            );
+            let t = spec.family_params["flight_s"];
+            assert!(
+                t >= MIN_FLIGHT_S - 1e-9,
+                "{} scene {index}: flight {t} s",
+                room.id
+            );
+        }
+    }
+}
+
 #[test]
 fn an_aimed_throw_meets_the_observer_at_the_sampled_height() {
     use families::thrown_object::{launch_velocity, longest_flight, FLIGHT_S};
@@ -405,14 +478,14 @@ fn an_aimed_throw_meets_the_observer_at_the_sampled_height() {
         let tmax = longest_flight(v, 4.0, h0, h);
         assert!(launch_velocity(v, tmax, h0, h).1 <= 4.0 + 1e-9);
     }
-    // In the simulation, every band of a group (a tennis ball in the gym): the release
+    // In the simulation, every band of a group (a soccer ball in the gym): the release
     // speed is the band's, the flight lasts past Δ + the reaction time, and the centre
     // of mass is at the target point (beside the observer, at the sampled height) when
     // the flight ends.
     for band in 0..4 {
         let spec = custom_scene(
             "thrown_object",
-            "tennis_ball",
+            "soccer_ball",
             "gym",
             [5.2, 5.8, 6.4, 7.4],
             band,
@@ -451,10 +524,10 @@ fn an_aimed_throw_meets_the_observer_at_the_sampled_height() {
 #[test]
 fn bouncing_height_ratio_is_the_restitution_squared() {
     for (object, room) in [
-        ("tennis_ball", "kitchen"),
+        ("soccer_ball", "kitchen"),
         ("basketball", "gym"),
-        ("rubber_ball", "living_room"),
-        ("golf_ball", "garage"),
+        ("basketball", "living_room"),
+        ("soccer_ball", "garage"),
     ] {
         let spec = custom_scene("bouncing_object", object, room, [1.5; 4], 2);
         let sim = plain(&spec);

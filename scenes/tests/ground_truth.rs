@@ -24,7 +24,14 @@ fn setup() -> (Catalog, Config) {
 
 /// A thrown-object spec for `object` (only the hazard as a body), observer at the origin.
 fn constructed(object: &str) -> SceneSpec {
-    let (catalog, config) = setup();
+    let (mut catalog, config) = setup();
+    // A constructed throw may carry any object, also one the catalog does not list for
+    // thrown_object (too small to be seen thrown from 5–8 m): the observer is placed here.
+    for o in catalog.objects.iter_mut().filter(|o| o.id == object) {
+        if !o.families.iter().any(|f| f == "thrown_object") {
+            o.families.push("thrown_object".into());
+        }
+    }
     let selection = Selection {
         family: "thrown_object".into(),
         object_id: object.into(),

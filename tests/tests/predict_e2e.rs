@@ -660,7 +660,7 @@ fn llm_planner_validates_reasks_falls_back_and_caches() {
     let d = dir.path();
     let bad = r#"select:{"family": "juggling", "object_id": "apple", "room_id": "kitchen"}"#;
     let good =
-        r#"select:{"family": "thrown_object", "object_id": "steel_apple", "room_id": "kitchen"}"#;
+        r#"select:{"family": "bouncing_object", "object_id": "steel_apple", "room_id": "kitchen"}"#;
     let srv = Server::start(d, bad, &good, &[]);
     let text = "someone throws a heavy apple-shaped thing at the robot";
     let o = pipeline(

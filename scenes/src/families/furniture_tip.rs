@@ -7,7 +7,8 @@
 //! floor. Gravity sets the pace of the fall (`speed_sweep = false`).
 //!
 //! Timing (label rule v2): the piece starts only 0.006–0.02 rad past balance with a gentle
-//! push, so its fall starts slowly (an inverted pendulum grows like `e^{λt}`), and the
+//! push (a heavy, tall piece starts just far enough past it that even the slowest band's
+//! top travels 0.1 m in the observation window), so its fall starts slowly (an inverted pendulum grows like `e^{λt}`), and the
 //! observer stands where only the late part of the fall reaches: beyond the front face's
 //! reach at the angle the fastest band's piece has fallen to 1 s after t0 (integrated from
 //! the rigid body's equation of motion about its edge, `φ'' = (g r_c / k²) sin φ`).
@@ -91,6 +92,36 @@ pub fn tilt_after(object: &Object, past: f64, omega0: f64, t: f64) -> f64 {
     balance + phi
 }
 
+/// The observation window Δ of the default configuration (s).
+const WINDOW_S: f64 = 0.6;
+/// How far the top of the slowest band's piece travels at least in the window (m): about
+/// 25 ego pixels at the observer's distance, twice the motion rule's minimum.
+pub const MIN_TOP_TRAVEL_M: f64 = 0.1;
+
+/// The least angle past balance (rad, at most 0.2) at which a piece pushed so that its top
+/// moves at `speed` tilts far enough in the window for its top to travel
+/// [`MIN_TOP_TRAVEL_M`] (bisection on [`tilt_after`]).
+pub fn least_past_balance(object: &Object, speed: f64) -> f64 {
+    let height = top_offset(object) + bottom_offset(object);
+    let travel = |past: f64| {
+        let (_, balance) = front_edge(object);
+        (tilt_after(object, past, speed / height, WINDOW_S) - balance - past) * height
+    };
+    if travel(0.0) >= MIN_TOP_TRAVEL_M {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = (0.0, 0.2);
+    for _ in 0..30 {
+        let mid = 0.5 * (lo + hi);
+        if travel(mid) >= MIN_TOP_TRAVEL_M {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
+}
+
 /// How far in front of the edge (horizontally) the front face of a piece of height
 /// `height` tilted `tilt` from upright reaches at torso heights (up to the top of the
 /// torso capsule's straight part).
@@ -112,7 +143,15 @@ impl Family for FurnitureTip {
         let object = input.object;
         let heading_angle = uniform(rng, 0.0, std::f64::consts::TAU);
         let dir = heading(heading_angle);
-        let past_balance = uniform(rng, 0.006, 0.02);
+        // Past balance by 0.006–0.02 rad, or, for a piece so heavy and tall that the
+        // slowest band would hardly stir in the observation window, by the least angle at
+        // which its top travels `MIN_TOP_TRAVEL_M` in it (and up to 0.014 rad more).
+        let slowest = input
+            .band_speeds
+            .iter()
+            .fold(f64::INFINITY, |a: f64, &b| a.min(b));
+        let least = least_past_balance(object, slowest);
+        let past_balance = least.max(0.006) + uniform(rng, 0.0, 0.014);
         let origin = event_origin(rng, input.room, dir, 0.9 + far_shift(input));
 
         let (edge, balance) = front_edge(object);

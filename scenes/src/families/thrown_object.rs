@@ -40,6 +40,110 @@ pub fn launch_velocity(speed: f64, flight: f64, h0: f64, h: f64) -> (f64, f64) {
     ((speed * speed - vz * vz).max(0.0).sqrt(), vz)
 }
 
+/// The shortest flight (s) of a throw's fastest band: it reaches the observer's reach at
+/// least Δ + the reaction time (0.8 s) after the release.
+pub const MIN_FLIGHT_S: f64 = 0.85;
+/// How many throws a layout draws at most to find one the room holds for [`MIN_FLIGHT_S`].
+const THROW_DRAWS: u32 = 16;
+
+/// One drawn throw: its heading, release height, drawn flight time, target and spin.
+#[derive(Clone, Copy)]
+struct Throw {
+    heading_angle: f64,
+    dir: [f64; 2],
+    side: [f64; 2],
+    launch_height: f64,
+    flight: f64,
+    ahead_d: f64,
+    across: f64,
+    height: f64,
+    spin: [f64; 3],
+    yaw: f64,
+    vz_ceiling: f64,
+    span: f64,
+}
+
+impl Throw {
+    /// The flight time of a band thrown at `v`: the drawn one, less where the ceiling
+    /// caps the arc or the room the range (bisection on t).
+    fn flight_of(&self, v: f64) -> f64 {
+        let (h0, h) = (self.launch_height, self.height);
+        let t = self.flight.min(longest_flight(v, self.vz_ceiling, h0, h));
+        let (vh, _) = launch_velocity(v, t, h0, h);
+        if vh * t <= self.span {
+            return t;
+        }
+        let (mut lo, mut hi) = (0.05, t);
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if launch_velocity(v, mid, h0, h).0 * mid > self.span {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        lo
+    }
+}
+
+/// Draws a throw: heading, release height, flight time, the target where the group's
+/// intent puts it, spin and yaw.
+fn draw_throw(input: &FamilyInput, rng: &mut ChaCha8Rng) -> Throw {
+    let room = input.room;
+    let heading_angle = diagonal_heading(rng, room, 0.05);
+    let dir = heading(heading_angle);
+    let side = left_of(dir);
+    let launch_height = uniform(rng, 1.0, 1.3);
+    let flight = uniform(rng, FLIGHT_S[0], FLIGHT_S[1]);
+    // Where the target lies from the torso axis: `ahead` toward the thrower, `across`
+    // to the side, at `height`.
+    let (ahead_d, across, height) = match input.intent {
+        Intent::Hands => (
+            uniform(rng, 0.2, 0.4),
+            uniform(rng, -0.15, 0.15),
+            uniform(rng, 0.75, 1.15),
+        ),
+        Intent::Body => (
+            uniform(rng, -0.05, 0.05),
+            uniform(rng, -0.05, 0.05),
+            uniform(rng, 1.0, 1.3),
+        ),
+        Intent::Miss => {
+            let off = uniform(rng, 1.8, 2.2);
+            let sign = if uniform(rng, 0.0, 1.0) < 0.5 {
+                -1.0
+            } else {
+                1.0
+            };
+            (0.0, off * sign, uniform(rng, 0.6, 1.2))
+        }
+    };
+    let spin = [
+        uniform(rng, -6.0, 6.0),
+        uniform(rng, -6.0, 6.0),
+        uniform(rng, -6.0, 6.0),
+    ];
+    let yaw = uniform(rng, 0.0, std::f64::consts::TAU);
+    let radius = input.object.half_extents().into_iter().fold(0.0, f64::max);
+    let rise = room.ceiling_height - CEILING_CLEARANCE - radius - launch_height;
+    // Each band's flight and range; the room must hold the longest range plus the
+    // observer's offset.
+    Throw {
+        heading_angle,
+        dir,
+        side,
+        launch_height,
+        flight,
+        ahead_d,
+        across,
+        height,
+        spin,
+        yaw,
+        vz_ceiling: (2.0 * GRAVITY * rise.max(0.0)).sqrt(),
+        span: room_span(room, dir, WALL_MARGIN) - ahead_d.max(0.0),
+    }
+}
+
 impl Family for ThrownObject {
     fn info(&self) -> FamilyInfo {
         FamilyInfo {
@@ -54,65 +158,32 @@ impl Family for ThrownObject {
     }
 
     fn sample(&self, input: &FamilyInput, rng: &mut ChaCha8Rng) -> Layout {
+        // A throw whose fastest band the room cannot hold for MIN_FLIGHT_S (its ceiling
+        // caps the arc, its length the range) arrives too soon to react: the throw is
+        // drawn again, up to THROW_DRAWS times (the last draw stands).
+        let fastest = input.band_speeds.iter().fold(0.0, |a: f64, &b| a.max(b));
+        let mut tries = 0;
+        let throw = loop {
+            let throw = draw_throw(input, rng);
+            tries += 1;
+            if throw.flight_of(fastest) >= MIN_FLIGHT_S || tries == THROW_DRAWS {
+                break throw;
+            }
+        };
+        let Throw {
+            heading_angle,
+            dir,
+            side,
+            launch_height,
+            ahead_d,
+            across,
+            height,
+            spin,
+            yaw,
+            ..
+        } = throw;
         let room = input.room;
-        let heading_angle = diagonal_heading(rng, room, 0.05);
-        let dir = heading(heading_angle);
-        let side = left_of(dir);
-        let launch_height = uniform(rng, 1.0, 1.3);
-        let flight = uniform(rng, FLIGHT_S[0], FLIGHT_S[1]);
-        // Where the target lies from the torso axis: `ahead` toward the thrower, `across`
-        // to the side, at `height`.
-        let (ahead_d, across, height) = match input.intent {
-            Intent::Hands => (
-                uniform(rng, 0.2, 0.4),
-                uniform(rng, -0.15, 0.15),
-                uniform(rng, 0.75, 1.15),
-            ),
-            Intent::Body => (
-                uniform(rng, -0.05, 0.05),
-                uniform(rng, -0.05, 0.05),
-                uniform(rng, 1.0, 1.3),
-            ),
-            Intent::Miss => {
-                let off = uniform(rng, 1.8, 2.2);
-                let sign = if uniform(rng, 0.0, 1.0) < 0.5 {
-                    -1.0
-                } else {
-                    1.0
-                };
-                (0.0, off * sign, uniform(rng, 0.6, 1.2))
-            }
-        };
-        let spin = [
-            uniform(rng, -6.0, 6.0),
-            uniform(rng, -6.0, 6.0),
-            uniform(rng, -6.0, 6.0),
-        ];
-        let yaw = uniform(rng, 0.0, std::f64::consts::TAU);
-        let radius = input.object.half_extents().into_iter().fold(0.0, f64::max);
-        let rise = room.ceiling_height - CEILING_CLEARANCE - radius - launch_height;
-        let vz_ceiling = (2.0 * GRAVITY * rise.max(0.0)).sqrt();
-        // Each band's flight and range; the room must hold the longest range plus the
-        // observer's offset.
-        let span = room_span(room, dir, WALL_MARGIN) - ahead_d.max(0.0);
-        let range_of = |v: f64| {
-            let t = flight.min(longest_flight(v, vz_ceiling, launch_height, height));
-            let (vh, _) = launch_velocity(v, t, launch_height, height);
-            // Shorten the flight of a throw the room cannot hold (bisection on t).
-            if vh * t <= span {
-                return t;
-            }
-            let (mut lo, mut hi) = (0.05, t);
-            for _ in 0..40 {
-                let mid = 0.5 * (lo + hi);
-                if launch_velocity(v, mid, launch_height, height).0 * mid > span {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            lo
-        };
+        let range_of = |v: f64| throw.flight_of(v);
         let range = |v: f64| {
             let t = range_of(v);
             launch_velocity(v, t, launch_height, height).0 * t
