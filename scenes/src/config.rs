@@ -761,6 +761,12 @@ pub struct DecorConfig {
     pub observer_clearance_m: f64,
     /// Positions drawn for a piece before it is left out.
     pub tries: u32,
+    /// Pieces of furniture (not windows or doors) a room should hold: while fewer are
+    /// placed, the pieces left out are tried again, `fill_tries` positions each.
+    #[serde(default)]
+    pub min_furniture: usize,
+    #[serde(default)]
+    pub fill_tries: u32,
 }
 
 impl Default for DecorConfig {
@@ -771,6 +777,8 @@ impl Default for DecorConfig {
             clearance_m: 0.25,
             observer_clearance_m: 0.45,
             tries: 8,
+            min_furniture: 0,
+            fill_tries: 0,
         }
     }
 }

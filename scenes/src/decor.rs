@@ -267,6 +267,59 @@ fn piece_body(piece: &DecorPiece, index: usize, position: Vec3, yaw: f64) -> (Bo
     (body, bounds)
 }
 
+/// The room a group is furnished in: its floor's half extents, its ceiling, and what
+/// the event keeps clear.
+struct Room<'a> {
+    half: [f64; 2],
+    ceiling: f64,
+    keepout: &'a Keepout,
+}
+
+impl Room<'_> {
+    /// Draws up to `tries` positions for a piece against a wall (flush in one of the
+    /// wall's corners half the time) and returns the first inside the room, clear of the
+    /// pieces placed and of the event.
+    fn place(
+        &self,
+        piece: &DecorPiece,
+        index: usize,
+        placed: &[(usize, BodySpec, Aabb)],
+        tries: u32,
+        rng: &mut impl RngExt,
+    ) -> Option<(BodySpec, Aabb)> {
+        let half = self.half;
+        let [x0, x1, _] = piece.footprint();
+        for _ in 0..tries {
+            let w = rng.random_range(0..4usize);
+            let u: f64 = rng.random_range(0.0..1.0);
+            let (yaw, wall, along, half_len) = wall_frame(w, half);
+            let (lo, hi) = (-half_len - x0, half_len - x1);
+            if lo > hi {
+                continue;
+            }
+            // A quarter of the draws at either end of the wall, half along it.
+            let s = match u {
+                u if u < 0.25 => lo,
+                u if u >= 0.75 => hi,
+                u => lo + (u - 0.25) * 2.0 * (hi - lo),
+            };
+            let position = [wall[0] + along[0] * s, wall[1] + along[1] * s, piece.height];
+            let (body, bounds) = piece_body(piece, index, position, yaw);
+            let inside = bounds.max[2] <= self.ceiling
+                && (0..2).all(|k| {
+                    bounds.min[k] >= -half[k] - WALL_SLACK && bounds.max[k] <= half[k] + WALL_SLACK
+                });
+            let free = placed
+                .iter()
+                .all(|(_, _, b)| !b.grown(0.02).overlaps(&bounds));
+            if inside && free && self.keepout.clear(&bounds, piece.collides()) {
+                return Some((body, bounds));
+            }
+        }
+        None
+    }
+}
+
 /// Furnishes a group's simulated, aimed bands (with their cameras): the same pieces
 /// appended to every band's bodies. Nothing changes when `[decor]` is off, the room has
 /// no decor, or no piece fits.
@@ -291,31 +344,42 @@ pub fn furnish(runs: &mut [(SceneSpec, Simulation)], catalog: &Catalog, config: 
     }
     let observer_radius = first.labels.escape_distance + cfg.observer_clearance_m;
     let keepout = Keepout::of(runs, cfg.clearance_m, observer_radius);
-    let mut placed: Vec<(BodySpec, Aabb)> = Vec::new();
-    for (index, piece) in pieces.into_iter().enumerate() {
-        let [x0, x1, _] = piece.footprint();
-        for _ in 0..cfg.tries {
-            let w = rng.random_range(0..4usize);
-            let u: f64 = rng.random_range(0.0..1.0);
-            let (yaw, wall, along, half_len) = wall_frame(w, half);
-            let (lo, hi) = (-half_len - x0, half_len - x1);
-            if lo > hi {
-                continue;
-            }
-            let s = lo + u * (hi - lo);
-            let position = [wall[0] + along[0] * s, wall[1] + along[1] * s, piece.height];
-            let (body, bounds) = piece_body(piece, index, position, yaw);
-            let inside = bounds.max[2] <= ceiling
-                && (0..2).all(|k| {
-                    bounds.min[k] >= -half[k] - WALL_SLACK && bounds.max[k] <= half[k] + WALL_SLACK
-                });
-            let free = placed.iter().all(|(_, b)| !b.grown(0.02).overlaps(&bounds));
-            if inside && free && keepout.clear(&bounds, piece.collides()) {
-                placed.push((body, bounds));
-                break;
-            }
+    let room = Room {
+        half,
+        ceiling,
+        keepout: &keepout,
+    };
+    let mut placed: Vec<(usize, BodySpec, Aabb)> = Vec::new();
+    let mut left_out = Vec::new();
+    for (index, piece) in pieces.iter().enumerate() {
+        match room.place(piece, index, &placed, cfg.tries, &mut rng) {
+            Some((body, bounds)) => placed.push((index, body, bounds)),
+            None => left_out.push(index),
         }
     }
+    // The fill pass: a room the event leaves little space in gets more tries for the
+    // furniture left out (the small pieces fit where the large ones did not).
+    let furniture = |placed: &[(usize, BodySpec, Aabb)]| {
+        placed
+            .iter()
+            .filter(|(i, _, _)| pieces[*i].is_furniture())
+            .count()
+    };
+    for index in left_out {
+        if furniture(&placed) >= cfg.min_furniture {
+            break;
+        }
+        let piece = pieces[index];
+        if !piece.is_furniture() {
+            continue;
+        }
+        if let Some((body, bounds)) = room.place(piece, index, &placed, cfg.fill_tries, &mut rng) {
+            placed.push((index, body, bounds));
+        }
+    }
+    // Bodies in the drawn order of their pieces, whichever pass placed them.
+    placed.sort_by_key(|(i, _, _)| *i);
+    let placed: Vec<(BodySpec, Aabb)> = placed.into_iter().map(|(_, b, a)| (b, a)).collect();
     for (spec, _) in runs.iter_mut() {
         spec.bodies.extend(placed.iter().map(|(b, _)| b.clone()));
     }

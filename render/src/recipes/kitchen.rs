@@ -456,7 +456,22 @@ fn kettle(m: &mut Mesh, k: &Kit) {
         28,
         &solid(s),
     );
+    // A dark lid on the steel body, its knob, and a lit switch on the base (switched
+    // on): a kettle, not a can.
+    m.cylinder(
+        &Xf::at([0.0, 0.0, hh * 0.71]),
+        rk * 0.62,
+        hh * 0.03,
+        24,
+        &solid(s),
+    );
     m.sphere(&Xf::at([0.0, 0.0, hh * 0.75]), rk * 0.15, 10, &solid(s));
+    m.sphere(
+        &Xf::at([-rk * 1.0, 0.0, -hh * 0.9]),
+        rk * 0.09,
+        8,
+        &solid(mat([1.0, 0.45, 0.1, 0.0], MAT_EMISSIVE)),
+    );
     m.torus(
         &Xf::rot(0, FRAC_PI_2, [-rk * 0.75, 0.0, 0.0]),
         hh * 0.55,

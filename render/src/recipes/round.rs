@@ -18,6 +18,10 @@ pub(super) const RECIPES: &[Recipe] = &[
         mesh: ball,
     },
     Recipe {
+        names: &["iron_ball"],
+        mesh: iron_ball,
+    },
+    Recipe {
         names: &["glass_sphere"],
         mesh: glass_sphere,
     },
@@ -118,6 +122,18 @@ fn ball(m: &mut Mesh, k: &Kit) {
         }
     };
     m.sphere(&id, r, 40, &paint);
+}
+
+/// A cast-iron ball (a shot put): matte, no seams, its grey faintly mottled as cast
+/// metal is (a fixed pattern of the surface point, the same in every frame).
+fn iron_ball(m: &mut Mesh, k: &Kit) {
+    let Kit { c, id, r, .. } = *k;
+    let paint = move |p: V3| {
+        let q = [p[0] / r, p[1] / r, p[2] / r];
+        let n = (q[0] * 11.0).sin() * (q[1] * 13.0).sin() * (q[2] * 7.0).cos();
+        mat(shade(c, 1.0 + 0.12 * n), MAT_PLAIN)
+    };
+    m.sphere(&id, r, 32, &paint);
 }
 
 fn glass_sphere(m: &mut Mesh, k: &Kit) {
