@@ -308,7 +308,8 @@ impl ShardCursor {
         // Every column, in small batches: a rendered shard's rows carry ~1 MB of frame
         // images each.
         let batch = crate::frames::IMAGE_ROW_GROUP_SIZE * 4;
-        let reader = crate::read::open_columns(path, batch, |_| true).map_err(input)?;
+        let reader =
+            crate::read::open_columns(path, batch, |_| true).map_err(|e| input(e.into()))?;
         Ok(ShardCursor {
             path: path.to_path_buf(),
             reader,

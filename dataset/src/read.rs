@@ -11,10 +11,54 @@ use arrow::datatypes::DataType;
 use parquet::arrow::arrow_reader::{ParquetRecordBatchReader, ParquetRecordBatchReaderBuilder};
 use std::path::{Path, PathBuf};
 
+/// Why the scene table could not be read: every message names the file (and the column).
+#[derive(Debug, thiserror::Error)]
+pub enum ReadError {
+    #[error("cannot read {}: {source}", .folder.display())]
+    Folder {
+        folder: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("cannot open {}: {source}", .file.display())]
+    Open {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{} is not a readable Parquet file: {message}", .file.display())]
+    NotParquet { file: PathBuf, message: String },
+    /// `FILE: column `NAME` WHAT`.
+    #[error("{}: column `{column}` {what}", .file.display())]
+    Column {
+        file: PathBuf,
+        column: String,
+        what: String,
+    },
+}
+
+impl ReadError {
+    /// The error of a column: `FILE: column `NAME` WHAT`.
+    pub fn column(file: &Path, column: &str, what: impl std::fmt::Display) -> ReadError {
+        ReadError::Column {
+            file: file.to_path_buf(),
+            column: column.to_string(),
+            what: what.to_string(),
+        }
+    }
+}
+
+/// The message, for callers that pass errors on as text.
+impl From<ReadError> for String {
+    fn from(e: ReadError) -> String {
+        e.to_string()
+    }
+}
+
 /// The `.parquet` files of a folder, in name order.
-pub fn parquet_files(folder: &Path) -> Result<Vec<PathBuf>, String> {
-    let rd =
-        std::fs::read_dir(folder).map_err(|e| format!("cannot read {}: {e}", folder.display()))?;
+pub fn parquet_files(folder: &Path) -> Result<Vec<PathBuf>, ReadError> {
+    let rd = std::fs::read_dir(folder).map_err(|source| ReadError::Folder {
+        folder: folder.to_path_buf(),
+        source,
+    })?;
     let mut files: Vec<PathBuf> = rd
         .flatten()
         .map(|e| e.path())
@@ -27,7 +71,7 @@ pub fn parquet_files(folder: &Path) -> Result<Vec<PathBuf>, String> {
 /// A record-batch reader over one Parquet file, every column but the model-input
 /// frames' images (`<cam>_frames`, about 1 MB a row: only `datasets` users and `merge`
 /// read them).
-pub fn open_parquet(file: &Path, batch_size: usize) -> Result<ParquetRecordBatchReader, String> {
+pub fn open_parquet(file: &Path, batch_size: usize) -> Result<ParquetRecordBatchReader, ReadError> {
     open_columns(file, batch_size, |name| {
         !rh_contract::columns::is_frames_column(name)
     })
@@ -39,9 +83,11 @@ pub fn open_columns(
     file: &Path,
     batch_size: usize,
     keep: impl Fn(&str) -> bool,
-) -> Result<ParquetRecordBatchReader, String> {
-    let f =
-        std::fs::File::open(file).map_err(|e| format!("cannot open {}: {e}", file.display()))?;
+) -> Result<ParquetRecordBatchReader, ReadError> {
+    let f = std::fs::File::open(file).map_err(|source| ReadError::Open {
+        file: file.to_path_buf(),
+        source,
+    })?;
     ParquetRecordBatchReaderBuilder::try_new(f)
         .and_then(|b| {
             let roots: Vec<usize> = b
@@ -55,19 +101,26 @@ pub fn open_columns(
             let mask = parquet::arrow::ProjectionMask::roots(b.parquet_schema(), roots);
             b.with_projection(mask).with_batch_size(batch_size).build()
         })
-        .map_err(|e| format!("{} is not a readable Parquet file: {e}", file.display()))
+        .map_err(|e| ReadError::NotParquet {
+            file: file.to_path_buf(),
+            message: e.to_string(),
+        })
 }
 
-/// The error of a column: `FILE: column `NAME` WHAT`.
+/// The error of a column as text: `FILE: column `NAME` WHAT` ([`ReadError::column`]).
 pub fn bad(file: &Path, column: &str, what: impl std::fmt::Display) -> String {
-    format!("{}: column `{column}` {what}", file.display())
+    ReadError::column(file, column, what).to_string()
 }
 
 /// A column by name.
-pub fn column<'a>(batch: &'a RecordBatch, file: &Path, name: &str) -> Result<&'a ArrayRef, String> {
+pub fn column<'a>(
+    batch: &'a RecordBatch,
+    file: &Path,
+    name: &str,
+) -> Result<&'a ArrayRef, ReadError> {
     batch
         .column_by_name(name)
-        .ok_or_else(|| bad(file, name, "is missing"))
+        .ok_or_else(|| ReadError::column(file, name, "is missing"))
 }
 
 /// A string column (Utf8, LargeUtf8 or Utf8View), nulls as `None`.
@@ -75,19 +128,24 @@ pub fn strings(
     batch: &RecordBatch,
     file: &Path,
     name: &str,
-) -> Result<Vec<Option<String>>, String> {
+) -> Result<Vec<Option<String>>, ReadError> {
     let col = column(batch, file, name)?;
     let col = match col.data_type() {
         DataType::Utf8 => col.clone(),
-        DataType::LargeUtf8 | DataType::Utf8View => {
-            arrow::compute::cast(col, &DataType::Utf8).map_err(|e| bad(file, name, e))?
+        DataType::LargeUtf8 | DataType::Utf8View => arrow::compute::cast(col, &DataType::Utf8)
+            .map_err(|e| ReadError::column(file, name, e))?,
+        other => {
+            return Err(ReadError::column(
+                file,
+                name,
+                format!("has type {other}, expected Utf8"),
+            ))
         }
-        other => return Err(bad(file, name, format!("has type {other}, expected Utf8"))),
     };
     let arr = col
         .as_any()
         .downcast_ref::<StringArray>()
-        .ok_or_else(|| bad(file, name, "is not a string array"))?;
+        .ok_or_else(|| ReadError::column(file, name, "is not a string array"))?;
     Ok((0..arr.len())
         .map(|i| (!arr.is_null(i)).then(|| arr.value(i).to_string()))
         .collect())
@@ -98,11 +156,11 @@ pub fn required_strings(
     batch: &RecordBatch,
     file: &Path,
     name: &str,
-) -> Result<Vec<String>, String> {
+) -> Result<Vec<String>, ReadError> {
     strings(batch, file, name)?
         .into_iter()
         .enumerate()
-        .map(|(i, v)| v.ok_or_else(|| bad(file, name, format!("is null in row {i}"))))
+        .map(|(i, v)| v.ok_or_else(|| ReadError::column(file, name, format!("is null in row {i}"))))
         .collect()
 }
 
@@ -114,10 +172,10 @@ fn non_null<A: Array + 'static, T>(
     name: &str,
     expected: &str,
     value: impl Fn(&A, usize) -> T,
-) -> Result<Vec<T>, String> {
+) -> Result<Vec<T>, ReadError> {
     let col = column(batch, file, name)?;
     let arr = col.as_any().downcast_ref::<A>().ok_or_else(|| {
-        bad(
+        ReadError::column(
             file,
             name,
             format!("has type {}, expected {expected}", col.data_type()),
@@ -125,21 +183,21 @@ fn non_null<A: Array + 'static, T>(
     })?;
     (0..arr.len())
         .map(|i| match arr.is_null(i) {
-            true => Err(bad(file, name, format!("is null in row {i}"))),
+            true => Err(ReadError::column(file, name, format!("is null in row {i}"))),
             false => Ok(value(arr, i)),
         })
         .collect()
 }
 
 /// A Boolean column without nulls.
-pub fn bools(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<bool>, String> {
+pub fn bools(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<bool>, ReadError> {
     non_null(batch, file, name, "Boolean", |a: &BooleanArray, i| {
         a.value(i)
     })
 }
 
 /// A UInt64 column without nulls.
-pub fn u64s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<u64>, String> {
+pub fn u64s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<u64>, ReadError> {
     non_null(batch, file, name, "UInt64", |a: &UInt64Array, i| a.value(i))
 }
 
@@ -148,10 +206,10 @@ pub fn u32_lists(
     batch: &RecordBatch,
     file: &Path,
     name: &str,
-) -> Result<Vec<Option<Vec<u32>>>, String> {
+) -> Result<Vec<Option<Vec<u32>>>, ReadError> {
     let col = column(batch, file, name)?;
     let wrong = || {
-        bad(
+        ReadError::column(
             file,
             name,
             format!("has type {}, expected List<UInt32>", col.data_type()),
@@ -175,10 +233,10 @@ pub fn vec3s(
     batch: &RecordBatch,
     file: &Path,
     name: &str,
-) -> Result<Vec<Option<[f64; 3]>>, String> {
+) -> Result<Vec<Option<[f64; 3]>>, ReadError> {
     let col = column(batch, file, name)?;
     let wrong = || {
-        bad(
+        ReadError::column(
             file,
             name,
             format!(
@@ -215,7 +273,7 @@ pub fn vec3s(
                 .downcast_ref::<Float64Array>()
                 .ok_or_else(wrong)?;
             if v.len() != 3 {
-                return Err(bad(
+                return Err(ReadError::column(
                     file,
                     name,
                     format!("row {i} has {} values, expected 3", v.len()),

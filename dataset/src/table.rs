@@ -216,7 +216,7 @@ pub fn row_group_size(render: bool) -> usize {
 }
 
 /// Paths of the dataset's Parquet files, in name order.
-pub fn data_files(dir: &Path) -> Result<Vec<PathBuf>, String> {
+pub fn data_files(dir: &Path) -> Result<Vec<PathBuf>, read::ReadError> {
     read::parquet_files(&dir.join("data"))
 }
 

@@ -167,7 +167,7 @@ impl Dataset {
 
 /// The `.parquet` files of a folder, in name order (`rh_dataset::read`).
 pub fn parquet_files(folder: &Path) -> Result<Vec<PathBuf>, InputError> {
-    rh_dataset::read::parquet_files(folder).map_err(InputError)
+    rh_dataset::read::parquet_files(folder).map_err(|e| InputError(e.into()))
 }
 
 /// A record-batch reader over one Parquet file (`rh_dataset::read`); a file that cannot
@@ -176,7 +176,7 @@ pub fn open_parquet(
     file: &Path,
     batch_size: usize,
 ) -> Result<parquet::arrow::arrow_reader::ParquetRecordBatchReader, InputError> {
-    rh_dataset::read::open_parquet(file, batch_size).map_err(InputError)
+    rh_dataset::read::open_parquet(file, batch_size).map_err(|e| InputError(e.into()))
 }
 
 /// One scene as read from a row (or made by a fixture), before interning.
@@ -207,19 +207,19 @@ fn bad(file: &Path, column: &str, what: impl std::fmt::Display) -> anyhow::Error
 }
 
 fn strings(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Option<String>>> {
-    Ok(rh_dataset::read::strings(batch, file, name).map_err(InputError)?)
+    Ok(rh_dataset::read::strings(batch, file, name).map_err(|e| InputError(e.into()))?)
 }
 
 fn required_strings(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<String>> {
-    Ok(rh_dataset::read::required_strings(batch, file, name).map_err(InputError)?)
+    Ok(rh_dataset::read::required_strings(batch, file, name).map_err(|e| InputError(e.into()))?)
 }
 
 fn bools(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<bool>> {
-    Ok(rh_dataset::read::bools(batch, file, name).map_err(InputError)?)
+    Ok(rh_dataset::read::bools(batch, file, name).map_err(|e| InputError(e.into()))?)
 }
 
 fn vec3s(batch: &RecordBatch, file: &Path, name: &str) -> Result<Vec<Option<[f64; 3]>>> {
-    Ok(rh_dataset::read::vec3s(batch, file, name).map_err(InputError)?)
+    Ok(rh_dataset::read::vec3s(batch, file, name).map_err(|e| InputError(e.into()))?)
 }
 
 fn read_parquet(file: &Path) -> Result<Vec<SceneInput>> {
@@ -421,7 +421,7 @@ pub fn eval_scene_ids(dir: &Path) -> Result<Option<BTreeSet<String>>> {
 /// naming what is missing and the command that finishes it; with `allow_incomplete`
 /// (`--allow-incomplete`) it is used as it is, with a warning on stderr.
 pub fn check_finished(dir: &Path, allow_incomplete: bool) -> Result<()> {
-    match rh_dataset::manifest::unfinished(dir).map_err(InputError)? {
+    match rh_dataset::manifest::unfinished(dir).map_err(|e| InputError(e.into()))? {
         None => Ok(()),
         Some(why) if allow_incomplete => {
             rh_contract::note!("rh-score: warning: {why}. Used as it is (--allow-incomplete).");

@@ -91,29 +91,48 @@ struct SettingsFile {
     released_dataset: String,
 }
 
-fn seconds(what: &str, v: f64) -> Result<Duration, String> {
+/// Why the Hub settings (`configs/hub.toml` and the environment's overrides) are unusable.
+#[derive(Debug, thiserror::Error)]
+pub enum SettingsError {
+    /// The file is not a valid `hub.toml` (TOML or a field).
+    #[error("{origin}: {message}")]
+    Parse { origin: String, message: String },
+    #[error("{origin}: released_dataset must be owner/name[@revision], not '{value}'")]
+    ReleasedDataset { origin: String, value: String },
+    /// `what` (a field or an environment variable) is out of range.
+    #[error("{what} must be a number of seconds in (0, 86400], not {value}")]
+    Seconds { what: String, value: f64 },
+    #[error("{var}={value} is not a number of seconds")]
+    NotANumber { var: String, value: String },
+}
+
+fn seconds(what: &str, v: f64) -> Result<Duration, SettingsError> {
     if v.is_finite() && v > 0.0 && v <= 86_400.0 {
         Ok(Duration::from_secs_f64(v))
     } else {
-        Err(format!(
-            "{what} must be a number of seconds in (0, 86400], not {v}"
-        ))
+        Err(SettingsError::Seconds {
+            what: what.to_string(),
+            value: v,
+        })
     }
 }
 
 impl Settings {
     /// Parses a `hub.toml` text (`origin` names it in errors).
-    pub fn parse(text: &str, origin: &str) -> Result<Settings, String> {
-        let f: SettingsFile = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
+    pub fn parse(text: &str, origin: &str) -> Result<Settings, SettingsError> {
+        let f: SettingsFile = toml::from_str(text).map_err(|e| SettingsError::Parse {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })?;
         let (repo, revision) = f
             .released_dataset
             .split_once('@')
             .unwrap_or((&f.released_dataset, "main"));
         if !is_repo_id(repo) || revision.is_empty() {
-            return Err(format!(
-                "{origin}: released_dataset must be owner/name[@revision], not '{}'",
-                f.released_dataset
-            ));
+            return Err(SettingsError::ReleasedDataset {
+                origin: origin.to_string(),
+                value: f.released_dataset,
+            });
         }
         Ok(Settings {
             metadata_timeout: seconds(
@@ -130,7 +149,7 @@ impl Settings {
     }
 
     /// The embedded configuration with the environment's overrides applied.
-    pub fn from_env() -> Result<Settings, String> {
+    pub fn from_env() -> Result<Settings, SettingsError> {
         let mut s = Settings::parse(EMBEDDED_CONFIG, "configs/hub.toml")?;
         for (var, slot) in [
             ("HF_HUB_ETAG_TIMEOUT", &mut s.metadata_timeout),
@@ -138,10 +157,10 @@ impl Settings {
         ] {
             if let Ok(v) = std::env::var(var) {
                 if !v.trim().is_empty() {
-                    let n: f64 = v
-                        .trim()
-                        .parse()
-                        .map_err(|_| format!("{var}={v} is not a number of seconds"))?;
+                    let n: f64 = v.trim().parse().map_err(|_| SettingsError::NotANumber {
+                        var: var.to_string(),
+                        value: v.clone(),
+                    })?;
                     *slot = seconds(var, n)?;
                 }
             }
@@ -246,7 +265,7 @@ pub fn token() -> Option<String> {
 /// timeouts, fails, or serves a corrupt file (or `HF_HUB_OFFLINE` is set), the snapshot
 /// that the cache's `refs/<revision>` names is used instead, if it is complete.
 pub fn fetch(repo_id: &str, revision: Option<&str>) -> Result<Snapshot, HubError> {
-    let settings = Settings::from_env().map_err(HubError::Failed)?;
+    let settings = Settings::from_env().map_err(|e| HubError::Failed(e.to_string()))?;
     fetch_with(repo_id, revision, &settings)
 }
 
@@ -425,6 +444,7 @@ mod tests {
         assert!(
             Settings::parse(&format!("{text}released_dataset = \"a b\""), "x.toml")
                 .unwrap_err()
+                .to_string()
                 .contains("x.toml: released_dataset")
         );
         assert!(Settings::parse(
@@ -432,9 +452,11 @@ mod tests {
             "x.toml"
         )
         .unwrap_err()
+        .to_string()
         .contains("x.toml: metadata_timeout_s"));
         assert!(Settings::parse("metadata_timeout_s = 1\n", "x.toml")
             .unwrap_err()
+            .to_string()
             .contains("x.toml"));
     }
 

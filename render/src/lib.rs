@@ -66,7 +66,6 @@ mod sheet;
 mod tiles;
 
 use encode::EncodeSettings;
-use rh_scenes::config::RenderConfig;
 use std::collections::BTreeMap;
 
 pub use camera::{full_event_camera, view_proj};
@@ -77,6 +76,8 @@ pub use measure::Observed;
 pub use renderer::{release_thread_renderer, render_stage, with_thread_renderer, Renderer};
 pub use rh_contract::layout::{frame_file_name, frame_path};
 pub use rh_contract::{CAMERAS, FRAME_TIMES, FULL_EVENT};
+/// The `[render]` section these options come from (the renderer's own settings type).
+pub use rh_render_config::RenderConfig;
 pub use sheet::{contact_sheet, ContactSheet, SheetTile};
 
 #[derive(Debug, thiserror::Error)]

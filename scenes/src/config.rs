@@ -5,6 +5,7 @@
 
 use crate::aim::AimConfig;
 use rh_physics::spec::{LabelConfig, LABELS_TOML};
+use rh_render_config::RenderConfig;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -185,76 +186,6 @@ impl ValidatorConfig {
             px_inset: self.visible_px_inset,
         }
     }
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RenderConfig {
-    pub width: u32,
-    pub height: u32,
-    pub fps: u32,
-    /// Size and frame rate of the full-event video (for people, not model input).
-    #[serde(default = "default_full_width")]
-    pub full_width: u32,
-    #[serde(default = "default_full_height")]
-    pub full_height: u32,
-    #[serde(default = "default_full_fps")]
-    pub full_fps: u32,
-    /// libx264 preset and constant rate factor.
-    #[serde(default = "default_preset")]
-    pub preset: String,
-    #[serde(default = "default_crf")]
-    pub crf: u32,
-    /// libx264 threads per video (0 = automatic).
-    #[serde(default = "default_encoder_threads")]
-    pub encoder_threads: u32,
-    /// libx264 B-frames between reference frames (0: none; the preset's own is 3).
-    #[serde(default)]
-    pub bframes: u32,
-    /// MSAA samples (4 or 1) on a hardware GPU.
-    #[serde(default = "default_msaa")]
-    pub msaa: u32,
-    /// MSAA samples (4 or 1) on a CPU rasterizer (Mesa's lavapipe), where 4 samples
-    /// cost about 3× the time.
-    #[serde(default = "default_msaa_cpu")]
-    pub msaa_cpu: u32,
-    /// FXAA-style post-process anti-aliasing where MSAA is off (a CPU rasterizer).
-    #[serde(default = "default_fxaa")]
-    pub fxaa: bool,
-    /// Real meshes of catalog objects: triangle budget, bounds tolerance, textures,
-    /// package directory (`[render.models]`).
-    #[serde(default)]
-    pub models: rh_catalog::models::ModelConfig,
-}
-
-fn default_fxaa() -> bool {
-    true
-}
-
-fn default_msaa_cpu() -> u32 {
-    1
-}
-
-fn default_full_width() -> u32 {
-    640
-}
-fn default_full_height() -> u32 {
-    360
-}
-fn default_full_fps() -> u32 {
-    30
-}
-fn default_preset() -> String {
-    "superfast".into()
-}
-fn default_crf() -> u32 {
-    20
-}
-fn default_encoder_threads() -> u32 {
-    1
-}
-fn default_msaa() -> u32 {
-    4
 }
 
 #[derive(Debug, Deserialize)]
@@ -455,14 +386,8 @@ impl Config {
                 "must be within [0, 1]".into(),
             ));
         }
-        if self.render.width == 0 || self.render.height == 0 || self.render.fps == 0 {
-            return Err(fail(
-                "render",
-                "width, height and fps must be positive".into(),
-            ));
-        }
-        if self.render.bframes > 16 {
-            return Err(fail("render.bframes", "must be at most 16".into()));
+        if let Some((field, message)) = self.render.problem() {
+            return Err(fail(field, message.into()));
         }
         for family in &self.build.families {
             if !rh_contract::FAMILIES.contains(&family.as_str()) {
@@ -488,7 +413,6 @@ impl Config {
     /// reaches an allocation failure.
     fn validate_bounds(&self, name: &str, labels_name: &str) -> Result<(), ConfigError> {
         let p = &self.physics;
-        let r = &self.render;
         let within = |file: &str, field: &str, v: f64, lo: f64, hi: f64| {
             if v.is_finite() && (lo..=hi).contains(&v) {
                 Ok(())
@@ -522,23 +446,8 @@ impl Config {
                 1.0,
                 100_000.0,
             ),
-            ("render.width", r.width as f64, 1.0, 7680.0),
-            ("render.height", r.height as f64, 1.0, 4320.0),
-            ("render.fps", r.fps as f64, 1.0, 240.0),
-            ("render.full_width", r.full_width as f64, 1.0, 7680.0),
-            ("render.full_height", r.full_height as f64, 1.0, 4320.0),
-            ("render.full_fps", r.full_fps as f64, 1.0, 240.0),
-            (
-                "render.encoder_threads",
-                r.encoder_threads as f64,
-                0.0,
-                64.0,
-            ),
-            ("render.crf", r.crf as f64, 0.0, 51.0),
-            ("render.msaa", r.msaa as f64, 1.0, 16.0),
-            ("render.msaa_cpu", r.msaa_cpu as f64, 1.0, 16.0),
         ];
-        for (field, v, lo, hi) in counts {
+        for (field, v, lo, hi) in counts.into_iter().chain(self.render.bounds()) {
             within(name, field, v, lo, hi)?;
         }
         let directions = self.labels.escape_directions as f64;
@@ -668,6 +577,50 @@ impl Config {
     /// The family's speed parameter in the four bands (slow, normal, fast, very fast).
     pub fn speed_bands(&self, family: &str) -> Option<&[f64; 4]> {
         self.speed_bands.get(family)
+    }
+}
+
+/// What the randomize stage reads of the build configuration: the sections a spec is
+/// laid out from (the driver hands it out, [`Config::randomize`]; `From<&Config>` for
+/// callers holding a whole configuration).
+#[derive(Debug, Clone)]
+pub struct RandomizeConfig<'a> {
+    /// `[build] far_observer_share`: the share of groups drawn as a near miss.
+    pub far_observer_share: f64,
+    pub physics: &'a PhysicsConfig,
+    pub observation: &'a ObservationConfig,
+    pub observer: &'a ObserverConfig,
+    /// `[render]`'s model-input image size and frame rate (the spec's `video`).
+    pub video: rh_physics::spec::VideoSpec,
+    pub speed_bands: &'a BTreeMap<String, [f64; 4]>,
+    pub labels: &'a LabelConfig,
+    /// `[aim] hands_half_length_max` (the intent of an object).
+    pub hands_half_length_max: f64,
+}
+
+impl Config {
+    /// The randomize stage's sections.
+    pub fn randomize(&self) -> RandomizeConfig<'_> {
+        RandomizeConfig {
+            far_observer_share: self.build.far_observer_share,
+            physics: &self.physics,
+            observation: &self.observation,
+            observer: &self.observer,
+            video: rh_physics::spec::VideoSpec {
+                width: self.render.width,
+                height: self.render.height,
+                fps: self.render.fps,
+            },
+            speed_bands: &self.speed_bands,
+            labels: &self.labels,
+            hands_half_length_max: self.aim.hands_half_length_max,
+        }
+    }
+}
+
+impl<'a> From<&'a Config> for RandomizeConfig<'a> {
+    fn from(config: &'a Config) -> RandomizeConfig<'a> {
+        config.randomize()
     }
 }
 

@@ -20,7 +20,6 @@
 //! One placement serves a group's bands (their union is kept clear), so the bands show
 //! the same room. `[decor] enabled = false` builds the same scenes bare.
 
-use crate::config::Config;
 use rand::RngExt;
 use rh_catalog::decor::DecorPiece;
 use rh_catalog::Catalog;
@@ -323,8 +322,7 @@ impl Room<'_> {
 /// Furnishes a group's simulated, aimed bands (with their cameras): the same pieces
 /// appended to every band's bodies. Nothing changes when `[decor]` is off, the room has
 /// no decor, or no piece fits.
-pub fn furnish(runs: &mut [(SceneSpec, Simulation)], catalog: &Catalog, config: &Config) {
-    let cfg = &config.decor;
+pub fn furnish(runs: &mut [(SceneSpec, Simulation)], catalog: &Catalog, cfg: &DecorConfig) {
     let Some((first, _)) = runs.first() else {
         return;
     };

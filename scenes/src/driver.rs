@@ -107,7 +107,7 @@ pub fn produce_planned_group(
     config: &Config,
 ) -> Result<(Vec<SceneResult>, Rejections), GroupError> {
     let input = |e: &dyn std::fmt::Display| GroupError::Input(e.to_string());
-    let policy = crate::selection::PlanPolicy::of(config);
+    let policy = crate::selection::PlanPolicy::of(&config.build, &config.labels);
     let Some(slot) = twins::slot(&config.probes, families, g) else {
         return replanned_group(catalog, families, seed, g, count, config).map_err(|e| input(&e));
     };
@@ -115,8 +115,6 @@ pub fn produce_planned_group(
     let mut selection = plan_group_with(catalog, families, seed, slot.probe_group, &policy)
         .map_err(|e| input(&e))?;
     selection.object_id = adversarial.id.clone();
-    let mut probe_config = config.clone();
-    probe_config.build.far_observer_share = 0.0;
     let heavy = config.labels.heavy_mass_kg;
     let benign = if crate::selection::intrinsically_dangerous(adversarial, heavy) {
         genuine
@@ -126,6 +124,7 @@ pub fn produce_planned_group(
     let stand_in = StandIn {
         aimed_as: Some(benign.id.clone()),
         pushed_as: slot.pair.twin.then(|| benign.id.clone()),
+        never_far: true,
     };
     // Both groups of a pair build the whole pair (deterministic): the probe's four bands
     // and, for a twin pair, the twins labelled — once per process ([`PROBES`]).
@@ -137,7 +136,7 @@ pub fn produce_planned_group(
             count: probe_count,
         };
         let (mut probe, rejections) =
-            probe_group_counted(&selection, bands, catalog, &probe_config, &stand_in)
+            probe_group_counted(&selection, bands, catalog, config, &stand_in)
                 .map_err(|e| e.to_string())?;
         let twins = slot.pair.twin.then(|| {
             let label = |spec, sim| label_scene(spec, sim, config);
@@ -156,7 +155,7 @@ pub fn produce_planned_group(
             seed,
             probe_group: slot.probe_group,
             families: families.to_vec(),
-            config: serde_json::to_string(&probe_config).expect("a config serializes"),
+            config: serde_json::to_string(config).expect("a config serializes"),
             catalog: format!("{catalog:?}"),
         };
         PROBES.get(key, 2, produce)
@@ -189,7 +188,7 @@ pub fn produce_planned_group(
 }
 
 /// What a probe group's bands are a function of (with the driver's code): the build's
-/// seed, the group, the families (the planner deals them), the probe's configuration and
+/// seed, the group, the families (the planner deals them), the build's configuration and
 /// the catalog (its `Debug` text: every field).
 #[derive(PartialEq)]
 struct ProbeKey {
@@ -222,7 +221,7 @@ fn replanned_group(
     count: u64,
     config: &Config,
 ) -> Result<(Vec<SceneResult>, Rejections), String> {
-    let policy = crate::selection::PlanPolicy::of(config);
+    let policy = crate::selection::PlanPolicy::of(&config.build, &config.labels);
     let mut total = Rejections::default();
     let aim_replans = config.aim.replans.min(config.validators.replans);
     // The plans tried for an aim are produced again at their own pose if every plan fails
@@ -328,7 +327,7 @@ fn framed_group(
     for (spec, _) in runs.iter_mut() {
         spec.cameras = framed.clone();
     }
-    crate::decor::furnish(&mut runs, catalog, config);
+    crate::decor::furnish(&mut runs, catalog, &config.decor);
     runs.into_iter()
 }
 
@@ -701,7 +700,7 @@ fn produce_attempts(
                 selection,
                 &SceneKey::new(build_seed, index, attempt),
                 catalog,
-                config,
+                &config.randomize(),
                 stand_in,
             )?;
             // Simulate what the file will say: a JSON round trip is exact (serde_json

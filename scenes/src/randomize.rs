@@ -5,14 +5,14 @@
 //! geometry and initial conditions), "lighting". Cameras are framed after simulation
 //! (see `cameras`), from their own stream.
 
-use crate::config::Config;
+use crate::config::RandomizeConfig;
 use crate::families::{self, FamilyInput};
 use crate::intent::Intent;
 use rand::RngExt;
 use rh_catalog::Catalog;
 use rh_physics::seeds;
 use rh_physics::spec::{
-    LightingSpec, ObserverSpec, PhysicsSpec, RoomSpec, SceneSpec, Selection, SpeedBand, VideoSpec,
+    LightingSpec, ObserverSpec, PhysicsSpec, RoomSpec, SceneSpec, Selection, SpeedBand,
     SCHEMA_VERSION,
 };
 
@@ -70,16 +70,20 @@ pub struct StandIn {
     /// Label rule v6, twin pairs: every launch is the push that gives this catalog object
     /// (the pair's benign member) the layout's velocities, whichever object is shown.
     pub pushed_as: Option<String>,
+    /// A probe pair's groups are never drawn as a near miss (`build.far_observer_share`
+    /// does not apply).
+    pub never_far: bool,
 }
 
-/// Lays out the scene `key` of the group planned as `selection`.
-pub fn randomize(
+/// Lays out the scene `key` of the group planned as `selection` (`config`: the stage's
+/// sections, or a whole build configuration).
+pub fn randomize<'a>(
     selection: &Selection,
     key: &SceneKey,
     catalog: &Catalog,
-    config: &Config,
+    config: impl Into<RandomizeConfig<'a>>,
 ) -> Result<SceneSpec, RandomizeError> {
-    randomize_as(selection, key, catalog, config, &StandIn::default())
+    randomize_as(selection, key, catalog, &config.into(), &StandIn::default())
 }
 
 /// [`randomize`] for a group laid out as `stand_in` says (an adversarial probe pair's).
@@ -87,7 +91,7 @@ pub fn randomize_as(
     selection: &Selection,
     key: &SceneKey,
     catalog: &Catalog,
-    config: &Config,
+    config: &RandomizeConfig,
     stand_in: &StandIn,
 ) -> Result<SceneSpec, RandomizeError> {
     let family =
@@ -108,14 +112,19 @@ pub fn randomize_as(
         .room(&selection.room_id)
         .ok_or_else(|| RandomizeError::UnknownRoom(selection.room_id.clone()))?;
     let bands = config
-        .speed_bands(&selection.family)
+        .speed_bands
+        .get(&selection.family)
         .ok_or_else(|| RandomizeError::NoSpeedBands(selection.family.clone()))?;
 
     let seed = seeds::group_seed(key.build_seed, key.group_index);
     // Drawn once per group, not per attempt: resampling must not favour near misses
     // (which never fail the reaction-time validator).
-    let far_observer =
-        seeds::stream(seed, 0, "observer").random_bool(config.build.far_observer_share);
+    let far_share = if stand_in.never_far {
+        0.0
+    } else {
+        config.far_observer_share
+    };
+    let far_observer = seeds::stream(seed, 0, "observer").random_bool(far_share);
     // An adversarial probe pair's groups are aimed as its benign member would be (`twins`).
     let aimed_as = stand_in
         .aimed_as
@@ -132,8 +141,8 @@ pub fn randomize_as(
         intent: Intent::for_object(
             aimed_as,
             far_observer,
-            &config.labels,
-            config.aim.hands_half_length_max,
+            config.labels,
+            config.hands_half_length_max,
         ),
     };
     let mut layout = family.sample(&input, &mut seeds::stream(seed, key.attempt, "placement"));
@@ -212,11 +221,7 @@ pub fn randomize_as(
             torso_radius: config.observer.torso_radius,
         },
         observation_window_s: config.observation.window_s,
-        video: VideoSpec {
-            width: config.render.width,
-            height: config.render.height,
-            fps: config.render.fps,
-        },
+        video: config.video.clone(),
         cameras: vec![],
         lighting,
         family_params,

@@ -10,7 +10,7 @@
 use rand::RngExt;
 use rh_catalog::{Catalog, Object, Room};
 use rh_physics::seeds;
-use rh_physics::spec::Selection;
+use rh_physics::spec::{LabelConfig, Selection};
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum PlanError {
@@ -53,11 +53,11 @@ pub struct PlanPolicy {
 impl PlanPolicy {
     /// What a build configuration's planner balances (`[build]`, the label rule's
     /// `heavy_mass_kg`).
-    pub fn of(config: &crate::config::Config) -> PlanPolicy {
+    pub fn of(build: &crate::config::BuildSection, labels: &LabelConfig) -> PlanPolicy {
         PlanPolicy {
-            benign_share: config.build.benign_share,
-            benign_share_by_family: config.build.benign_share_by_family.clone(),
-            heavy_mass_kg: config.labels.heavy_mass_kg,
+            benign_share: build.benign_share,
+            benign_share_by_family: build.benign_share_by_family.clone(),
+            heavy_mass_kg: labels.heavy_mass_kg,
         }
     }
 }
@@ -84,9 +84,9 @@ pub fn plan_group(
 ) -> Result<Selection, PlanError> {
     static EMBEDDED: std::sync::OnceLock<PlanPolicy> = std::sync::OnceLock::new();
     let policy = EMBEDDED.get_or_init(|| {
-        PlanPolicy::of(
-            &crate::config::Config::embedded().expect("the embedded configuration is valid"),
-        )
+        let config =
+            crate::config::Config::embedded().expect("the embedded configuration is valid");
+        PlanPolicy::of(&config.build, &config.labels)
     });
     plan_group_with(catalog, families, build_seed, group, policy)
 }
