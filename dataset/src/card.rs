@@ -665,7 +665,7 @@ standing body (a knife that stops a metre away: standing still is safe). Rule v4
 every dangerous or too fast reachable hazard `DODGE`, touch or not, and rules v2–v3 every \
 benign reachable one `CATCH`, including balls rolling to the feet, which the executor's \
 humanoid cannot catch (`rh-score --execute`: on a 340-scene build the oracle baseline \
-caught 58 of 146 rule-v3 CATCH labels, 128 of 134 rule-v6 ones; 69 of 72 under rule v4).
+caught 58 of 146 rule-v3 CATCH labels, 131 of 137 rule-v6 ones; 69 of 72 under rule v4).
 * **Escape** (validator `valid_escapable`, rule v4): a `DODGE` scene with danger present whose \
 hazard reaches the observer within {esc_within} s of Δ must be escapable — of {esc_n} walks of {esc_d} m at {esc_v} m/s in evenly spaced directions (the \
 first straight back), hands at rest, executed in physics from Δ by the executor of `rh-score \

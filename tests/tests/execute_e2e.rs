@@ -143,7 +143,7 @@ fn oracle_plans_catch_and_never_get_struck_dodging() {
         catch >= 20,
         "too few CATCH scenes ({catch}) for the test to mean anything"
     );
-    // Issue #23's target on an unseen seed: >= 95% (measured: 128 of 134, rule v6).
+    // Issue #23's target on an unseen seed: >= 95% (measured: 131 of 137, rule v6).
     assert!(
         caught as f64 >= 0.95 * catch as f64,
         "oracle caught only {caught}/{catch}"
@@ -206,7 +206,7 @@ fn freeze_is_struck_exactly_where_the_label_says_danger() {
     );
     assert!(danger >= 20 && safe >= 20, "{danger} / {safe} scenes");
     // Harmed on >= 95% of danger_present scenes, and on at most 1% of the others, each
-    // listed below as a disagreement (measured under rule v6: 157 of 158, and 1 of 182 —
+    // listed below as a disagreement (measured under rule v6: 158 of 159, and 1 of 181 —
     // a touch at the harm limit that the label's fixed links and the executor's kinematic
     // ones resolve differently; docs/execution.md. Under rule v5 it was 0 of 181).
     assert!(
