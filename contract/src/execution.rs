@@ -102,7 +102,7 @@ impl ExecConfig {
     }
 
     /// Checks every number is finite and in range; names the field otherwise.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ExecConfigError> {
         let positive = [
             ("horizon_s", self.horizon_s),
             ("max_speed", self.max_speed),
@@ -117,7 +117,10 @@ impl ExecConfig {
         ];
         for (name, v) in positive {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("execution.{name} = {v} must be a positive number"));
+                return Err(ExecConfigError::NotPositive {
+                    field: name,
+                    value: v,
+                });
             }
         }
         let non_negative = [
@@ -138,16 +141,16 @@ impl ExecConfig {
         ];
         for (name, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(format!(
-                    "execution.{name} = {v} must be a non-negative number"
-                ));
+                return Err(ExecConfigError::Negative {
+                    field: name,
+                    value: v,
+                });
             }
         }
         if self.horizon_s > 60.0 {
-            return Err(format!(
-                "execution.horizon_s = {} is more than 60 s",
-                self.horizon_s
-            ));
+            return Err(ExecConfigError::LongHorizon {
+                horizon_s: self.horizon_s,
+            });
         }
         Ok(())
     }
@@ -162,6 +165,24 @@ impl ExecConfig {
                 .as_bytes(),
         );
         hash_hex(h)
+    }
+}
+
+/// Why an `[execution]` section is unusable; the message names the field.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ExecConfigError {
+    #[error("execution.{field} = {value} must be a positive number")]
+    NotPositive { field: &'static str, value: f64 },
+    #[error("execution.{field} = {value} must be a non-negative number")]
+    Negative { field: &'static str, value: f64 },
+    #[error("execution.horizon_s = {horizon_s} is more than 60 s")]
+    LongHorizon { horizon_s: f64 },
+}
+
+/// The message, for callers that pass errors on as text.
+impl From<ExecConfigError> for String {
+    fn from(e: ExecConfigError) -> String {
+        e.to_string()
     }
 }
 

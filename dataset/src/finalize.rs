@@ -48,12 +48,12 @@ pub fn finalize(
     let source = rows;
     let rows = move |sink: &mut RowSink| -> Result<(), BuildError> {
         source(&mut |batch| {
-            let batch = frames::embed(&batch, out).map_err(BuildError::Internal)?;
+            let batch = frames::embed(&batch, out).map_err(|e| BuildError::Internal(e.into()))?;
             sink(batch)
         })
     };
-    let mut data =
-        stream::ParquetStream::create_with(&data_path, group_rows).map_err(BuildError::Internal)?;
+    let mut data = stream::ParquetStream::create_with(&data_path, group_rows)
+        .map_err(|e| BuildError::Internal(e.into()))?;
     let summary_schema = stream::project(
         &RecordBatch::new_empty(std::sync::Arc::new(table::schema())),
         &stream::SUMMARY_COLUMNS,
@@ -65,14 +65,15 @@ pub fn finalize(
     };
     let mut summary: Vec<RecordBatch> = Vec::new();
     rows(&mut |batch| {
-        data.write(&batch).map_err(BuildError::Internal)?;
+        data.write(&batch)
+            .map_err(|e| BuildError::Internal(e.into()))?;
         summary.push(stream::project(&batch, &stream::SUMMARY_COLUMNS));
         if summary.len() >= 256 {
             summary = vec![compact(&summary)?];
         }
         Ok(())
     })?;
-    data.finish().map_err(BuildError::Internal)?;
+    data.finish().map_err(|e| BuildError::Internal(e.into()))?;
     let data_sum =
         rh_contract::digest::sha256_file(&data_path).map_err(|e| internal(&data_path, e))?;
     sums.insert(data_file.clone(), data_sum);
@@ -80,10 +81,10 @@ pub fn finalize(
     let eval = if manifest.is_whole() {
         let (indices, counts) = card::manifest_eval_selection(&summary, manifest);
         let path = out.join(card::EVAL_FILE);
-        let mut eval =
-            stream::ParquetStream::create_with(&path, group_rows).map_err(BuildError::Internal)?;
+        let mut eval = stream::ParquetStream::create_with(&path, group_rows)
+            .map_err(|e| BuildError::Internal(e.into()))?;
         write_streamed(&rows, &indices, &mut eval)?;
-        eval.finish().map_err(BuildError::Internal)?;
+        eval.finish().map_err(|e| BuildError::Internal(e.into()))?;
         let sum = rh_contract::digest::sha256_file(&path).map_err(|e| internal(&path, e))?;
         sums.insert(card::EVAL_FILE.to_string(), sum);
         Some(counts)
@@ -137,7 +138,7 @@ fn write_streamed(
         next += local.len();
         if !local.is_empty() {
             to.write(&table::take_rows(&batch, &local))
-                .map_err(BuildError::Internal)?;
+                .map_err(|e| BuildError::Internal(e.into()))?;
         }
         offset = end;
         Ok(())

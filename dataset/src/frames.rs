@@ -57,10 +57,37 @@ pub fn null_columns(rows: usize) -> Vec<ArrayRef> {
         .collect()
 }
 
+/// Why the frames of rendered rows could not be embedded.
+#[derive(Debug, thiserror::Error)]
+pub enum FramesError {
+    #[error(transparent)]
+    Read(#[from] crate::read::ReadError),
+    #[error("the scene table has no column `{0}`")]
+    NoColumn(String),
+    #[error("column `{0}` is not a list")]
+    NotAList(String),
+    /// A frame file that cannot be read: `FILE: WHAT`.
+    #[error("{}: {source}", .path.display())]
+    Frame {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
+    /// Arrow refused the rows with their images.
+    #[error("{0}")]
+    Arrow(String),
+}
+
+/// The message, for callers that pass errors on as text.
+impl From<FramesError> for String {
+    fn from(e: FramesError) -> String {
+        e.to_string()
+    }
+}
+
 /// `batch` with the `<cam>_frames` of every rendered row (its `<cam>_file_name` set)
 /// read from the frame files under `dir`; rows whose frames are already there, and rows
 /// not rendered, are unchanged.
-pub fn embed(batch: &RecordBatch, dir: &Path) -> Result<RecordBatch, String> {
+pub fn embed(batch: &RecordBatch, dir: &Path) -> Result<RecordBatch, FramesError> {
     let table = Path::new("scene table");
     let ids = crate::read::required_strings(batch, table, "scene_id")?;
     let mut columns = batch.columns().to_vec();
@@ -69,12 +96,12 @@ pub fn embed(batch: &RecordBatch, dir: &Path) -> Result<RecordBatch, String> {
         let index = batch
             .schema()
             .index_of(&name)
-            .map_err(|_| format!("the scene table has no column `{name}`"))?;
+            .map_err(|_| FramesError::NoColumn(name.clone()))?;
         let current = batch
             .column(index)
             .as_any()
             .downcast_ref::<ListArray>()
-            .ok_or_else(|| format!("column `{name}` is not a list"))?;
+            .ok_or_else(|| FramesError::NotAList(name.clone()))?;
         let rendered = match batch.column_by_name(&video_column(cam)) {
             Some(_) => crate::read::strings(batch, table, &video_column(cam))?,
             None => vec![None; batch.num_rows()],
@@ -89,8 +116,11 @@ pub fn embed(batch: &RecordBatch, dir: &Path) -> Result<RecordBatch, String> {
             } else if rendered[r].is_some() {
                 for &t in FRAME_TIMES.iter() {
                     let rel = frame_path(id, cam, t);
-                    let bytes = std::fs::read(dir.join(&rel))
-                        .map_err(|e| format!("{}: {e}", dir.join(&rel).display()))?;
+                    let bytes =
+                        std::fs::read(dir.join(&rel)).map_err(|source| FramesError::Frame {
+                            path: dir.join(&rel),
+                            source,
+                        })?;
                     let s = b.values();
                     s.field_builder::<BinaryBuilder>(0)
                         .expect("bytes")
@@ -107,7 +137,7 @@ pub fn embed(batch: &RecordBatch, dir: &Path) -> Result<RecordBatch, String> {
         }
         columns[index] = Arc::new(b.finish());
     }
-    RecordBatch::try_new(batch.schema(), columns).map_err(|e| e.to_string())
+    RecordBatch::try_new(batch.schema(), columns).map_err(|e| FramesError::Arrow(e.to_string()))
 }
 
 /// Copies row `r`'s list of images from `from`.

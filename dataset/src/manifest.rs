@@ -28,6 +28,32 @@ pub type PlannedSelection = rh_physics::spec::Selection;
 pub type PlannedSelection = serde_json::Value;
 
 pub const MANIFEST_FILE: &str = "build.json";
+
+/// Why `build.json` (or the configuration it records) cannot be used; the message names
+/// the file.
+#[derive(Debug, thiserror::Error)]
+pub enum ManifestError {
+    #[error("cannot read {}: {source}", .path.display())]
+    Read {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{} is not an rh-pipeline build manifest: {message}", .path.display())]
+    NotAManifest {
+        path: std::path::PathBuf,
+        message: String,
+    },
+    /// The recorded configuration does not parse as this version's `Config`.
+    #[error("{MANIFEST_FILE}: its configuration cannot be read: {message}")]
+    Config { message: String },
+}
+
+/// The message, for callers that pass errors on as text.
+impl From<ManifestError> for String {
+    fn from(e: ManifestError) -> String {
+        e.to_string()
+    }
+}
 pub const FORMAT: &str = "rh-build/1";
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -165,9 +191,10 @@ impl Manifest {
 
     /// The configuration the build ran with.
     #[cfg(feature = "write")]
-    pub fn build_config(&self) -> Result<Config, String> {
-        serde_json::from_value(self.config.clone())
-            .map_err(|e| format!("{MANIFEST_FILE}: its configuration cannot be read: {e}"))
+    pub fn build_config(&self) -> Result<Config, ManifestError> {
+        serde_json::from_value(self.config.clone()).map_err(|e| ManifestError::Config {
+            message: e.to_string(),
+        })
     }
 
     /// Names the fields in which `other` differs from `self` (empty when equal; the
@@ -239,19 +266,19 @@ impl Manifest {
     }
 
     /// Reads `DIR/build.json`; `Ok(None)` when there is none.
-    pub fn read(dir: &Path) -> Result<Option<Manifest>, String> {
+    pub fn read(dir: &Path) -> Result<Option<Manifest>, ManifestError> {
         let path = dir.join(MANIFEST_FILE);
         let text = match std::fs::read_to_string(&path) {
             Ok(t) => t,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-            Err(e) => return Err(format!("cannot read {}: {e}", path.display())),
+            Err(source) => return Err(ManifestError::Read { path, source }),
         };
-        serde_json::from_str(&text).map(Some).map_err(|e| {
-            format!(
-                "{} is not an rh-pipeline build manifest: {e}",
-                path.display()
-            )
-        })
+        serde_json::from_str(&text)
+            .map(Some)
+            .map_err(|e| ManifestError::NotAManifest {
+                path,
+                message: e.to_string(),
+            })
     }
 }
 
@@ -261,7 +288,7 @@ impl Manifest {
 /// it records are missing. The message names what is missing and the command that
 /// finishes the build (`build` with the same arguments resumes). Only looks whether the
 /// files are there; `rh-pipeline verify` checks their content.
-pub fn unfinished(dir: &Path) -> Result<Option<String>, String> {
+pub fn unfinished(dir: &Path) -> Result<Option<String>, ManifestError> {
     let Some(m) = Manifest::read(dir)? else {
         return Ok(None);
     };

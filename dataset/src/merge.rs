@@ -54,12 +54,14 @@ fn file_columns() -> Vec<String> {
 /// Reads and checks one shard directory; returns its manifest and its rows' scene ids,
 /// indices and file columns.
 fn read_shard(dir: &Path) -> Result<(Manifest, arrow::array::RecordBatch), BuildError> {
-    let manifest = Manifest::read(dir).map_err(input)?.ok_or_else(|| {
-        input(format!(
-            "{}: no {MANIFEST_FILE}; not a directory written by `rh-pipeline build`",
-            dir.display()
-        ))
-    })?;
+    let manifest = Manifest::read(dir)
+        .map_err(|e| input(e.into()))?
+        .ok_or_else(|| {
+            input(format!(
+                "{}: no {MANIFEST_FILE}; not a directory written by `rh-pipeline build`",
+                dir.display()
+            ))
+        })?;
     let data = dir.join(table::data_file_name(
         manifest.shard[0] as usize,
         manifest.shard[1] as usize,
@@ -74,7 +76,7 @@ fn read_shard(dir: &Path) -> Result<(Manifest, arrow::array::RecordBatch), Build
     }
     let columns = file_columns();
     let names: Vec<&str> = columns.iter().map(String::as_str).collect();
-    let rows = stream::read_columns(&data, &names).map_err(input)?;
+    let rows = stream::read_columns(&data, &names).map_err(|e| input(e.into()))?;
     let indices = table::u64_column(&rows, "scene_index");
     let expected: Vec<u64> = manifest
         .groups()
@@ -233,7 +235,7 @@ pub fn merge(out: &Path, shards: &[PathBuf]) -> Result<MergeSummary, BuildError>
         &out.join(table::data_file_name(0, 1)),
         &stream::SUMMARY_COLUMNS,
     )
-    .map_err(BuildError::Internal)?;
+    .map_err(|e| BuildError::Internal(e.into()))?;
     Ok(MergeSummary {
         out: out.display().to_string(),
         shards: read.len(),

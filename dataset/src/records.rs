@@ -26,8 +26,30 @@ pub fn record_path(out: &Path, g: u64) -> PathBuf {
         .join(format!("{g:08}.parquet"))
 }
 
-fn internal(path: &Path, e: impl std::fmt::Display) -> String {
-    format!("{}: {e}", path.display())
+/// Why a group's records could not be written, gathered or restored; the message names
+/// the file.
+#[derive(Debug, thiserror::Error)]
+pub enum RecordError {
+    /// `FILE: WHAT` (writing it, or reading back what it names).
+    #[error("{}: {message}", .path.display())]
+    File { path: PathBuf, message: String },
+    /// A finished group without its `<g>.sha256.json`.
+    #[error("{}: checksums missing", .path.display())]
+    ChecksumsMissing { path: PathBuf },
+}
+
+/// The message, for callers that pass errors on as text.
+impl From<RecordError> for String {
+    fn from(e: RecordError) -> String {
+        e.to_string()
+    }
+}
+
+fn internal(path: &Path, e: impl std::fmt::Display) -> RecordError {
+    RecordError::File {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
 }
 
 /// Group `g`'s files, written under temporary names for the syncer to make durable in
@@ -40,7 +62,7 @@ pub fn group_files(
     results: &[SceneResult],
     rejections: &Rejections,
     catalog: &Catalog,
-) -> Result<Vec<Unsynced>, String> {
+) -> Result<Vec<Unsynced>, RecordError> {
     let mut files = Vec::with_capacity(results.len() + 3);
     let mut spec_sums = FileSums::new();
     for r in results {
@@ -135,16 +157,14 @@ pub fn gather_rejections(out: &Path, groups: &[u64]) -> Option<BTreeMap<String, 
 }
 
 /// The checksums of every finished group's files, together.
-pub fn gather_sums(out: &Path, groups: &[u64]) -> Result<FileSums, String> {
+pub fn gather_sums(out: &Path, groups: &[u64]) -> Result<FileSums, RecordError> {
     let mut sums = FileSums::new();
     for &g in groups {
         let path = record_path(out, g);
-        let group = integrity::read_group_sums(&path).ok_or_else(|| {
-            format!(
-                "{}: checksums missing",
-                integrity::group_sums_path(&path).display()
-            )
-        })?;
+        let group =
+            integrity::read_group_sums(&path).ok_or_else(|| RecordError::ChecksumsMissing {
+                path: integrity::group_sums_path(&path),
+            })?;
         sums.extend(group);
     }
     Ok(sums)
@@ -187,7 +207,7 @@ pub fn load_record(out: &Path, manifest: &Manifest, g: u64) -> Option<RecordBatc
 pub fn reopen_if_damaged(
     out: &Path,
     manifest: &Manifest,
-) -> Result<Vec<integrity::FileProblem>, String> {
+) -> Result<Vec<integrity::FileProblem>, RecordError> {
     let Some(sums) = &manifest.files else {
         // A finished build of a version that recorded no checksums: nothing to compare.
         return Ok(vec![]);

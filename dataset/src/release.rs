@@ -25,6 +25,78 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
+/// Why a release file, a dataset's fingerprint or a downloaded dataset is unusable; the
+/// message names the file, the field or the repository.
+#[derive(Debug, thiserror::Error)]
+pub enum ReleaseError {
+    /// The release file is not valid TOML of a release.
+    #[error("{origin}: {message}")]
+    Parse { origin: String, message: String },
+    #[error("{origin}: {field} must be a SHA-256 in lowercase hex (64 digits), not '{value}'")]
+    NotSha256 {
+        origin: String,
+        field: String,
+        value: String,
+    },
+    #[error("{origin}: id must be set and n at least 1")]
+    NoIdentity { origin: String },
+    #[error("cannot read the release file {origin}: {source}")]
+    ReadRelease {
+        origin: String,
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Read(#[from] crate::read::ReadError),
+    #[error(transparent)]
+    Manifest(#[from] crate::manifest::ManifestError),
+    #[error("{} holds no Parquet table", .folder.display())]
+    NoTable { folder: PathBuf },
+    /// A file of the fingerprint: `FILE: WHAT`.
+    #[error("{}: {what}", .file.display())]
+    Rows { file: PathBuf, what: String },
+    /// A spec file or the `specs/` folder.
+    #[error("cannot read {}: {source}", .path.display())]
+    Specs {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(
+        "the Hub dataset {repo} holds no ReactHuman tables (no data/*.parquet), so nothing in it can be scored or run: it holds {holds}. \
+         The paper's metadata-only release is such a repository. A dataset that scores: the project's release {released} \
+         (what rh-score uses without --dataset), or the same release built here with `rh-pipeline build --release --out DIR`, then --dataset DIR"
+    )]
+    NoTables {
+        repo: String,
+        holds: String,
+        released: String,
+    },
+    /// The release's repository holds a build that names another release (`named`: "no
+    /// release" or "release ID").
+    #[error("{repo} should hold release {id} ({origin}) but its build.json names {named}: build and upload it with `rh-pipeline build --release`")]
+    WrongRelease {
+        repo: String,
+        id: String,
+        origin: String,
+        named: String,
+    },
+    #[error(
+        "{repo} is not release {id} as {origin} pins it (a changed or damaged copy): {differences}"
+    )]
+    Differs {
+        repo: String,
+        id: String,
+        origin: String,
+        differences: String,
+    },
+}
+
+/// The message, for callers that pass errors on as text.
+impl From<ReleaseError> for String {
+    fn from(e: ReleaseError) -> String {
+        e.to_string()
+    }
+}
+
 /// The embedded `configs/release.toml`.
 pub const EMBEDDED_RELEASE: &str = include_str!("../../configs/release.toml");
 /// The embedded `configs/prompt.toml` (only its `version` is read here).
@@ -88,8 +160,11 @@ fn is_sha256(s: &str) -> bool {
 
 impl Release {
     /// Parses a release file's text (`origin` names it in errors).
-    pub fn parse(text: &str, origin: &str) -> Result<Release, String> {
-        let r: Release = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
+    pub fn parse(text: &str, origin: &str) -> Result<Release, ReleaseError> {
+        let r: Release = toml::from_str(text).map_err(|e| ReleaseError::Parse {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })?;
         let hashes = [
             ("pins.config_sha256", &r.pins.config_sha256),
             ("pins.catalog_sha256", &r.pins.catalog_sha256),
@@ -99,20 +174,24 @@ impl Release {
         ];
         for (field, value) in hashes {
             if !is_sha256(value) {
-                return Err(format!(
-                    "{origin}: {field} must be a SHA-256 in lowercase hex (64 digits), not '{value}'"
-                ));
+                return Err(ReleaseError::NotSha256 {
+                    origin: origin.to_string(),
+                    field: field.to_string(),
+                    value: value.to_string(),
+                });
             }
         }
         if r.id.trim().is_empty() || r.n == 0 {
-            return Err(format!("{origin}: id must be set and n at least 1"));
+            return Err(ReleaseError::NoIdentity {
+                origin: origin.to_string(),
+            });
         }
         Ok(r)
     }
 
     /// The release file `path`, else `$RH_RELEASE_CONFIG`, else the embedded
     /// `configs/release.toml`; with the name it was read from.
-    pub fn load(path: Option<&Path>) -> Result<(Release, String), String> {
+    pub fn load(path: Option<&Path>) -> Result<(Release, String), ReleaseError> {
         let path: Option<PathBuf> = path.map(Path::to_path_buf).or_else(|| {
             std::env::var_os(RELEASE_ENV)
                 .filter(|v| !v.is_empty())
@@ -125,8 +204,10 @@ impl Release {
             )),
             Some(p) => {
                 let origin = p.display().to_string();
-                let text = std::fs::read_to_string(&p)
-                    .map_err(|e| format!("cannot read the release file {origin}: {e}"))?;
+                let text = match std::fs::read_to_string(&p) {
+                    Ok(text) => text,
+                    Err(source) => return Err(ReleaseError::ReadRelease { origin, source }),
+                };
                 Ok((Release::parse(&text, &origin)?, origin))
             }
         }
@@ -157,7 +238,7 @@ pub fn is_rendered_media(column: &str) -> bool {
     }) || column == video_column("full_event")
 }
 
-fn hash_rows(hasher: &mut Sha256, batch: &RecordBatch, file: &Path) -> Result<(), String> {
+fn hash_rows(hasher: &mut Sha256, batch: &RecordBatch, file: &Path) -> Result<(), ReleaseError> {
     let options = FormatOptions::default().with_null("null");
     let schema = batch.schema();
     let formatters: Vec<ArrayFormatter> = batch
@@ -165,7 +246,10 @@ fn hash_rows(hasher: &mut Sha256, batch: &RecordBatch, file: &Path) -> Result<()
         .iter()
         .map(|c| ArrayFormatter::try_new(c.as_ref(), &options))
         .collect::<Result<_, _>>()
-        .map_err(|e| format!("{}: a column cannot be read: {e}", file.display()))?;
+        .map_err(|e| ReleaseError::Rows {
+            file: file.to_path_buf(),
+            what: format!("a column cannot be read: {e}"),
+        })?;
     for row in 0..batch.num_rows() {
         for (field, f) in schema.fields().iter().zip(&formatters) {
             hasher.update(format!("{}={}\x1f", field.name(), f.value(row)).as_bytes());
@@ -176,16 +260,21 @@ fn hash_rows(hasher: &mut Sha256, batch: &RecordBatch, file: &Path) -> Result<()
 }
 
 /// SHA-256 of the rows of the tables in `folder` (name order), media columns left out.
-fn table_sha256(folder: &Path) -> Result<String, String> {
+fn table_sha256(folder: &Path) -> Result<String, ReleaseError> {
     let files = crate::read::parquet_files(folder)?;
     if files.is_empty() {
-        return Err(format!("{} holds no Parquet table", folder.display()));
+        return Err(ReleaseError::NoTable {
+            folder: folder.to_path_buf(),
+        });
     }
     let mut hasher = Sha256::new();
     for file in &files {
         let reader = crate::read::open_columns(file, 256, |name| !is_rendered_media(name))?;
         for batch in reader {
-            let batch = batch.map_err(|e| format!("{}: cannot be read: {e}", file.display()))?;
+            let batch = batch.map_err(|e| ReleaseError::Rows {
+                file: file.to_path_buf(),
+                what: format!("cannot be read: {e}"),
+            })?;
             hash_rows(&mut hasher, &batch, file)?;
         }
     }
@@ -193,18 +282,23 @@ fn table_sha256(folder: &Path) -> Result<String, String> {
 }
 
 /// SHA-256 of `name<TAB>SHA-256\n` for every file of `specs/`, by name.
-fn specs_sha256(dir: &Path) -> Result<String, String> {
+fn specs_sha256(dir: &Path) -> Result<String, ReleaseError> {
     let specs = dir.join("specs");
     let mut names: Vec<String> = std::fs::read_dir(&specs)
-        .map_err(|e| format!("cannot read {}: {e}", specs.display()))?
+        .map_err(|source| ReleaseError::Specs {
+            path: specs.clone(),
+            source,
+        })?
         .flatten()
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .collect();
     names.sort();
     let mut hasher = Sha256::new();
     for name in names {
-        let sum = sha256_file(&specs.join(&name))
-            .map_err(|e| format!("cannot read {}: {e}", specs.join(&name).display()))?;
+        let sum = sha256_file(&specs.join(&name)).map_err(|source| ReleaseError::Specs {
+            path: specs.join(&name),
+            source,
+        })?;
         hasher.update(format!("{name}\t{sum}\n").as_bytes());
     }
     Ok(hex(&hasher.finalize()))
@@ -212,7 +306,7 @@ fn specs_sha256(dir: &Path) -> Result<String, String> {
 
 impl Fingerprint {
     /// The fingerprint of the dataset in `dir`.
-    pub fn of(dir: &Path) -> Result<Fingerprint, String> {
+    pub fn of(dir: &Path) -> Result<Fingerprint, ReleaseError> {
         Ok(Fingerprint {
             scenes_sha256: table_sha256(&dir.join("data"))?,
             eval_sha256: table_sha256(&dir.join("eval"))?,
@@ -295,13 +389,17 @@ pub fn without_tables(dir: &Path) -> Option<String> {
 /// why, for exit 2): a repository with no ReactHuman tables (the paper's metadata-only
 /// release), and a copy of the release whose content differs from the release's pinned
 /// fingerprint. A copy of the release that matches returns the note saying so.
-pub fn check_download(repo: &str, dir: &Path, released: &str) -> Result<Option<String>, String> {
+pub fn check_download(
+    repo: &str,
+    dir: &Path,
+    released: &str,
+) -> Result<Option<String>, ReleaseError> {
     if let Some(holds) = without_tables(dir) {
-        return Err(format!(
-            "the Hub dataset {repo} holds no ReactHuman tables (no data/*.parquet), so nothing in it can be scored or run: it holds {holds}. \
-             The paper's metadata-only release is such a repository. A dataset that scores: the project's release {released} \
-             (what rh-score uses without --dataset), or the same release built here with `rh-pipeline build --release --out DIR`, then --dataset DIR"
-        ));
+        return Err(ReleaseError::NoTables {
+            repo: repo.to_string(),
+            holds,
+            released: released.to_string(),
+        });
     }
     let manifest = crate::manifest::Manifest::read(dir)?;
     let claimed = manifest.as_ref().and_then(|m| m.release.clone());
@@ -320,11 +418,12 @@ pub fn check_download(repo: &str, dir: &Path, released: &str) -> Result<Option<S
             )))
         }
         other => {
-            return Err(format!(
-                "{repo} should hold release {} ({origin}) but its build.json names {}: build and upload it with `rh-pipeline build --release`",
-                release.id,
-                other.map_or("no release".to_string(), |id| format!("release {id}"))
-            ))
+            return Err(ReleaseError::WrongRelease {
+                repo: repo.to_string(),
+                id: release.id,
+                origin,
+                named: other.map_or("no release".to_string(), |id| format!("release {id}")),
+            })
         }
     }
     let mut differs = Vec::new();
@@ -333,11 +432,12 @@ pub fn check_download(repo: &str, dir: &Path, released: &str) -> Result<Option<S
     }
     differs.extend(Fingerprint::of(dir)?.differences(&release.fingerprint));
     if !differs.is_empty() {
-        return Err(format!(
-            "{repo} is not release {} as {origin} pins it (a changed or damaged copy): {}",
-            release.id,
-            differs.join("; ")
-        ));
+        return Err(ReleaseError::Differs {
+            repo: repo.to_string(),
+            id: release.id,
+            origin,
+            differences: differs.join("; "),
+        });
     }
     Ok(Some(format!(
         "{repo} is release {}: its fingerprint matches {origin}",
@@ -386,7 +486,7 @@ mod tests {
             Some(r.pins.prompt_version.as_str())
         );
         let bad = EMBEDDED_RELEASE.replace(&r.fingerprint.specs_sha256, "abc");
-        let e = Release::parse(&bad, "x.toml").unwrap_err();
+        let e = Release::parse(&bad, "x.toml").unwrap_err().to_string();
         assert!(e.contains("x.toml: fingerprint.specs_sha256"), "{e}");
     }
 
@@ -410,7 +510,9 @@ mod tests {
         std::fs::write(tmp.path().join("meta/scenes.json"), "[]").unwrap();
         let what = without_tables(tmp.path()).unwrap();
         assert_eq!(what, "2 file(s): README.md, meta/scenes.json");
-        let e = check_download("a/b", tmp.path(), "c/d@v1").unwrap_err();
+        let e = check_download("a/b", tmp.path(), "c/d@v1")
+            .unwrap_err()
+            .to_string();
         assert!(
             e.contains("a/b holds no ReactHuman tables") && e.contains(&what),
             "{e}"

@@ -10,6 +10,35 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+/// Why a streamed scene table could not be written or a projection read; the message
+/// names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum StreamError {
+    /// `FILE: WHAT` (creating, writing, syncing or renaming it, or decoding its rows).
+    #[error("{}: {message}", .path.display())]
+    File { path: PathBuf, message: String },
+    #[error("{}: no column '{column}'", .path.display())]
+    NoColumn { path: PathBuf, column: String },
+    #[error(transparent)]
+    Read(#[from] crate::read::ReadError),
+}
+
+impl StreamError {
+    fn file(path: &Path, e: impl std::fmt::Display) -> StreamError {
+        StreamError::File {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        }
+    }
+}
+
+/// The message, for callers that pass errors on as text.
+impl From<StreamError> for String {
+    fn from(e: StreamError) -> String {
+        e.to_string()
+    }
+}
+
 /// A scene table written to disk as its rows arrive, one row group at a time: at most
 /// `ROW_GROUP_SIZE` rows are held in memory, whatever the table's length. The rows are
 /// gathered into whole row groups before they reach the Parquet writer, so the file is
@@ -26,14 +55,14 @@ pub struct ParquetStream {
 
 impl ParquetStream {
     /// A table of `ROW_GROUP_SIZE` rows per row group.
-    pub fn create(path: &Path) -> Result<ParquetStream, String> {
+    pub fn create(path: &Path) -> Result<ParquetStream, StreamError> {
         ParquetStream::create_with(path, ROW_GROUP_SIZE)
     }
 
     /// A table of `group_rows` rows per row group (`frames::IMAGE_ROW_GROUP_SIZE` when
     /// the rows carry images).
-    pub fn create_with(path: &Path, group_rows: usize) -> Result<ParquetStream, String> {
-        let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    pub fn create_with(path: &Path, group_rows: usize) -> Result<ParquetStream, StreamError> {
+        let fail = |e: &dyn std::fmt::Display| StreamError::file(path, e);
         fs::create_dir_all(path.parent().unwrap_or(Path::new("."))).map_err(|e| fail(&e))?;
         let tmp = rh_contract::fsio::temp_sibling(path);
         let file = fs::File::create(&tmp).map_err(|e| fail(&e))?;
@@ -52,7 +81,7 @@ impl ParquetStream {
     }
 
     /// Appends rows (scene-table columns, any number of rows).
-    pub fn write(&mut self, batch: &RecordBatch) -> Result<(), String> {
+    pub fn write(&mut self, batch: &RecordBatch) -> Result<(), StreamError> {
         let mut offset = 0;
         while offset < batch.num_rows() {
             let take = (self.group_rows - self.pending_rows).min(batch.num_rows() - offset);
@@ -67,23 +96,23 @@ impl ParquetStream {
     }
 
     /// Hands the gathered rows (one row group or the last, shorter one) to the writer.
-    fn write_pending(&mut self) -> Result<(), String> {
+    fn write_pending(&mut self) -> Result<(), StreamError> {
         if self.pending.is_empty() {
             return Ok(());
         }
-        let rows = concat(&self.pending).map_err(|e| format!("{}: {e}", self.path.display()))?;
+        let rows = concat(&self.pending).map_err(|e| StreamError::file(&self.path, e))?;
         self.pending.clear();
         self.pending_rows = 0;
         let writer = self.writer.as_mut().expect("open until finish");
         writer
             .write(&rows)
-            .map_err(|e| format!("{}: {e}", self.path.display()))
+            .map_err(|e| StreamError::file(&self.path, e))
     }
 
     /// Writes the last rows and the footer, syncs, and renames the file into place.
-    pub fn finish(mut self) -> Result<(), String> {
+    pub fn finish(mut self) -> Result<(), StreamError> {
         self.write_pending()?;
-        let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", self.path.display());
+        let fail = |e: &dyn std::fmt::Display| StreamError::file(&self.path, e);
         let writer = self.writer.take().expect("open until finish");
         let file = writer
             .into_inner()
@@ -125,12 +154,15 @@ pub fn project(batch: &RecordBatch, names: &[&str]) -> RecordBatch {
 
 /// The named columns of a scene-table Parquet file (a projection: the other columns are
 /// never decoded).
-pub fn read_columns(path: &Path, names: &[&str]) -> Result<RecordBatch, String> {
-    let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+pub fn read_columns(path: &Path, names: &[&str]) -> Result<RecordBatch, StreamError> {
+    let fail = |e: &dyn std::fmt::Display| StreamError::file(path, e);
     let reader = crate::read::open_columns(path, 8192, |n| names.contains(&n))?;
     let schema = arrow::array::RecordBatchReader::schema(&reader);
     if let Some(n) = names.iter().find(|n| schema.index_of(n).is_err()) {
-        return Err(format!("{}: no column '{n}'", path.display()));
+        return Err(StreamError::NoColumn {
+            path: path.to_path_buf(),
+            column: n.to_string(),
+        });
     }
     let batches: Vec<RecordBatch> = reader.collect::<Result<_, _>>().map_err(|e| fail(&e))?;
     let batch = arrow::compute::concat_batches(&schema, &batches).map_err(|e| fail(&e))?;

@@ -93,14 +93,48 @@ pub fn optional_string_column(batch: &RecordBatch, name: &str) -> Vec<Option<Str
     }
 }
 
+/// Why scene rows could not be read back or put together.
+#[derive(Debug, thiserror::Error)]
+pub enum TableError {
+    #[error(transparent)]
+    Read(#[from] read::ReadError),
+    /// `FILE: WHAT` (its rows could not be decoded or put together).
+    #[error("{}: {message}", .path.display())]
+    File { path: PathBuf, message: String },
+    #[error("{}: no data/*.parquet files", .dir.display())]
+    NoData { dir: PathBuf },
+    /// A batch whose columns are not `schema()`'s.
+    #[error("its columns are not this version's scene table")]
+    Columns,
+    /// Arrow refused to put the batches together.
+    #[error("{0}")]
+    Arrow(String),
+}
+
+impl TableError {
+    fn file(path: &Path, e: impl std::fmt::Display) -> TableError {
+        TableError::File {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        }
+    }
+}
+
+/// The message, for callers that pass errors on as text.
+impl From<TableError> for String {
+    fn from(e: TableError) -> String {
+        e.to_string()
+    }
+}
+
 /// Reads a Parquet file of scene rows written by `parquet_bytes` back into one batch with
 /// the canonical schema (`schema()`), the images of `<cam>_frames` left out (null).
-pub fn read_batch(path: &Path) -> Result<RecordBatch, String> {
+pub fn read_batch(path: &Path) -> Result<RecordBatch, TableError> {
     let batches: Vec<RecordBatch> = read::open_parquet(path, 8192)?
         .map(|b| b.map(|b| with_null_images(&b)))
         .collect::<Result<_, _>>()
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    concat(&batches).map_err(|e| format!("{}: {e}", path.display()))
+        .map_err(|e| TableError::file(path, e))?;
+    concat(&batches).map_err(|e| TableError::file(path, e))
 }
 
 /// `batch` (read without its image columns) with null `<cam>_frames` columns in their
@@ -124,20 +158,20 @@ fn with_null_images(batch: &RecordBatch) -> RecordBatch {
 
 /// Concatenates scene batches into one with the canonical schema; fails if a batch's
 /// columns differ from `schema()`.
-pub fn concat(batches: &[RecordBatch]) -> Result<RecordBatch, String> {
+pub fn concat(batches: &[RecordBatch]) -> Result<RecordBatch, TableError> {
     let schema = Arc::new(schema());
     let plain = plain_schema();
     let mut aligned = Vec::with_capacity(batches.len());
     for b in batches {
         if b.schema().fields() != plain.fields() {
-            return Err("its columns are not this version's scene table".into());
+            return Err(TableError::Columns);
         }
         aligned.push(
             RecordBatch::try_new(schema.clone(), b.columns().to_vec())
-                .map_err(|e| e.to_string())?,
+                .map_err(|e| TableError::Arrow(e.to_string()))?,
         );
     }
-    arrow::compute::concat_batches(&schema, &aligned).map_err(|e| e.to_string())
+    arrow::compute::concat_batches(&schema, &aligned).map_err(|e| TableError::Arrow(e.to_string()))
 }
 
 /// The rows of `batch` at `indices`, in that order.
@@ -221,15 +255,17 @@ pub fn data_files(dir: &Path) -> Result<Vec<PathBuf>, read::ReadError> {
 }
 
 /// The (scene_id, spec_file, state_hash) of every row of a dataset, for `verify`.
-pub fn read_hashes(dir: &Path) -> Result<Vec<(String, String, String)>, String> {
+pub fn read_hashes(dir: &Path) -> Result<Vec<(String, String, String)>, TableError> {
     let files = data_files(dir)?;
     if files.is_empty() {
-        return Err(format!("{}: no data/*.parquet files", dir.display()));
+        return Err(TableError::NoData {
+            dir: dir.to_path_buf(),
+        });
     }
     let mut rows = Vec::new();
     for path in files {
         for batch in read::open_parquet(&path, 8192)? {
-            let batch = batch.map_err(|e| format!("{}: {e}", path.display()))?;
+            let batch = batch.map_err(|e| TableError::file(&path, e))?;
             let ids = read::required_strings(&batch, &path, "scene_id")?;
             let specs = read::required_strings(&batch, &path, "spec_file")?;
             let hashes = read::required_strings(&batch, &path, "state_hash")?;

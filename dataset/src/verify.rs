@@ -25,6 +25,29 @@ use rh_scenes::driver::{plan_and_produce, SceneResult};
 use serde::Serialize;
 use std::path::Path;
 
+/// Why a dataset cannot be checked at all (its problems are in the [`VerifyReport`]).
+#[derive(Debug, thiserror::Error)]
+pub enum VerifyError {
+    #[error(transparent)]
+    Table(#[from] table::TableError),
+    #[error(transparent)]
+    Manifest(#[from] crate::manifest::ManifestError),
+    #[error("{}: no {MANIFEST_FILE}; not a dataset written by `rh-pipeline build` (`verify --fast` replays specs without it)", .dir.display())]
+    NoManifest { dir: std::path::PathBuf },
+    #[error("{} was built from another catalog than the one loaded; pass the same --catalog DIR as the build", .dir.display())]
+    OtherCatalog { dir: std::path::PathBuf },
+    /// A scene group could not be derived again (`driver::plan_and_produce`'s message).
+    #[error("{0}")]
+    Derive(String),
+}
+
+/// The message, for callers that pass errors on as text.
+impl From<VerifyError> for String {
+    fn from(e: VerifyError) -> String {
+        e.to_string()
+    }
+}
+
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct Mismatch {
     pub scene_id: String,
@@ -51,7 +74,7 @@ impl VerifyReport {
 }
 
 /// The replay-only check (`verify --fast`). Err only when the dataset itself cannot be read.
-pub fn verify_fast(dir: &Path) -> Result<VerifyReport, String> {
+pub fn verify_fast(dir: &Path) -> Result<VerifyReport, VerifyError> {
     let rows = table::read_hashes(dir)?;
     let mut mismatches: Vec<Mismatch> = rows
         .par_iter()
@@ -92,18 +115,14 @@ pub fn verify_fast(dir: &Path) -> Result<VerifyReport, String> {
 
 /// The full check. Err when the dataset cannot be checked at all (no manifest, another
 /// catalog than the one it was built from).
-pub fn verify(dir: &Path, catalog: &Catalog) -> Result<VerifyReport, String> {
-    let manifest = Manifest::read(dir)?.ok_or_else(|| {
-        format!(
-            "{}: no {MANIFEST_FILE}; not a dataset written by `rh-pipeline build` (`verify --fast` replays specs without it)",
-            dir.display()
-        )
+pub fn verify(dir: &Path, catalog: &Catalog) -> Result<VerifyReport, VerifyError> {
+    let manifest = Manifest::read(dir)?.ok_or_else(|| VerifyError::NoManifest {
+        dir: dir.to_path_buf(),
     })?;
     if catalog_sha256(catalog) != manifest.catalog_sha256 {
-        return Err(format!(
-            "{} was built from another catalog than the one loaded; pass the same --catalog DIR as the build",
-            dir.display()
-        ));
+        return Err(VerifyError::OtherCatalog {
+            dir: dir.to_path_buf(),
+        });
     }
     let config = manifest.build_config()?;
 
@@ -141,7 +160,7 @@ pub fn verify(dir: &Path, catalog: &Catalog) -> Result<VerifyReport, String> {
     let rows = rows.ok();
     let index = rows.as_ref().map(|r| table::u64_column(r, "scene_index"));
     let groups = manifest.groups();
-    let per_group: Vec<Result<(usize, Vec<Mismatch>), String>> = groups
+    let per_group: Vec<Result<(usize, Vec<Mismatch>), VerifyError>> = groups
         .par_iter()
         .map(|&g| {
             // As a build (`driver::plan_and_produce`): a build from descriptions stored
@@ -154,7 +173,8 @@ pub fn verify(dir: &Path, catalog: &Catalog) -> Result<VerifyReport, String> {
                 g,
                 manifest.group_size(g),
                 &config,
-            )?;
+            )
+            .map_err(VerifyError::Derive)?;
             let stored = match (&rows, &index) {
                 (Some(rows), Some(index)) => {
                     let picks: Vec<u32> = (0..rows.num_rows() as u32)

@@ -47,7 +47,7 @@ pub fn resolve_dir(arg: Option<String>) -> Result<PathBuf> {
                 Err(e) => {
                     let paper = rh_grade::dataset_diagnosis::paper_scene_folders(&snapshot.path);
                     return Err(InputError(match paper {
-                        0 => e,
+                        0 => e.to_string(),
                         _ => format!("{e} ({paper} scene folders <family>/<family>__dN_vM/: the paper's metadata-only layout)"),
                     })
                     .into());

@@ -47,6 +47,29 @@ pub struct Command {
     pub knee_bend: f64,
 }
 
+/// Why a session cannot start or take a command; the message names the field or rate.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ControlError {
+    #[error("command field {field} is not finite ({value})")]
+    NotFinite { field: &'static str, value: f64 },
+    #[error(transparent)]
+    Config(#[from] rh_contract::execution::ExecConfigError),
+    /// `max_hz`: the physics rate.
+    #[error("control_hz must be in (0, {max_hz}] (the physics rate), got {control_hz}")]
+    RateOutOfRange { max_hz: f64, control_hz: f64 },
+    #[error("control_hz must divide the physics rate {physics_hz} Hz (a whole number of physics steps per command), got {control_hz}")]
+    NotADivisor { physics_hz: f64, control_hz: f64 },
+    #[error("the session has ended (terminated or truncated); start a new one")]
+    Ended,
+}
+
+/// The message, for callers that pass errors on as text.
+impl From<ControlError> for String {
+    fn from(e: ControlError) -> String {
+        e.to_string()
+    }
+}
+
 impl Command {
     /// Standing still with the hands at rest.
     pub fn rest() -> Command {
@@ -59,7 +82,7 @@ impl Command {
     }
 
     /// Refuses a non-finite number, naming the field.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ControlError> {
         let fields: [(&str, &[f64]); 4] = [
             ("twist", &self.twist),
             ("left_hand", &self.left),
@@ -68,7 +91,10 @@ impl Command {
         ];
         for (name, values) in fields {
             if let Some(x) = values.iter().find(|x| !x.is_finite()) {
-                return Err(format!("command field {name} is not finite ({x})"));
+                return Err(ControlError::NotFinite {
+                    field: name,
+                    value: *x,
+                });
             }
         }
         Ok(())
@@ -138,21 +164,25 @@ pub struct Session {
 impl Session {
     /// A session from Δ of `replay` (check it first: [`Replay::check`]) under `cfg`,
     /// commanded at `control_hz` (the physics rate divided by a whole number of steps).
-    pub fn new(replay: &Replay, cfg: &ExecConfig, control_hz: f64) -> Result<Session, String> {
+    pub fn new(
+        replay: &Replay,
+        cfg: &ExecConfig,
+        control_hz: f64,
+    ) -> Result<Session, ControlError> {
         cfg.validate()?;
         let dt = replay.spec().physics.dt;
         let ratio = 1.0 / (dt * control_hz);
         if !control_hz.is_finite() || control_hz <= 0.0 || ratio < 1.0 - 1e-9 {
-            return Err(format!(
-                "control_hz must be in (0, {}] (the physics rate), got {control_hz}",
-                1.0 / dt
-            ));
+            return Err(ControlError::RateOutOfRange {
+                max_hz: 1.0 / dt,
+                control_hz,
+            });
         }
         if (ratio - ratio.round()).abs() > 1e-6 {
-            return Err(format!(
-                "control_hz must divide the physics rate {} Hz (a whole number of physics steps per command), got {control_hz}",
-                1.0 / dt
-            ));
+            return Err(ControlError::NotADivisor {
+                physics_hz: 1.0 / dt,
+                control_hz,
+            });
         }
         let substeps = ratio.round() as u32;
         let ex = replay.start(cfg);
@@ -211,9 +241,9 @@ impl Session {
 
     /// Applies `cmd` for one control period (fewer steps if the outcome settles or the
     /// horizon comes first). Refuses after the end and on non-finite numbers.
-    pub fn step(&mut self, cmd: &Command) -> Result<Option<&End>, String> {
+    pub fn step(&mut self, cmd: &Command) -> Result<Option<&End>, ControlError> {
         if self.end.is_some() {
-            return Err("the session has ended (terminated or truncated); start a new one".into());
+            return Err(ControlError::Ended);
         }
         cmd.validate()?;
         let t0 = self.time();
@@ -367,10 +397,10 @@ mod tests {
     fn non_finite_commands_are_refused_by_name() {
         let mut c = Command::rest();
         c.right[1] = f64::NAN;
-        assert!(c.validate().unwrap_err().contains("right_hand"));
+        assert!(c.validate().unwrap_err().to_string().contains("right_hand"));
         c = Command::rest();
         c.knee_bend = f64::INFINITY;
-        assert!(c.validate().unwrap_err().contains("knee_bend"));
+        assert!(c.validate().unwrap_err().to_string().contains("knee_bend"));
         assert!(Command::rest().validate().is_ok());
     }
 }

@@ -336,7 +336,7 @@ pub fn claim_out_dir(out: &Path, manifest: &Manifest) -> Result<bool, BuildError
     std::fs::create_dir_all(out).map_err(fail)?;
     // A build.json without file checksums is a build that stopped before it finished.
     let mut sums_recorded = false;
-    match Manifest::read(out).map_err(BuildError::Input)? {
+    match Manifest::read(out).map_err(|e| BuildError::Input(e.into()))? {
         Some(existing) => {
             sums_recorded = existing.files.is_some();
             let diff = existing.differences(manifest);
@@ -442,9 +442,9 @@ fn finished_build(
         return Ok(None);
     }
     let on_disk = Manifest::read(out)
-        .map_err(BuildError::Input)?
+        .map_err(|e| BuildError::Input(e.into()))?
         .unwrap_or_else(|| manifest.clone());
-    let problems = reopen_if_damaged(out, &on_disk).map_err(BuildError::Internal)?;
+    let problems = reopen_if_damaged(out, &on_disk).map_err(|e| BuildError::Internal(e.into()))?;
     if !problems.is_empty() {
         rh_contract::note!(
             "{} holds this build, but {} file(s) are not what its {MANIFEST_FILE} records ({}); rebuilding the groups they belong to",
@@ -462,7 +462,7 @@ fn finished_build(
     }
     let data_file = table::data_file_name(manifest.shard[0] as usize, manifest.shard[1] as usize);
     let rows = stream::read_columns(&out.join(&data_file), &stream::SUMMARY_COLUMNS)
-        .map_err(BuildError::Internal)?;
+        .map_err(|e| BuildError::Internal(e.into()))?;
     let eval = out
         .join(card::EVAL_FILE)
         .exists()
@@ -571,7 +571,7 @@ pub fn build(
                 // Specs, then the checksums of every file the rows name, and the record
                 // last: its presence says the group (specs, media, sums) is done.
                 let files = group_files(out, g, &results, &rejections, catalog)
-                    .map_err(BuildError::Internal)?;
+                    .map_err(|e| BuildError::Internal(e.into()))?;
                 syncer.submit(files)?;
                 progress.advance(count);
                 Ok(())
@@ -591,11 +591,13 @@ pub fn build(
     // at a time, so memory does not grow with --n.
     let records = |f: &mut RowSink| -> Result<(), BuildError> {
         for &g in &groups {
-            f(table::read_batch(&record_path(out, g)).map_err(BuildError::Internal)?)?;
+            f(table::read_batch(&record_path(out, g))
+                .map_err(|e| BuildError::Internal(e.into()))?)?;
         }
         Ok(())
     };
-    let sums = rh_dataset::records::gather_sums(out, &groups).map_err(BuildError::Internal)?;
+    let sums = rh_dataset::records::gather_sums(out, &groups)
+        .map_err(|e| BuildError::Internal(e.into()))?;
     let rejections = gather_rejections(out, &groups);
     let (rows, eval) = finalize(out, &manifest, &records, sums)?;
     // Retire the records in one atomic step (a rename), then delete them: a crash in

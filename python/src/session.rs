@@ -24,7 +24,7 @@ fn command(a: &[f64]) -> Result<Command> {
         right: [a[6], a[7], a[8]],
         knee_bend: a[9],
     };
-    c.validate().map_err(Error::Value)?;
+    c.validate().map_err(|e| Error::Value(e.to_string()))?;
     Ok(c)
 }
 
@@ -71,8 +71,8 @@ impl NativeSession {
     ) -> PyResult<Self> {
         run(py, || {
             let replay = dataset.replay(&scene_id)?;
-            let s =
-                Session::new(&replay, &dataset.cfg.execution, control_hz).map_err(Error::Value)?;
+            let s = Session::new(&replay, &dataset.cfg.execution, control_hz)
+                .map_err(|e| Error::Value(e.to_string()))?;
             Ok(NativeSession {
                 session: Mutex::new(s),
                 replay,
@@ -85,7 +85,7 @@ impl NativeSession {
         run(py, || {
             let c = command(&action)?;
             self.with(|s| {
-                let end = s.step(&c).map_err(Error::Value)?;
+                let end = s.step(&c).map_err(|e| Error::Value(e.to_string()))?;
                 Ok(end.map(|e| match e {
                     End::Terminated(_) => "terminated",
                     End::Truncated(_) => "truncated",

@@ -198,7 +198,7 @@ mod tests {
         assert_eq!(c.hash(), ExecConfig::embedded_default().hash());
         let mut d = c.clone();
         d.max_speed = f64::NAN;
-        assert!(d.validate().unwrap_err().contains("max_speed"));
+        assert!(d.validate().unwrap_err().to_string().contains("max_speed"));
     }
 
     /// One body, one harm test: the executor judges `struck` with the scene's own label

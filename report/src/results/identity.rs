@@ -64,7 +64,7 @@ impl DatasetIdentity {
     /// The identity of `ds` with the expected scenes `expected`; `build.json` is read
     /// when the dataset has one (a damaged one is an input error naming it).
     pub fn of(ds: &Dataset, expected: &Expected) -> Result<DatasetIdentity> {
-        let manifest = Manifest::read(&ds.dir).map_err(InputError)?;
+        let manifest = Manifest::read(&ds.dir).map_err(|e| InputError(e.into()))?;
         let mut rows: Vec<(&str, &str)> = ds
             .scenes
             .iter()
