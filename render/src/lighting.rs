@@ -113,10 +113,10 @@ fn light_matrix(dir: Vec3, size: [f64; 2], ceiling: f64) -> ([[f32; 4]; 4], f64)
 }
 
 /// The shader's shadow lookup offset along the surface normal (m; `shadow_factor`).
-const SHADOW_NORMAL_OFFSET: f64 = 0.025;
+const SHADOW_NORMAL_OFFSET: f64 = 0.005;
 /// The shader's largest slope-scaled extra normal offset, in shadow-map texels (on
 /// surfaces the light grazes).
-const SHADOW_SLOPE_OFFSET: f64 = 2.5;
+const SHADOW_SLOPE_OFFSET: f64 = 1.0;
 /// How far (texels) the shader's filter reads from the lookup point: a 3×3 grid of
 /// bilinear taps one texel apart, each reading one more texel: 2 texels per axis,
 /// 2·√2 along the diagonal, which 3 bounds.

@@ -81,32 +81,51 @@ fn vs_shadow(v: VIn) -> @builtin(position) vec4<f32> {
 // (SHADOW_PCF_TEXELS).
 fn shadow_factor(world: vec3<f32>, n: vec3<f32>, ndl: f32) -> f32 {
     let size = vec2<f32>(textureDimensions(shadow_tex));
+    // The light matrix's rows: right / radius, up / radius, sun direction / depth range.
+    let r0 = vec3<f32>(u.light_vp[0].x, u.light_vp[1].x, u.light_vp[2].x);
+    let r1 = vec3<f32>(u.light_vp[0].y, u.light_vp[1].y, u.light_vp[2].y);
+    let r2 = vec3<f32>(u.light_vp[0].z, u.light_vp[1].z, u.light_vp[2].z);
     // World size of a shadow-map texel: the orthographic light matrix scales x by
-    // 1 / half-width (its first row).
-    let sx = length(vec3<f32>(u.light_vp[0].x, u.light_vp[1].x, u.light_vp[2].x));
+    // 1 / half-width.
+    let sx = length(r0);
     let texel = 2.0 / (sx * size.x);
-    // Normal offset: a constant (2.5 cm) plus up to 2.5 texels on surfaces the light
-    // grazes (a wall lit at a low angle spans many depths within one texel: without
-    // it the lookup compares a surface against itself and shows acne hatching).
+    // Normal offset: 5 mm plus up to one texel on surfaces the light grazes. Kept small
+    // so that the lookup point is not lifted past a caster a few centimetres above the
+    // receiver (a board resting on a table: larger offsets showed a comb of stripes
+    // there); the receiver-plane depth below keeps lit surfaces free of acne.
     let sin_t = sqrt(max(1.0 - ndl * ndl, 0.0));
-    let lp = u.light_vp * vec4<f32>(world + n * (0.025 + 2.5 * texel * sin_t), 1.0);
+    let lp = u.light_vp * vec4<f32>(world + n * (0.005 + texel * sin_t), 1.0);
     let ndc = lp.xyz / lp.w;
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
     if (uv.x < 0.0 || uv.x > 1.0 || uv.y < 0.0 || uv.y > 1.0 || ndc.z > 1.0) {
         return 1.0;
     }
+    // Receiver-plane depth: the surface's own light depth at each tap, from its normal
+    // in the light's clip space. With the rows r0 = right / R, r1 = up / R, r2 = sun / D
+    // the plane n·dp = 0 has dz/dx = -(n·r0) / (n·r2) · |r2|² / |r0|² (and dz/dy with
+    // r1), so the wide filter compares each tap against the receiver's depth there, not
+    // the centre's. n·sun is clamped to -0.1 where the light grazes.
+    let k2 = dot(r2, r2) / dot(r0, r0);
+    let nd = min(dot(n, r2) / length(r2), -0.1) * length(r2);
+    let dzdx = -k2 * dot(n, r0) / nd;
+    let dzdy = -k2 * dot(n, r1) / nd;
+    // uv = (x / 2 + 1/2, 1/2 - y / 2): dz/du = 2 dz/dx, dz/dv = -2 dz/dy.
+    let dzduv = vec2<f32>(2.0 * dzdx, -2.0 * dzdy);
+    let o = 1.0 / size;
+    // One texel of the receiver's slope (the bilinear taps read up to a texel away) and
+    // a small constant.
+    let base = ndc.z - abs(dzduv.x) * o.x - abs(dzduv.y) * o.y - 0.0002;
     // Percentage-closer filtering: a 3×3 grid of bilinear comparison taps one texel
     // apart, tent-weighted (1 2 1): together a smooth 4×4-texel footprint whose edge
     // ramps over two texels, so shadow edges close to a camera show neither the
     // staircase of the map's texels nor the comb of a narrower filter.
-    let d = ndc.z - 0.002;
-    let o = 1.0 / size;
     var sum = 0.0;
     for (var j = -1; j <= 1; j = j + 1) {
         for (var k = -1; k <= 1; k = k + 1) {
             let w = f32((2 - abs(j)) * (2 - abs(k)));
-            let at = uv + vec2<f32>(f32(k) * o.x, f32(j) * o.y);
-            sum = sum + w * textureSampleCompareLevel(shadow_tex, shadow_smp, at, d);
+            let off = vec2<f32>(f32(k) * o.x, f32(j) * o.y);
+            let d = base + dot(dzduv, off);
+            sum = sum + w * textureSampleCompareLevel(shadow_tex, shadow_smp, uv + off, d);
         }
     }
     return sum / 16.0;

@@ -280,7 +280,7 @@ fn pipelines(
         color_writes: wgpu::ColorWrites::ALL,
         depth_bias: wgpu::DepthBiasState {
             constant: 2,
-            slope_scale: 2.0,
+            slope_scale: 1.0,
             clamp: 0.0,
         },
         samples: 1,
