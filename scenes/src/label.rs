@@ -441,7 +441,14 @@ mod tests {
 
     /// A real spec (thrown apple) whose observer stands at the origin facing +x.
     fn spec(object: &str) -> SceneSpec {
-        let catalog = Catalog::embedded().unwrap();
+        // A constructed throw may carry an object the catalog does not list for
+        // thrown_object (too small to be seen thrown from 5–8 m): the test places it.
+        let mut catalog = Catalog::embedded().unwrap();
+        for o in catalog.objects.iter_mut().filter(|o| o.id == object) {
+            if !o.families.iter().any(|f| f == "thrown_object") {
+                o.families.push("thrown_object".into());
+            }
+        }
         let config = Config::embedded().unwrap();
         let selection = Selection {
             family: "thrown_object".into(),
