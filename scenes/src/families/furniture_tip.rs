@@ -8,9 +8,9 @@
 //!
 //! Timing (label rule v2): the piece starts only 0.006–0.02 rad past balance with a gentle
 //! push (a heavy, tall piece starts just far enough past it that even the slowest band's
-//! top travels 0.1 m in the observation window), so its fall starts slowly (an inverted pendulum grows like `e^{λt}`), and the
-//! observer stands where only the late part of the fall reaches: beyond the front face's
-//! reach at the angle the fastest band's piece has fallen to 1 s after t0 (integrated from
+//! top travels 0.1 m in the observation window), so its fall starts slowly (an inverted
+//! pendulum grows like `e^{λt}`), and the observer stands where only the late part of the
+//! fall reaches: beyond the front face's reach at the angle the fastest band's piece has fallen to 1 s after t0 (integrated from
 //! the rigid body's equation of motion about its edge, `φ'' = (g r_c / k²) sin φ`).
 //!
 //! Labels: nearly always DODGE. Every catalog piece but the styrofoam TV is heavy
@@ -103,10 +103,9 @@ pub const MIN_TOP_TRAVEL_M: f64 = 0.1;
 /// [`MIN_TOP_TRAVEL_M`] (bisection on [`tilt_after`]).
 pub fn least_past_balance(object: &Object, speed: f64) -> f64 {
     let height = top_offset(object) + bottom_offset(object);
-    let travel = |past: f64| {
-        let (_, balance) = front_edge(object);
-        (tilt_after(object, past, speed / height, WINDOW_S) - balance - past) * height
-    };
+    let (_, balance) = front_edge(object);
+    let travel =
+        |past: f64| (tilt_after(object, past, speed / height, WINDOW_S) - balance - past) * height;
     if travel(0.0) >= MIN_TOP_TRAVEL_M {
         return 0.0;
     }
