@@ -10,8 +10,9 @@
 //! push (a heavy, tall piece starts just far enough past it that even the slowest band's
 //! top travels 0.1 m in the observation window), so its fall starts slowly (an inverted
 //! pendulum grows like `e^{λt}`), and the observer stands where only the late part of the
-//! fall reaches: beyond the front face's reach at the angle the fastest band's piece has fallen to 1 s after t0 (integrated from
-//! the rigid body's equation of motion about its edge, `φ'' = (g r_c / k²) sin φ`).
+//! fall reaches: beyond the front face's reach at the angle the fastest band's piece has
+//! fallen to 1 s after t0 (integrated from the rigid body's equation of motion about its
+//! edge, `φ'' = (g r_c / k²) sin φ`).
 //!
 //! Labels: nearly always DODGE. Every catalog piece but the styrofoam TV is heavy
 //! (bookcases, wardrobes, fridges, mirrors: 5–80 kg), and a toppling one must be dodged;
