@@ -472,23 +472,43 @@ fn kettle(m: &mut Mesh, k: &Kit) {
         8,
         &solid(mat([1.0, 0.45, 0.1, 0.0], MAT_EMISSIVE)),
     );
+    // A big dark handle arching from the lid to the base and a thick spout rising from
+    // the body's front, with steam above it: what makes a kettle read as a kettle.
     m.torus(
-        &Xf::rot(0, FRAC_PI_2, [-rk * 0.75, 0.0, 0.0]),
-        hh * 0.55,
-        rk * 0.1,
+        &Xf::rot(0, FRAC_PI_2, [-rk * 0.8, 0.0, 0.0]),
+        hh * 0.62,
+        rk * 0.17,
         FRAC_PI_2,
         PI * 1.5,
-        12,
+        14,
         &solid(s),
     );
     m.rod(
         &id,
-        [rk * 0.7, 0.0, -hh * 0.3],
-        [rk * 1.3, 0.0, hh * 0.35],
-        rk * 0.1,
-        8,
+        [rk * 0.6, 0.0, -hh * 0.35],
+        [rk * 1.25, 0.0, hh * 0.2],
+        rk * 0.24,
+        12,
         &solid(mat(c, MAT_GLOSSY)),
     );
+    m.rod(
+        &id,
+        [rk * 1.2, 0.0, hh * 0.15],
+        [rk * 1.5, 0.0, hh * 0.5],
+        rk * 0.15,
+        10,
+        &solid(mat(c, MAT_GLOSSY)),
+    );
+    let steam = solid(mat([0.93, 0.95, 0.97, 0.0], MAT_EMISSIVE));
+    for (i, r) in [0.13f32, 0.17, 0.21].iter().enumerate() {
+        let up = hh * (0.72 + 0.3 * i as f32);
+        m.sphere(
+            &Xf::at([rk * (1.55 + 0.12 * i as f32), 0.0, up]),
+            rk * r,
+            10,
+            &steam,
+        );
+    }
 }
 
 fn iron(m: &mut Mesh, k: &Kit) {
